@@ -1,0 +1,33 @@
+"""assistive-compiler: assistive-robotics tasks as YAML specs, compiled to URDF scenes and run in
+PyBullet behind Gymnasium.
+
+Importing the package is light (no pybullet, no training libraries): it registers the shipped
+tasks' Gymnasium ids and exposes :func:`make`. Heavy modules load when first used.
+"""
+
+from __future__ import annotations
+
+__version__ = "0.1.0"
+
+__all__ = ["__version__", "make", "compile_task", "load_spec"]
+
+
+def load_spec(path):
+    """Load and validate a task spec (see :func:`assistive_compiler.spec.load.load_spec`)."""
+    from .spec.load import load_spec as _load
+
+    return _load(path)
+
+
+def compile_task(spec_path, robot=None, out_dir=None, **kwargs):
+    """Compile a task spec for a robot (see :func:`assistive_compiler.compile.compiler.compile_task`)."""
+    from .compile.compiler import compile_task as _compile
+
+    return _compile(spec_path, robot, out_dir, **kwargs)
+
+
+def make(spec, robot=None, **kwargs):
+    """A Gymnasium env for the task spec at ``spec`` (a path) and ``robot``."""
+    from .runtime.env import AssistiveEnv
+
+    return AssistiveEnv.from_spec(spec, robot=robot, **kwargs)

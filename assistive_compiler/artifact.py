@@ -1,0 +1,201 @@
+"""The compiled artifact: the contract between the compiler (writes it) and the runtime (reads it).
+
+An artifact is a directory::
+
+    manifest.json          this model, serialised with sorted keys
+    urdf/<body>.urdf       one standard URDF per body (person variants: person_<variant>.urdf)
+
+Everything the runtime needs is here, already decided: body files and poses, the person's
+posture and which joints move, the robot's arm joints and precomputed start configurations,
+tool attachments, targets, particles with their settled positions, and the observation, reward
+and success programs with references normalised to URDF link and joint names. The runtime never
+reads YAML and never searches (no IK at reset).
+
+Frames and units: positions in metres in the world frame unless a field says otherwise;
+orientations are quaternions (x, y, z, w) as pybullet uses; joint values in radians.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+FORMAT_VERSION = 1
+
+Vec3 = tuple[float, float, float]
+Quat = tuple[float, float, float, float]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Body(_Model):
+    """One body loaded into the world."""
+
+    name: str = Field(description="Body name used in references (robot, person_<variant>, spoon, table, ...).")
+    kind: Literal["robot", "person", "furniture", "tool"] = Field(description="What the body is.")
+    urdf: str = Field(description="URDF path relative to the artifact directory.")
+    position: Vec3 = Field(description="Base position, world frame, m.")
+    orientation: Quat = Field(description="Base orientation, world frame.")
+    fixed_base: bool = Field(description="Loaded with useFixedBase.")
+    gravity: float | None = Field(description="Gravity on this body, m/s² along z (None: the world's).")
+    friction: float | None = Field(None, description="Lateral friction of every link (None: URDF value).")
+    position_noise: Vec3 = Field((0.0, 0.0, 0.0), description="Per-reset uniform position noise half-widths, m.")
+
+
+class PersonVariant(_Model):
+    """One person body the task may draw at reset."""
+
+    name: str = Field(description="Variant (library person) name.")
+    body: str = Field(description="Body name of this variant in ``bodies``.")
+    sex: Literal["male", "female"] = Field(description="Body model.")
+    mass_kg: float = Field(description="Total mass, kg.")
+    standing_height_m: float = Field(description="Standing height at zero joint angles, m.")
+    movable_joints: list[str] = Field(description="Joints left revolute (the rest are baked into the URDF).")
+    initial_angles: dict[str, float] = Field(description="Initial angle of each movable joint, rad.")
+    randomize: dict[str, tuple[float, float]] = Field(description="Per-reset uniform angle ranges, rad.")
+    target_offsets: dict[str, Vec3] = Field(description="Offset of each person-attached target in its link, m.")
+    start_configurations: list[list[float]] = Field(description="Robot arm start configurations for this variant, rad.")
+    start_tool_positions: list[Vec3] = Field(description="Tool position each start configuration reaches, m.")
+
+
+class Person(_Model):
+    """The person: variants, control and impairments."""
+
+    variants: list[PersonVariant] = Field(description="Bodies one of which is active per episode.")
+    policy_joints: list[str] = Field(description="Joints a human policy controls (co-optimisation action order).")
+    position_gain: float = Field(description="Gain of policy-controlled joints.")
+    max_force: float = Field(description="Force limit of policy-controlled joints, N·m.")
+    hold_gain: float = Field(description="Gain holding the non-policy movable joints at their initial angles.")
+    hold_force: float = Field(description="Force limit of that hold, N·m.")
+    compliant_joints: list[str] = Field(description="Joints held compliantly (static-person task).")
+    compliant_gain: float = Field(0.0, description="Gain of the compliant hold.")
+    compliant_force: float = Field(0.0, description="Force of the compliant hold, N·m.")
+    impairments: list[dict[str, Any]] = Field(description="Impairment choices (spec form, angles in rad).")
+
+
+class Robot(_Model):
+    """The robot: which joints act, links by role, control, gripper."""
+
+    name: str = Field(description="Library robot name.")
+    title: str = Field(description="Display name.")
+    body: str = Field("robot", description="Body name.")
+    arm_joints: list[str] = Field(description="Controlled joints in action order.")
+    joint_lower: list[float] = Field(description="Lower limit per arm joint, rad.")
+    joint_upper: list[float] = Field(description="Upper limit per arm joint, rad.")
+    links: dict[str, str] = Field(description="Semantic link name → URDF link name.")
+    action_scale: float = Field(description="Target change per unit action per physics step, rad.")
+    position_gain: float = Field(description="Arm position gain.")
+    max_force: float = Field(description="Arm force limit, N·m.")
+    gripper_joints: list[str] = Field(description="Gripper joints, held at gripper_position.")
+    gripper_position: float = Field(description="Gripper joint target (rad or m).")
+
+
+class ToolAttachment(_Model):
+    """A tool fixed to a robot link by a constraint."""
+
+    body: str = Field(description="Tool body name.")
+    parent_link: str = Field(description="Robot link it is attached to.")
+    position: Vec3 = Field(description="Tool frame origin in the parent link frame, m.")
+    orientation: Quat = Field(description="Tool frame orientation in the parent link frame.")
+    links: dict[str, str] = Field(description="Semantic → URDF link names of the tool.")
+
+
+class Target(_Model):
+    """A named point on a body (per-variant offsets for the person live in PersonVariant)."""
+
+    body: str = Field(description="Body name ('person' means the active variant).")
+    link: str = Field(description="URDF link name.")
+    offset: Vec3 = Field(description="Offset in the link frame, m (for the person: the first variant's).")
+    show_rgba: tuple[float, float, float, float] | None = Field(None, description="Marker colour for renders.")
+
+
+class ParticleSet(_Model):
+    """Small spheres with a lifecycle: active → consumed | lost; first contact with hit_body counts once."""
+
+    name: str = Field(description="Set name.")
+    count: int = Field(description="Number of particles.")
+    radius: float = Field(description="Radius, m.")
+    mass: float = Field(description="Mass of one particle, kg.")
+    attach: str = Field(description="Body whose reference frame the start positions are in.")
+    attach_link: str = Field(description="URDF link of that body.")
+    start_positions: list[Vec3] = Field(description="Settled positions in the attach link frame, m.")
+    colors: list[tuple[float, float, float, float]] = Field(description="RGBA per particle.")
+    consumed_target: str | None = Field(description="Target that consumes particles.")
+    consumed_radius: float = Field(0.0, description="Consumption radius, m.")
+    lost_body: str | None = Field(description="Body a particle must stay near.")
+    lost_link: str | None = Field(None, description="URDF link of that body (closest-points query).")
+    lost_distance: float = Field(0.0, description="Distance beyond which it is lost, m.")
+    hit_body: str | None = Field(description="Body whose first contact with an active particle is a hit.")
+
+
+class TermUse(_Model):
+    """A bound term: registered kind, normalised parameters, weight."""
+
+    name: str = Field(description="Name in info.")
+    term: str = Field(description="Registered term kind.")
+    category: Literal["reward", "observation", "preference"] = Field(description="Registry category.")
+    weight: float = Field(description="Weight (1 for observations).")
+    params: dict[str, Any] = Field(description="Parameters with normalised references.")
+    size: int = Field(1, description="Number of floats it produces (observations).")
+
+
+class Success(_Model):
+    """Success: aggregate of a reward term's value ≥ threshold (absolute)."""
+
+    term: str = Field(description="Reward term name.")
+    aggregate: Literal["sum", "max", "min", "last"] = Field(description="Aggregation over the episode.")
+    threshold: float = Field(description="Absolute threshold.")
+
+
+class Sim(_Model):
+    """World physics and timing."""
+
+    time_step: float = Field(description="Physics step, s.")
+    frame_skip: int = Field(description="Physics steps per env step.")
+    episode_steps: int = Field(description="Env steps per episode.")
+    gravity: float = Field(description="World gravity along z, m/s².")
+    sub_steps: int = Field(description="Solver sub-steps.")
+    solver_iterations: int = Field(description="Solver iterations.")
+    ground_friction: tuple[float, float] = Field(description="Floor friction, uniform [low, high] per reset.")
+
+
+class Manifest(_Model):
+    """The whole artifact description."""
+
+    format_version: int = Field(FORMAT_VERSION, description="Artifact format version.")
+    task: str = Field(description="Task name.")
+    title: str = Field(description="Task title.")
+    robot_name: str = Field(description="Robot compiled for.")
+    gym_id: str = Field(description="Gymnasium id of this (task, robot).")
+    input_hash: str = Field(description="sha256 of every input (spec files, parts, templates, compiler source).")
+    content_hash: str = Field("", description="sha256 of the output files (URDFs and manifest minus this field).")
+    sources: list[str] = Field(description="Spec and part files this was compiled from.")
+    sim: Sim
+    bodies: list[Body]
+    person: Person
+    robot: Robot
+    tools: list[ToolAttachment]
+    targets: dict[str, Target]
+    particles: list[ParticleSet]
+    joint_groups: dict[str, dict[str, Any]] = Field(description="Joint groups by reference name.")
+    observations: dict[str, list[TermUse]] = Field(description="Observation features per agent, in order.")
+    reward: list[TermUse] = Field(description="Reward terms including preference costs.")
+    success: Success
+
+    def body(self, name: str) -> Body:
+        for b in self.bodies:
+            if b.name == name:
+                return b
+        raise KeyError(name)
+
+    def to_json(self) -> str:
+        return json.dumps(self.model_dump(mode="json"), indent=1, sort_keys=True) + "\n"
+
+    @classmethod
+    def read(cls, artifact_dir: str | Path) -> "Manifest":
+        return cls.model_validate_json(Path(artifact_dir, "manifest.json").read_text())

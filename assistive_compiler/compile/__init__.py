@@ -1,0 +1,1 @@
+"""Compilation: render templates, lint what is written, emit the artifact."""

@@ -1,0 +1,113 @@
+"""Rendering xacro templates to URDF text, deterministically, and reading what a URDF declares."""
+
+from __future__ import annotations
+
+import math
+import re
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Mapping
+
+import xacro
+
+from ..errors import SpecError
+from ..paths import display, templates_dir
+
+_BANNER = re.compile(r"<!--\s*=+\s*-->\s*<!--.*?-->\s*<!--.*?-->\s*<!--\s*=+\s*-->\s*", re.S)
+
+
+def format_param(value: object) -> str:
+    """A template parameter as the string xacro receives (floats in shortest round-trip form)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(float(value))
+    return str(value)
+
+
+def render_template(relpath: str, params: Mapping[str, object]) -> str:
+    """Render ``templates/<relpath>`` with ``params``; the same inputs give the same bytes."""
+    return _render_cached(relpath, tuple(sorted((k, format_param(v)) for k, v in params.items())))
+
+
+@lru_cache(maxsize=256)
+def _render_cached(relpath: str, params: tuple[tuple[str, str], ...]) -> str:
+    path = templates_dir() / relpath
+    if not path.is_file():
+        raise SpecError.at(display(path), "template not found")
+    declared = set(_declared_args(path))
+    unknown = [k for k, _ in params if k not in declared]
+    if unknown:
+        from ..errors import did_you_mean
+
+        raise SpecError.at(
+            display(path),
+            f"template has no parameter '{unknown[0]}'; it declares {', '.join(sorted(declared)) or 'none'}"
+            + did_you_mean(unknown[0], declared),
+        )
+    try:
+        doc = xacro.process_file(str(path), mappings=dict(params))
+    except Exception as exc:  # xacro raises plain Exceptions (XacroException, NameError, ...)
+        raise SpecError.at(display(path), f"template failed to render: {exc}") from None
+    text = doc.toprettyxml(indent="  ")
+    return _BANNER.sub("", text, count=1)
+
+
+@lru_cache(maxsize=64)
+def _declared_args(path: Path) -> tuple[str, ...]:
+    root = ET.parse(path).getroot()
+    ns = "{http://www.ros.org/wiki/xacro}"
+    return tuple(el.get("name", "") for el in root.iter(f"{ns}arg"))
+
+
+@dataclass(frozen=True)
+class JointInfo:
+    """A URDF joint: type, parent/child links, limits (radians or metres; None when absent)."""
+
+    name: str
+    type: str
+    parent: str
+    child: str
+    lower: float | None
+    upper: float | None
+    axis: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class UrdfInfo:
+    """Names declared by a URDF, for cross-reference checks."""
+
+    root_link: str
+    links: tuple[str, ...]
+    joints: dict[str, JointInfo]
+
+    @property
+    def movable_joints(self) -> dict[str, JointInfo]:
+        return {n: j for n, j in self.joints.items() if j.type in ("revolute", "prismatic", "continuous")}
+
+
+def urdf_info(urdf_xml: str) -> UrdfInfo:
+    """Link and joint names (and joint limits) declared by ``urdf_xml``."""
+    root = ET.fromstring(urdf_xml)
+    links = tuple(el.get("name", "") for el in root.findall("link"))
+    joints: dict[str, JointInfo] = {}
+    children: set[str] = set()
+    for el in root.findall("joint"):
+        limit = el.find("limit")
+        axis_el = el.find("axis")
+        axis = tuple(float(v) for v in axis_el.get("xyz", "1 0 0").split()) if axis_el is not None else (1.0, 0.0, 0.0)
+        jtype = el.get("type", "")
+        lower = upper = None
+        if limit is not None and jtype in ("revolute", "prismatic"):
+            lower, upper = float(limit.get("lower", "0")), float(limit.get("upper", "0"))
+        if jtype == "continuous":
+            lower, upper = -math.inf, math.inf
+        child = el.find("child").get("link", "")  # type: ignore[union-attr]
+        children.add(child)
+        joints[el.get("name", "")] = JointInfo(
+            el.get("name", ""), jtype, el.find("parent").get("link", ""), child, lower, upper, axis  # type: ignore[union-attr]
+        )
+    roots = [l for l in links if l not in children]
+    return UrdfInfo(roots[0] if roots else "", links, joints)

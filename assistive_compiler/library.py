@@ -1,0 +1,150 @@
+"""The part library: robots, tools, furniture and people under ``specs/<kind>/<name>.yaml``.
+
+Parts are loaded lazily by name with located errors, and each part's semantic names are checked
+against its rendered URDF. Users can add a directory of their own parts with the same layout
+(``Library([their_dir, *default])``); the first directory that has a part wins.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+from typing import Generic, TypeVar
+
+from pydantic import BaseModel, ValidationError
+
+from .compile.render import UrdfInfo, render_template, urdf_info
+from .errors import Problem, SpecError
+from .paths import display, specs_dir
+from .spec.parts import FurniturePart, PersonPart, RobotPart, ToolPart
+from .spec.validation import problems_from_validation
+from .yamlsrc import load_located
+
+P = TypeVar("P", bound=BaseModel)
+
+PERSON_TEMPLATE_RELPATH = "person/person.urdf.xacro"
+
+KINDS: dict[str, type[BaseModel]] = {
+    "robots": RobotPart,
+    "tools": ToolPart,
+    "furniture": FurniturePart,
+    "people": PersonPart,
+}
+
+
+@dataclass(frozen=True)
+class LoadedPart(Generic[P]):
+    """A validated part, the file it came from, and (for template parts) its default render."""
+
+    part: P
+    path: Path
+    smap: object
+
+    @property
+    def shown(self) -> str:
+        return display(self.path)
+
+
+class Library:
+    """Parts by kind and name, from one or more directories laid out like ``specs/``."""
+
+    def __init__(self, roots: list[Path] | None = None):
+        self.roots = [Path(r) for r in (roots or [specs_dir()])]
+        self._cache: dict[tuple[str, str], LoadedPart] = {}
+
+    def names(self, kind: str) -> list[str]:
+        """All part names of ``kind`` (e.g. 'robots')."""
+        found: set[str] = set()
+        for root in self.roots:
+            found.update(p.stem for p in (root / kind).glob("*.yaml"))
+        return sorted(found)
+
+    def path_of(self, kind: str, name: str) -> Path | None:
+        for root in self.roots:
+            candidate = root / kind / f"{name}.yaml"
+            if candidate.is_file():
+                return candidate
+        return None
+
+    def get(self, kind: str, name: str) -> LoadedPart:
+        """The part ``name`` of ``kind``; raises :class:`SpecError` located in the part's file."""
+        key = (kind, name)
+        if key not in self._cache:
+            path = self.path_of(kind, name)
+            if path is None:
+                raise KeyError(name)
+            data, smap = load_located(path, display_path=display(path))
+            model = KINDS[kind]
+            try:
+                part = model.model_validate(data)
+            except ValidationError as exc:
+                raise SpecError(problems_from_validation(exc, data, smap, model)) from None
+            if getattr(part, "name", name) != name:
+                raise SpecError([Problem(smap.value(("name",)), f"part name '{part.name}' must match its file name '{name}'")])
+            loaded = LoadedPart(part, path, smap)
+            self._check_semantics(kind, loaded)
+            self._cache[key] = loaded
+        return self._cache[key]
+
+    def default_urdf(self, kind: str, name: str) -> UrdfInfo:
+        """Links and joints of the part rendered with its own parameters."""
+        return self._urdf_of(kind, self.get(kind, name))
+
+    def _urdf_of(self, kind: str, loaded: LoadedPart) -> UrdfInfo:
+        part = loaded.part
+        if kind == "people":
+            from .person.body import body_measurements
+
+            m = body_measurements(part.sex, part.mass_kg, part.height_scale, part.radius_scale)
+            return urdf_info(render_template(PERSON_TEMPLATE_RELPATH, m.xacro_args()))
+        if getattr(part, "urdf", None):
+            path = (loaded.path.parent / part.urdf).resolve()
+            return urdf_info(path.read_text())
+        params = dict(part.template.params) | dict(getattr(part, "mount_params", {}) or {})
+        return urdf_info(render_template(part.template.path, params))
+
+    def _check_semantics(self, kind: str, loaded: LoadedPart) -> None:
+        """Every URDF name a part declares must exist in the URDF it renders."""
+        if kind == "people":
+            return
+        part = loaded.part
+        smap = loaded.smap
+        if getattr(part, "urdf", None):
+            urdf_path = (loaded.path.parent / part.urdf).resolve()
+            if not urdf_path.is_file():
+                raise SpecError([Problem(smap.value(("urdf",)), f"URDF file not found: {urdf_path}")])
+        info = self._urdf_of(kind, loaded)
+        links, joints = set(info.links), set(info.joints)
+        problems: list[Problem] = []
+
+        def need(value: str | None, pool: set[str], what: str, at: tuple) -> None:
+            from .errors import did_you_mean
+
+            if value is not None and value not in pool:
+                problems.append(Problem(smap.value(at), f"{what} '{value}' is not in the URDF{did_you_mean(value, pool)}"))
+
+        need(part.base_link, links, "link", ("base_link",))
+        if info.root_link and part.base_link in links and part.base_link != info.root_link:
+            problems.append(Problem(smap.value(("base_link",)), f"base_link '{part.base_link}' is not the URDF root link '{info.root_link}'"))
+        for sem, link in getattr(part, "links", {}).items():
+            need(link, links, "link", ("links", sem))
+        for attr in ("seat_link", "mount_link"):
+            need(getattr(part, attr, None), links, "link", (attr,))
+        if isinstance(part, RobotPart):
+            for side, arm in part.arms.items():
+                for i, j in enumerate(arm.joints):
+                    need(j, joints, "joint", ("arms", side, "joints", i))
+                need(arm.end_effector, links, "link", ("arms", side, "end_effector"))
+                need(arm.tool_mount, links, "link", ("arms", side, "tool_mount"))
+            for side, grip in part.gripper.items():
+                for i, j in enumerate(grip.joints):
+                    need(j, joints, "joint", ("gripper", side, "joints", i))
+        if isinstance(part, ToolPart) and part.reference_link not in part.links:
+            problems.append(Problem(smap.value(("reference_link",)), f"reference_link '{part.reference_link}' is not one of links {sorted(part.links)}"))
+        if problems:
+            raise SpecError(problems)
+
+    @cached_property
+    def everything(self) -> dict[str, list[str]]:
+        return {kind: self.names(kind) for kind in KINDS}

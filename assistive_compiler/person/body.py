@@ -1,0 +1,496 @@
+"""The parametric human body model: a person description -> the person template's xacro args.
+
+Units are metres, kilograms and radians (degrees only where a name says ``_deg``). Frames follow
+the templates' convention: Z-up, the person faces -Y and their right side is -X. The body is a
+fixed-base tree rooted at link ``chest`` (the reference's base); at zero joint angles it stands
+upright. Every landmark link's frame is at its joint centre (e.g. ``right_elbow`` at the elbow).
+
+The numbers are the reference's (Assistive Gym ``human_creation.py``, facts section 3.1): the male
+and female segment tables (radius ``r``, capsule cylinder length ``L``, offsets), scaled by
+``radius_scale`` (radii) and ``height_scale`` (lengths and vertical offsets; a few lateral offsets
+and the head are not scaled, as in the reference), and the mass fractions.
+
+This module is pure Python (no pybullet); the template renders with ``xacro`` alone.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Literal, Mapping, NamedTuple
+
+__all__ = [
+    "PERSON_TEMPLATE",
+    "ROOT_LINK",
+    "JOINT_NAMES",
+    "REVOLUTE_JOINTS",
+    "LINK_NAMES",
+    "LANDMARKS",
+    "JOINT_GROUPS",
+    "JOINT_AXES",
+    "JOINT_LIMITS_DEG",
+    "LIMIT_SCALED_JOINTS",
+    "MASS_FRACTIONS",
+    "DEFAULT_MASS_KG",
+    "CollisionGroup",
+    "SELF_COLLISION_GROUPS",
+    "self_collision_pairs",
+    "BodyMeasurements",
+    "body_measurements",
+    "format_fixed_joints",
+    "TEMPLATE_ARGS",
+]
+
+Sex = Literal["male", "female"]
+
+
+def _templates_dir() -> Path:
+    """The ``templates/`` directory: the repository root in a checkout, or next to the package
+    when installed (``<site-packages>/templates`` or ``assistive_compiler/_data/templates``)."""
+    here = Path(__file__).resolve()
+    candidates = (
+        here.parents[2] / "templates",
+        here.parents[1] / "templates",
+        here.parents[1] / "_data" / "templates",
+    )
+    for candidate in candidates:
+        if (candidate / "person" / "person.urdf.xacro").is_file():
+            return candidate
+    return candidates[0]
+
+
+#: The person xacro template.
+PERSON_TEMPLATE: Path = _templates_dir() / "person" / "person.urdf.xacro"
+
+#: The root (base) link.
+ROOT_LINK = "chest"
+
+#: All 42 joints in the reference's depth-first order: pybullet joint index k == reference index
+#: k (index 24, ``stomach``, is the only fixed one).
+JOINT_NAMES: tuple[str, ...] = (
+    "right_pecs_x", "right_pecs_y", "right_pecs_z",
+    "right_shoulder_x", "right_shoulder_y", "right_shoulder_z",
+    "right_elbow", "right_forearm", "right_wrist_x", "right_wrist_y",
+    "left_pecs_x", "left_pecs_y", "left_pecs_z",
+    "left_shoulder_x", "left_shoulder_y", "left_shoulder_z",
+    "left_elbow", "left_forearm", "left_wrist_x", "left_wrist_y",
+    "neck", "head_x", "head_y", "head_z",
+    "stomach",
+    "waist_x", "waist_y", "waist_z",
+    "right_hip_x", "right_hip_y", "right_hip_z", "right_knee",
+    "right_ankle_x", "right_ankle_y", "right_ankle_z",
+    "left_hip_x", "left_hip_y", "left_hip_z", "left_knee",
+    "left_ankle_x", "left_ankle_y", "left_ankle_z",
+)
+
+#: The 41 revolute joints (every joint but ``stomach``), in index order.
+REVOLUTE_JOINTS: tuple[str, ...] = tuple(j for j in JOINT_NAMES if j != "stomach")
+
+#: Landmark joint -> the link that carries the landmark name, for joints whose child link is not
+#: ``<joint>_link``. (The landmark link is the last link of its joint group.)
+_LANDMARK_CHILD: dict[str, str] = {
+    "right_pecs_z": "right_pecs", "right_shoulder_z": "right_shoulder", "right_forearm": "right_elbow",
+    "right_wrist_y": "right_wrist", "left_pecs_z": "left_pecs", "left_shoulder_z": "left_shoulder",
+    "left_forearm": "left_elbow", "left_wrist_y": "left_wrist", "neck": "neck", "head_z": "head",
+    "stomach": "stomach", "waist_z": "waist", "right_hip_z": "right_hip", "right_knee": "right_knee",
+    "right_ankle_z": "right_ankle", "left_hip_z": "left_hip", "left_knee": "left_knee",
+    "left_ankle_z": "left_ankle",
+}
+
+#: Child link of each joint, in joint order (so pybullet link index k is ``LINK_NAMES[k]``).
+LINK_NAMES: tuple[str, ...] = tuple(_LANDMARK_CHILD.get(j, f"{j}_link") for j in JOINT_NAMES)
+
+#: The landmark links specs may refer to. Each frame is at its joint centre.
+LANDMARKS: tuple[str, ...] = (
+    "chest",
+    "right_pecs", "right_shoulder", "right_elbow", "right_wrist",
+    "left_pecs", "left_shoulder", "left_elbow", "left_wrist",
+    "neck", "head", "stomach", "waist",
+    "right_hip", "right_knee", "right_ankle",
+    "left_hip", "left_knee", "left_ankle",
+)
+
+#: The reference's joint groups (its ``*_joints`` lists), by joint name.
+JOINT_GROUPS: dict[str, tuple[str, ...]] = {
+    "right_arm": JOINT_NAMES[0:10],
+    "left_arm": JOINT_NAMES[10:20],
+    "head": JOINT_NAMES[20:24],
+    "waist": JOINT_NAMES[25:28],
+    "right_leg": JOINT_NAMES[28:35],
+    "left_leg": JOINT_NAMES[35:42],
+}
+
+#: Rotation axis (in the joint frame) of each revolute joint. Note shoulder_x turns about y and
+#: shoulder_y about x, as in the reference.
+JOINT_AXES: dict[str, Literal["x", "y", "z"]] = {}
+for _j in REVOLUTE_JOINTS:
+    if _j.endswith(("_elbow", "_knee")) or _j == "neck":
+        JOINT_AXES[_j] = "x"
+    elif _j.endswith("_forearm"):
+        JOINT_AXES[_j] = "z"
+    elif _j.endswith("_shoulder_x"):
+        JOINT_AXES[_j] = "y"
+    elif _j.endswith("_shoulder_y"):
+        JOINT_AXES[_j] = "x"
+    else:
+        JOINT_AXES[_j] = _j[-1]  # type: ignore[assignment]
+del _j
+
+#: Pose-independent joint limits in degrees (facts 3.2); the template emits the same in radians.
+JOINT_LIMITS_DEG: dict[str, tuple[float, float]] = {
+    "right_pecs_x": (-10, 10), "right_pecs_y": (-10, 30), "right_pecs_z": (-35, 35),
+    "right_shoulder_x": (5, 198), "right_shoulder_y": (-188, 61), "right_shoulder_z": (-90, 90),
+    "right_elbow": (-128, 0), "right_forearm": (-90, 90), "right_wrist_x": (-81, 90), "right_wrist_y": (-27, 47),
+    "left_pecs_x": (-10, 10), "left_pecs_y": (-30, 10), "left_pecs_z": (-35, 35),
+    "left_shoulder_x": (-198, -5), "left_shoulder_y": (-188, 61), "left_shoulder_z": (-90, 90),
+    "left_elbow": (-128, 0), "left_forearm": (-90, 90), "left_wrist_x": (-81, 90), "left_wrist_y": (-47, 27),
+    "neck": (-10, 20), "head_x": (-50, 50), "head_y": (-34, 34), "head_z": (-70, 70),
+    "waist_x": (-75, 30), "waist_y": (-30, 30), "waist_z": (-30, 30),
+    "right_hip_x": (-127, 30), "right_hip_y": (-40, 45), "right_hip_z": (-45, 40), "right_knee": (0, 130),
+    "right_ankle_x": (-35, 38), "right_ankle_y": (-23, 24), "right_ankle_z": (-43, 35),
+    "left_hip_x": (-127, 30), "left_hip_y": (-45, 40), "left_hip_z": (-40, 45), "left_knee": (0, 130),
+    "left_ankle_x": (-35, 38), "left_ankle_y": (-24, 23), "left_ankle_z": (-35, 43),
+}
+
+#: Joints whose limits the reference's limited-range-of-motion impairment multiplies by gamma
+#: (reference indices 0-23: both arms, neck and head; not the waist or legs).
+LIMIT_SCALED_JOINTS: tuple[str, ...] = JOINT_NAMES[0:24]
+
+#: Fraction of the body mass per segment (facts 3.1; sums to 1). ``abdomen`` is the reference's
+#: link 26 (waist_y) mass; ``hips`` is the ``waist`` link's capsule.
+MASS_FRACTIONS: dict[str, float] = {
+    "chest": 0.10, "pecs": 0.05, "neck": 0.01, "head": 0.07,
+    "upper_arm": 0.033, "forearm": 0.019, "hand": 0.0065,
+    "abdomen": 0.13, "hips": 0.14,
+    "thigh": 0.105, "shin": 0.0475, "foot": 0.014,
+}
+# Segments that exist twice (left and right).
+_PAIRED = frozenset({"pecs", "upper_arm", "forearm", "hand", "thigh", "shin", "foot"})
+
+#: The reference's default masses (config.ini), kg.
+DEFAULT_MASS_KG: dict[str, float] = {"male": 78.4, "female": 62.5}
+
+#: Mouth point in the ``head`` link frame (reference feeding/drinking), metres.
+_MOUTH_OFFSET: dict[str, tuple[float, float, float]] = {
+    "male": (0.0, -0.11, 0.03),
+    "female": (0.0, -0.10, 0.03),
+}
+
+
+class CollisionGroup(NamedTuple):
+    """Self-collision is enabled between every link of ``links`` and every link of ``against``."""
+
+    links: tuple[str, ...]
+    against: tuple[str, ...]
+
+
+def _links(first: int, last: int) -> tuple[str, ...]:
+    """Links of reference indices first..last inclusive (-1 is the root, ``chest``)."""
+    return tuple(ROOT_LINK if i < 0 else LINK_NAMES[i] for i in range(first, last + 1))
+
+
+#: Self-collision groups (facts 3.3). The body is loaded with self-collision on, every link pair
+#: is disabled, and only these pairs are re-enabled; torso, head and shoulder girdles never
+#: collide with each other.
+SELF_COLLISION_GROUPS: dict[str, CollisionGroup] = {
+    "right_arm": CollisionGroup(_links(3, 9), _links(-1, -1) + _links(10, 41)),
+    "left_arm": CollisionGroup(_links(13, 19), _links(-1, 9) + _links(20, 41)),
+    "right_leg": CollisionGroup(_links(28, 34), _links(-1, 23) + _links(35, 41)),
+    "left_leg": CollisionGroup(_links(35, 41), _links(-1, 23) + _links(28, 34)),
+}
+
+
+def self_collision_pairs() -> frozenset[tuple[str, str]]:
+    """Every enabled self-collision link pair, each as a name-sorted tuple."""
+    pairs: set[tuple[str, str]] = set()
+    for group in SELF_COLLISION_GROUPS.values():
+        for a in group.links:
+            for b in group.against:
+                if a != b:
+                    pairs.add((a, b) if a < b else (b, a))
+    return frozenset(pairs)
+
+
+# ----------------------------------------------------------------------------------------------
+# Segment tables. Each entry: (value at scale 1, scaling): "r" x radius_scale, "h" x height_scale,
+# None unscaled (as in the reference: chest/pecs/waist/hips capsule lengths, lateral gaps, the
+# ankle offset, the foot's forward offset and the head).
+# ----------------------------------------------------------------------------------------------
+_Scaling = Literal["r", "h"] | None
+
+_TABLES: dict[str, dict[str, tuple[float, _Scaling]]] = {
+    "male": {
+        "chest_radius": (0.127, "r"), "chest_length": (0.056, None),
+        "pecs_radius": (0.106, "r"), "pecs_length": (0.253 / 8, None),
+        "pecs_offset": (0.253 / 2.5 - 0.253 / 16, None), "pecs_height": (0.1415, "h"),
+        "neck_radius": (0.06, "r"), "neck_length": (0.124, "h"),
+        "neck_height": (0.1515, "h"), "neck_offset": (0.2565 - 0.1415 - 0.025, "h"),
+        "head_height": (0.399 - 0.1415 - 0.1205, "h"),
+        "upper_arm_radius": (0.043, "r"), "upper_arm_length": (0.279, "h"),
+        "forearm_radius": (0.033, "r"), "forearm_length": (0.257, "h"),
+        "hand_radius": (0.043, "r"),
+        "waist_radius": (0.1205, "r"), "waist_length": (0.049, None), "waist_drop": (0.156, "h"),
+        "hips_radius": (0.1335, "r"), "hips_length": (0.094, None), "hips_drop": (0.08125, "h"),
+        "thigh_radius": (0.08, "r"), "thigh_length": (0.424, "h"),
+        "shin_radius": (0.05, "r"), "shin_length": (0.403, "h"), "ankle_offset": (0.025, None),
+        "foot_radius": (0.05, "r"), "foot_length": (0.215, "h"),
+        "foot_forward": (0.10, None), "foot_drop": (0.025, "r"),
+    },
+    "female": {
+        "chest_radius": (0.127, "r"), "chest_length": (0.01, None),
+        "pecs_radius": (0.092, "r"), "pecs_length": (0.225 / 8, None),
+        "pecs_offset": (0.225 / 2.5 - 0.225 / 16, None), "pecs_height": (0.132, "h"),
+        "neck_radius": (0.05, "r"), "neck_length": (0.121, "h"),
+        "neck_height": (0.132, "h"), "neck_offset": (0.2565 - 0.1415 - 0.025, "h"),
+        "head_height": (0.12, "h"),
+        "upper_arm_radius": (0.0355, "r"), "upper_arm_length": (0.264, "h"),
+        "forearm_radius": (0.027, "r"), "forearm_length": (0.234, "h"),
+        "hand_radius": (0.0355, "r"),
+        "waist_radius": (0.11, "r"), "waist_length": (0.009, None), "waist_drop": (0.15, "h"),
+        "hips_radius": (0.127, "r"), "hips_length": (0.117, None), "hips_drop": (0.075, "h"),
+        "thigh_radius": (0.0775, "r"), "thigh_length": (0.391, "h"),
+        "shin_radius": (0.045, "r"), "shin_length": (0.367, "h"), "ankle_offset": (0.0225, None),
+        "foot_radius": (0.045, "r"), "foot_length": (0.195, "h"),
+        "foot_forward": (0.09, None), "foot_drop": (0.0225, "r"),
+    },
+}
+
+# Unscaled lateral gaps: shoulder joint at +-(pecs_radius + gap), hip joint at +-(thigh_radius + gap).
+_SHOULDER_GAP = {"male": 0.073, "female": 0.067}
+_HIP_GAP = {"male": 0.009, "female": 0.0145}
+
+# Head built from primitives (the reference's head mesh is not scaled, so neither is this):
+# skull sphere of radius head_radius whose top is head_top above the head joint (this sets the
+# standing heights 1.733 / 1.584 m), plus a face sphere in front of it (-Y). The face sphere is
+# sized so that the mouth point lies about 1 cm in front of its surface.
+_HEADS: dict[str, dict[str, float]] = {
+    "male": {"head_top": 0.199, "head_radius": 0.095, "head_skull_y": 0.0,
+             "face_radius": 0.06, "face_y": -0.04, "face_z": 0.035},
+    "female": {"head_top": 0.184, "head_radius": 0.088, "head_skull_y": 0.0,
+               "face_radius": 0.055, "face_y": -0.036, "face_z": 0.033},
+}
+
+# Template args that are not body measurements (passed through xacro_args' keywords).
+_SETTINGS_ARGS = ("strength", "skin_rgba", "cloth_spheres", "fixed_joints")
+
+
+@dataclass(frozen=True)
+class BodyMeasurements:
+    """Every measurement of one body, in metres and kilograms, named as the template's args.
+
+    Lengths are capsule cylinder lengths (without the caps); offsets and drops are distances
+    between joint frames (or from a joint frame to a shape's centre) at zero joint angles. The
+    derived fields ``chest_height_m`` (height of the chest frame when standing on z = 0),
+    ``standing_height_m`` (top of head above the soles) and ``mouth_offset_m`` (mouth point in
+    the ``head`` frame) are computed, not passed.
+    """
+
+    sex: Sex
+    mass_kg: float
+    height_scale: float
+    radius_scale: float
+    # Geometry (m).
+    chest_radius: float
+    chest_length: float
+    pecs_radius: float
+    pecs_length: float
+    pecs_offset: float
+    pecs_height: float
+    neck_radius: float
+    neck_length: float
+    neck_height: float
+    neck_offset: float
+    head_height: float
+    head_top: float
+    head_radius: float
+    head_skull_y: float
+    face_radius: float
+    face_y: float
+    face_z: float
+    shoulder_offset: float
+    upper_arm_radius: float
+    upper_arm_length: float
+    forearm_radius: float
+    forearm_length: float
+    hand_radius: float
+    waist_radius: float
+    waist_length: float
+    waist_drop: float
+    hips_radius: float
+    hips_length: float
+    hips_drop: float
+    hip_offset: float
+    thigh_radius: float
+    thigh_length: float
+    shin_radius: float
+    shin_length: float
+    ankle_offset: float
+    foot_radius: float
+    foot_length: float
+    foot_forward: float
+    foot_drop: float
+    # Segment masses (kg); paired segments are per side.
+    mass_chest: float
+    mass_pecs: float
+    mass_neck: float
+    mass_head: float
+    mass_upper_arm: float
+    mass_forearm: float
+    mass_hand: float
+    mass_abdomen: float
+    mass_hips: float
+    mass_thigh: float
+    mass_shin: float
+    mass_foot: float
+    #: Mass of each intermediate joint link, taken out of its segment by the template.
+    joint_link_mass: float
+    # Derived.
+    chest_height_m: float = field(init=False)
+    standing_height_m: float = field(init=False)
+    mouth_offset_m: tuple[float, float, float] = field(init=False)
+
+    def __post_init__(self) -> None:
+        if self.sex not in ("male", "female"):
+            raise ValueError(f"sex must be 'male' or 'female', got {self.sex!r}")
+        for f in fields(self):
+            if f.init and f.name != "sex":
+                v = getattr(self, f.name)
+                if not isinstance(v, (int, float)) or not math.isfinite(v):
+                    raise ValueError(f"{f.name} must be a finite number, got {v!r}")
+                if v < 0 and f.name not in ("head_skull_y", "face_y", "face_z"):
+                    raise ValueError(f"{f.name} must not be negative, got {v!r}")
+        for name in ("mass_kg", "height_scale", "radius_scale", "joint_link_mass"):
+            if getattr(self, name) <= 0:
+                raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
+        # Each segment gives up to two intermediate links' mass (one for forearm and hand).
+        for seg, n in (("pecs", 2), ("head", 2), ("upper_arm", 2), ("forearm", 1), ("hand", 1),
+                       ("abdomen", 2), ("thigh", 2), ("foot", 2)):
+            if getattr(self, f"mass_{seg}") <= n * self.joint_link_mass:
+                raise ValueError(f"mass_{seg} must exceed {n} x joint_link_mass")
+        chest_height = (self.waist_drop + 2 * self.hips_drop + self.thigh_length + self.shin_length
+                        + self.ankle_offset + self.foot_drop + self.foot_radius)
+        object.__setattr__(self, "chest_height_m", chest_height)
+        object.__setattr__(self, "standing_height_m",
+                           chest_height + self.neck_height + self.head_height + self.head_top)
+        object.__setattr__(self, "mouth_offset_m", _MOUTH_OFFSET[self.sex])
+
+    @property
+    def total_mass_kg(self) -> float:
+        """Sum of the segment masses (equals ``mass_kg``)."""
+        return sum(getattr(self, f"mass_{seg}") * (2 if seg in _PAIRED else 1) for seg in MASS_FRACTIONS)
+
+    def xacro_args(
+        self,
+        *,
+        strength: float | None = None,
+        skin_rgba: tuple[float, float, float, float] | None = None,
+        fixed_joints: Mapping[str, float] | str | None = None,
+        cloth_spheres: bool | None = None,
+    ) -> dict[str, str]:
+        """The template's args as strings for ``xacro.process_file(PERSON_TEMPLATE, mappings=...)``.
+
+        Always every measurement and mass (floats as ``repr``); the keyword settings only when
+        given (the template's defaults are strength 1, skin (0.8, 0.6, 0.4, 1), no cloth spheres,
+        no fixed joints). ``fixed_joints`` maps revolute joint names to angles in radians.
+        """
+        out = {f.name: repr(float(getattr(self, f.name))) for f in fields(self) if f.name in _MEASUREMENT_ARGS}
+        if strength is not None:
+            if not (math.isfinite(strength) and strength > 0):
+                raise ValueError(f"strength must be positive, got {strength!r}")
+            out["strength"] = repr(float(strength))
+        if skin_rgba is not None:
+            if len(skin_rgba) != 4:
+                raise ValueError(f"skin_rgba needs 4 components, got {skin_rgba!r}")
+            out["skin_rgba"] = " ".join(repr(float(c)) for c in skin_rgba)
+        if cloth_spheres is not None:
+            out["cloth_spheres"] = "true" if cloth_spheres else "false"
+        if fixed_joints is not None:
+            out["fixed_joints"] = (fixed_joints if isinstance(fixed_joints, str)
+                                   else format_fixed_joints(fixed_joints))
+        return out
+
+    def standing_landmark_positions(self) -> dict[str, tuple[float, float, float]]:
+        """Position (m) of every landmark frame at zero joint angles, standing with the soles on
+        z = 0 and the chest frame at (0, 0, ``chest_height_m``)."""
+        c = self.chest_height_m
+        pecs = c + self.pecs_height
+        elbow = pecs - self.upper_arm_length
+        wrist = elbow - (self.forearm_radius + self.forearm_length)
+        stomach = c - self.waist_drop
+        waist = stomach - self.hips_drop
+        hip = waist - self.hips_drop
+        knee = hip - self.thigh_length
+        ankle = knee - (self.shin_length + self.ankle_offset)
+        out: dict[str, tuple[float, float, float]] = {
+            "chest": (0.0, 0.0, c),
+            "neck": (0.0, 0.0, c + self.neck_height),
+            "head": (0.0, 0.0, c + self.neck_height + self.head_height),
+            "stomach": (0.0, 0.0, stomach),
+            "waist": (0.0, 0.0, waist),
+        }
+        for side, s in (("right", -1.0), ("left", 1.0)):
+            x = s * self.shoulder_offset
+            out[f"{side}_pecs"] = (0.0, 0.0, pecs)
+            out[f"{side}_shoulder"] = (x, 0.0, pecs)
+            out[f"{side}_elbow"] = (x, 0.0, elbow)
+            out[f"{side}_wrist"] = (x, 0.0, wrist)
+            out[f"{side}_hip"] = (s * self.hip_offset, 0.0, hip)
+            out[f"{side}_knee"] = (s * self.hip_offset, 0.0, knee)
+            out[f"{side}_ankle"] = (s * self.hip_offset, 0.0, ankle)
+        return {name: out[name] for name in LANDMARKS}
+
+
+_MEASUREMENT_ARGS: tuple[str, ...] = tuple(
+    f.name for f in fields(BodyMeasurements)
+    if f.init and f.name not in ("sex", "mass_kg", "height_scale", "radius_scale")
+)
+
+#: Names of every arg the person template declares.
+TEMPLATE_ARGS: tuple[str, ...] = _MEASUREMENT_ARGS + _SETTINGS_ARGS
+
+
+def body_measurements(
+    sex: Sex,
+    mass_kg: float | None = None,
+    height_scale: float = 1.0,
+    radius_scale: float = 1.0,
+) -> BodyMeasurements:
+    """The reference's body for ``sex`` (50th percentile at scales 1): lengths and vertical
+    offsets x ``height_scale``, radii x ``radius_scale``, segment masses = the reference's
+    fractions x ``mass_kg`` (default 78.4 kg male, 62.5 kg female)."""
+    if sex not in _TABLES:
+        raise ValueError(f"sex must be 'male' or 'female', got {sex!r}")
+    mass = DEFAULT_MASS_KG[sex] if mass_kg is None else float(mass_kg)
+    for name, v in (("mass_kg", mass), ("height_scale", height_scale), ("radius_scale", radius_scale)):
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+            raise ValueError(f"{name} must be a positive finite number, got {v!r}")
+    hs, rs = float(height_scale), float(radius_scale)
+    scale = {"r": rs, "h": hs, None: 1.0}
+    geo = {name: value * scale[how] for name, (value, how) in _TABLES[sex].items()}
+    geo["shoulder_offset"] = geo["pecs_radius"] + _SHOULDER_GAP[sex]
+    geo["hip_offset"] = geo["thigh_radius"] + _HIP_GAP[sex]
+    geo.update(_HEADS[sex])
+    masses = {f"mass_{seg}": frac * mass for seg, frac in MASS_FRACTIONS.items()}
+    return BodyMeasurements(
+        sex=sex, mass_kg=mass, height_scale=hs, radius_scale=rs,
+        joint_link_mass=min(0.01, 0.001 * mass),
+        **geo, **masses,
+    )
+
+
+def format_fixed_joints(angles: Mapping[str, float]) -> str:
+    """``{"right_elbow": -1.5708}`` -> ``"right_elbow=-1.5708"`` (joint order, angles in radians,
+    ``repr`` floats), the template's ``fixed_joints`` arg. Raises ValueError on a name that is not
+    a revolute joint."""
+    unknown = sorted(set(angles) - set(REVOLUTE_JOINTS))
+    if unknown:
+        raise ValueError(f"not revolute person joints: {', '.join(unknown)}")
+    parts = []
+    for name in REVOLUTE_JOINTS:
+        if name in angles:
+            a = float(angles[name])
+            if not math.isfinite(a):
+                raise ValueError(f"angle of {name} must be finite, got {angles[name]!r}")
+            parts.append(f"{name}={a!r}")
+    return " ".join(parts)

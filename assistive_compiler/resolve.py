@@ -1,0 +1,412 @@
+"""Resolution: a validated spec plus the part library → a :class:`ResolvedTask` for one robot.
+
+Every name a spec uses is checked here, with a located message and a "did you mean" on failure:
+library parts, body names, links (semantic names for robots and tools; URDF names for the
+person), joints and joint limits, targets, particle sets, term kinds and term parameters,
+preference names, and the success term. References come out normalised so the compiler and the
+runtime never parse a spec string again:
+
+* point → ``{"target": name}`` or ``{"body": body, "link": urdf_link}``
+* body → body name; bodies → list of body names
+* joints → ``{"body": "robot" | "person", "group": name, "joints": [urdf joint names]}``
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from pydantic import ValidationError
+
+from .compile.render import UrdfInfo
+from .errors import Problem, SpecError, did_you_mean, one_of
+from .library import Library, LoadedPart
+from .spec.load import LoadedSpec
+from .spec.models import PAPER_PREFERENCE_WEIGHTS, PREFERENCE_NAMES, TaskSpec, Uniform
+from .spec.validation import problems_from_validation
+from .terms.registry import Category, TermDef, ref_fields, terms
+
+RESERVED_BODIES = ("robot", "person")
+ROBOT_SEMANTIC_LINKS = ("base", "end_effector", "tool_mount")
+
+
+@dataclass(frozen=True)
+class ResolvedTerm:
+    """A term use with its parameters validated and references normalised (JSON-ready)."""
+
+    name: str
+    term: str
+    category: Category
+    weight: float
+    params: dict[str, Any]
+
+
+@dataclass
+class ResolvedTask:
+    """Everything the compiler needs for one (task, robot) pair."""
+
+    loaded: LoadedSpec
+    robot_name: str
+    robot: LoadedPart
+    robot_urdf: UrdfInfo
+    tools: dict[str, LoadedPart]
+    furniture: dict[str, LoadedPart]
+    people: dict[str, LoadedPart]
+    person_urdf: UrdfInfo
+    robot_links: dict[str, str]
+    joint_groups: dict[str, dict[str, Any]]
+    observations: dict[str, list[ResolvedTerm]]
+    reward: list[ResolvedTerm]
+    success_threshold: float
+    points: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+    @property
+    def spec(self) -> TaskSpec:
+        return self.loaded.spec
+
+
+def _deg_range(lower: float | None, upper: float | None) -> str:
+    return f"[{math.degrees(lower):.0f}°, {math.degrees(upper):.0f}°]" if lower is not None and upper is not None else "unlimited"
+
+
+class _Resolver:
+    def __init__(self, loaded: LoadedSpec, library: Library, robot_name: str):
+        self.loaded = loaded
+        self.spec = loaded.spec
+        self.lib = library
+        self.robot_name = robot_name
+        self.problems: list[Problem] = []
+
+    # -- helpers -----------------------------------------------------------------------------
+    def at(self, *path: Any):
+        return self.loaded.smap.value(tuple(path))
+
+    def key_at(self, *path: Any):
+        return self.loaded.smap.key(tuple(path))
+
+    def problem(self, path: tuple, message: str, key: bool = False) -> None:
+        self.problems.append(Problem(self.key_at(*path) if key else self.at(*path), message))
+
+    def part(self, kind: str, name: str, path: tuple, what: str) -> LoadedPart | None:
+        try:
+            return self.lib.get(kind, name)
+        except KeyError:
+            names = self.lib.names(kind)
+            self.problem(path, f"unknown {what} '{name}'; expected one of {one_of(names)}{did_you_mean(name, names)}")
+        except SpecError as exc:
+            self.problems.extend(exc.problems)
+        return None
+
+    # -- the passes ----------------------------------------------------------------------------
+    def run(self) -> ResolvedTask:
+        spec = self.spec
+        robot_path = ("robot", "default")
+        for i, name in enumerate(spec.robot.supported):
+            if not self.lib.path_of("robots", name):
+                names = self.lib.names("robots")
+                self.problem(("robot", "supported", i), f"unknown robot '{name}'; expected one of {one_of(names)}{did_you_mean(name, names)}")
+        if self.robot_name not in spec.robot.supported:
+            raise SpecError([Problem(self.at(*robot_path), f"robot '{self.robot_name}' is not supported by task '{spec.name}'; supported: {one_of(spec.robot.supported)}{did_you_mean(self.robot_name, spec.robot.supported)}")])
+        robot = self.part("robots", self.robot_name, robot_path, "robot")
+        furniture = {n: p for n, use in spec.scene.furniture.items() if (p := self.part("furniture", use.part, ("scene", "furniture", n, "part"), "furniture part"))}
+        tools = {n: p for n, use in spec.tools.items() if (p := self.part("tools", use.part, ("tools", n, "part"), "tool"))}
+        people = {n: p for i, n in enumerate(spec.person.variants) if (p := self.part("people", n, ("person", "variants", i), "person"))}
+        for name in spec.robot.per_robot:
+            if name not in spec.robot.supported:
+                self.problem(("robot", "per_robot", name), f"per_robot names '{name}', which is not in supported {spec.robot.supported}{did_you_mean(name, spec.robot.supported)}", key=True)
+        if self.problems or robot is None or not people:
+            raise SpecError(self.problems)
+
+        self.robot = robot
+        self.robot_urdf = self.lib.default_urdf("robots", self.robot_name)
+        self.person_urdf = self.lib.default_urdf("people", spec.person.variants[0])
+        self.tools, self.furniture, self.people = tools, furniture, people
+        self._bodies(spec)
+        self.robot_links = self._robot_links()
+        self.joint_groups = self._joint_groups()
+        self._person(spec)
+        self._robot_role(spec)
+        points = self._targets(spec)
+        self._particles(spec)
+        observations = {
+            agent: [self._term(use, "observation", ("observations", agent, i), f"{agent}_{i}", 1.0) for i, use in enumerate(getattr(spec.observations, agent))]
+            for agent in ("robot", "human")
+        }
+        reward = [self._term(t, "reward", ("reward", i), t.name, t.weight) for i, t in enumerate(spec.reward)]
+        names_seen: dict[str, int] = {}
+        for i, t in enumerate(spec.reward):
+            if t.name in names_seen:
+                self.problem(("reward", i, "name"), f"reward term name '{t.name}' is already used by reward[{names_seen[t.name]}]")
+            names_seen[t.name] = i
+        reward += self._preferences(spec)
+        threshold = self._success(spec, {t.name for t in spec.reward})
+        if self.problems:
+            raise SpecError(self.problems)
+        return ResolvedTask(
+            self.loaded, self.robot_name, robot, self.robot_urdf, tools, furniture, people, self.person_urdf,
+            self.robot_links, self.joint_groups, {a: [t for t in ts if t] for a, ts in observations.items()},
+            [t for t in reward if t], threshold, points,
+        )
+
+    def _bodies(self, spec: TaskSpec) -> None:
+        self.body_names: dict[str, str] = {"robot": "robot", "person": "person"}
+        for section, names in (("scene.furniture", spec.scene.furniture), ("tools", spec.tools), ("particles", spec.particles)):
+            for name in names:
+                path = tuple(section.split(".")) + (name,)
+                if name in self.body_names:
+                    other = self.body_names[name]
+                    why = "is reserved" if name in RESERVED_BODIES else f"is already used in {other}"
+                    self.problem(path, f"body name '{name}' {why}; every furniture, tool and particle set needs its own name", key=True)
+                else:
+                    self.body_names[name] = section
+
+    def _robot_links(self) -> dict[str, str]:
+        part = self.robot.part
+        side = self.spec.robot.arm if self.spec.robot.arm != "both" else "right"
+        out = {"base": part.base_link}
+        _, arm = part.arm_for(side)
+        out["end_effector"], out["tool_mount"] = arm.end_effector, arm.tool_mount
+        for s in ("right", "left"):
+            _, a = part.arm_for(s)
+            out[f"{s}_end_effector"], out[f"{s}_tool_mount"] = a.end_effector, a.tool_mount
+        return out
+
+    def _joint_groups(self) -> dict[str, dict[str, Any]]:
+        from .person.body import JOINT_GROUPS
+
+        part = self.robot.part
+        groups: dict[str, dict[str, Any]] = {}
+        sides = ("right", "left") if self.spec.robot.arm == "both" and len(part.arms) > 1 else (self.spec.robot.arm if self.spec.robot.arm != "both" else "right",)
+        arm_joints: list[str] = []
+        for s in sides:
+            arm_joints += part.arm_for(s)[1].joints
+        groups["robot.arm"] = {"body": "robot", "group": "arm", "joints": arm_joints}
+        for s in ("right", "left"):
+            groups[f"robot.{s}_arm"] = {"body": "robot", "group": f"{s}_arm", "joints": list(part.arm_for(s)[1].joints)}
+        for name, joints in JOINT_GROUPS.items():
+            groups[f"person.{name}"] = {"body": "person", "group": name, "joints": list(joints)}
+        return groups
+
+    # -- references ----------------------------------------------------------------------------
+    def links_of(self, body: str) -> dict[str, str]:
+        if body == "robot":
+            return self.robot_links
+        if body == "person":
+            return {l: l for l in self.person_urdf.links}
+        if body in self.tools:
+            return dict(self.tools[body].part.links) | {"base": self.tools[body].part.base_link}
+        if body in self.furniture:
+            return dict(self.furniture[body].part.links) | {"base": self.furniture[body].part.base_link}
+        return {}
+
+    def reference_link(self, body: str) -> str | None:
+        if body == "robot":
+            return self.robot_links["end_effector"]
+        if body == "person":
+            return self.robot_person_root()
+        if body in self.tools:
+            tool = self.tools[body].part
+            return tool.links[tool.reference_link]
+        if body in self.furniture:
+            return self.furniture[body].part.base_link
+        return None
+
+    def robot_person_root(self) -> str:
+        return self.person_urdf.root_link
+
+    def body(self, value: str, path: tuple, *, allow_particles: bool = True) -> str | None:
+        pool = [b for b, section in self.body_names.items() if allow_particles or section != "particles"]
+        if value not in pool:
+            self.problem(path, f"unknown body '{value}'; expected one of {one_of(pool)}{did_you_mean(value, pool)}")
+            return None
+        return value
+
+    def point(self, value: str, path: tuple, *, allow_target: bool = True) -> dict[str, Any] | None:
+        if allow_target and value in self.spec.targets:
+            return {"target": value}
+        body, _, link = value.partition(".")
+        if body not in self.body_names or self.body_names[body] == "particles":
+            pool = [b for b, s in self.body_names.items() if s != "particles"] + (list(self.spec.targets) if allow_target else [])
+            what = "a target or body" if allow_target else "body"
+            self.problem(path, f"unknown {what} '{value}'; expected one of {one_of(pool)}{did_you_mean(body, pool)}")
+            return None
+        if not link:
+            return {"body": body, "link": self.reference_link(body)}
+        links = self.links_of(body)
+        if link not in links:
+            self.problem(path, f"unknown link '{link}' of {body}; expected one of {one_of(links)}{did_you_mean(link, links)}")
+            return None
+        return {"body": body, "link": links[link]}
+
+    def joints(self, value: str, path: tuple) -> dict[str, Any] | None:
+        if value == "person.policy":
+            return {"body": "person", "group": "policy", "joints": self.policy_joints}
+        if value not in self.joint_groups:
+            pool = list(self.joint_groups) + ["person.policy"]
+            self.problem(path, f"unknown joint group '{value}'; expected one of {one_of(pool, 20)}{did_you_mean(value, pool)}")
+            return None
+        return self.joint_groups[value]
+
+    def particles(self, value: str, path: tuple) -> str | None:
+        if value not in self.spec.particles:
+            pool = list(self.spec.particles)
+            self.problem(path, f"unknown particle set '{value}'; expected one of {one_of(pool) or 'none (declare one under particles:)'}{did_you_mean(value, pool)}")
+            return None
+        return value
+
+    # -- sections ------------------------------------------------------------------------------
+    def _person(self, spec: TaskSpec) -> None:
+        person = spec.person
+        movable = self.person_urdf.movable_joints
+        for section, values in (("joints_deg", person.joints_deg), ("randomize_deg", person.randomize_deg)):
+            for name, value in values.items():
+                path = ("person", section, name)
+                if name not in movable:
+                    self.problem(path, f"unknown person joint '{name}'; expected one of {one_of(movable)}{did_you_mean(name, movable)}", key=True)
+                    continue
+                j = movable[name]
+                lows, highs = (value.uniform if isinstance(value, Uniform) else (value, value))
+                for deg in (lows, highs):
+                    rad = math.radians(deg)
+                    if j.lower is not None and not (j.lower - 1e-9 <= rad <= j.upper + 1e-9):
+                        self.problem(path, f"{name} = {deg:g}° is outside the joint's limits {_deg_range(j.lower, j.upper)}")
+                        break
+        self.policy_joints: list[str] = []
+        for i, ref in enumerate(person.control.policy_joints):
+            group = self.joints(ref, ("person", "control", "policy_joints", i))
+            if group:
+                if group["body"] != "person":
+                    self.problem(("person", "control", "policy_joints", i), f"policy_joints must be person joint groups, got '{ref}'")
+                else:
+                    self.policy_joints += [j for j in group["joints"] if j not in self.policy_joints]
+        if person.control.compliant:
+            for i, ref in enumerate(person.control.compliant.joints):
+                self.joints(ref, ("person", "control", "compliant", "joints", i))
+        for i, choice in enumerate(person.impairments.choices):
+            for k, ref in enumerate(getattr(choice, "joints", [])):
+                self.joints(ref, ("person", "impairments", "choices", i, "joints", k))
+        seat = person.placement.seated_on
+        if seat is not None:
+            if seat not in spec.scene.furniture:
+                pool = list(spec.scene.furniture)
+                self.problem(("person", "placement", "seated_on"), f"unknown furniture '{seat}'; expected one of {one_of(pool)}{did_you_mean(seat, pool)}")
+            elif seat in self.furniture and not self.furniture[seat].part.seat_link:
+                self.problem(("person", "placement", "seated_on"), f"furniture '{seat}' (part '{self.furniture[seat].part.name}') has no seat_link to sit on")
+
+    def _robot_role(self, spec: TaskSpec) -> None:
+        mount = spec.robot.mount_on
+        if mount is not None:
+            if mount not in spec.scene.furniture:
+                pool = list(spec.scene.furniture)
+                self.problem(("robot", "mount_on"), f"unknown furniture '{mount}'; expected one of {one_of(pool)}{did_you_mean(mount, pool)}")
+            elif mount in self.furniture and self.robot.part.mountable and not self.furniture[mount].part.mount_link:
+                self.problem(("robot", "mount_on"), f"furniture '{mount}' has no mount_link for the robot")
+        for name, use in spec.tools.items():
+            if use.part not in self.robot.part.grips:
+                self.problem(("tools", name, "part"), f"robot '{self.robot_name}' has no grip for tool '{use.part}' (add it under grips: in {self.robot.shown})")
+
+    def _targets(self, spec: TaskSpec) -> dict[str, dict[str, Any]]:
+        out: dict[str, dict[str, Any]] = {}
+        for name, target in spec.targets.items():
+            p = self.point(target.link, ("targets", name, "link"), allow_target=False)
+            for variant in target.offset_by_variant:
+                if variant not in spec.person.variants:
+                    self.problem(("targets", name, "offset_by_variant", variant), f"'{variant}' is not a person variant of this task; variants are {one_of(spec.person.variants)}{did_you_mean(variant, spec.person.variants)}", key=True)
+            if p:
+                out[name] = p
+        return out
+
+    def _particles(self, spec: TaskSpec) -> None:
+        for name, ps in spec.particles.items():
+            base = ("particles", name)
+            self.body(ps.attach, base + ("attach",), allow_particles=False)
+            if ps.consumed_at:
+                self.point(ps.consumed_at.target, base + ("consumed_at", "target"))
+            if ps.lost_beyond:
+                self.body(ps.lost_beyond.body, base + ("lost_beyond", "body"), allow_particles=False)
+            if ps.hit_body:
+                self.body(ps.hit_body, base + ("hit_body",), allow_particles=False)
+
+    def _term(self, use: Any, category: Category, path: tuple, name: str, weight: float) -> ResolvedTerm | None:
+        registry = terms(category)
+        if use.term not in registry:
+            self.problem(path + ("term",), f"unknown {category} term '{use.term}'; expected one of {one_of(registry)}{did_you_mean(use.term, registry)}")
+            return None
+        params = self._params(registry[use.term], use.params, path + ("params",))
+        return None if params is None else ResolvedTerm(name, use.term, category, weight, params)
+
+    def _params(self, tdef: TermDef, raw: dict[str, Any], path: tuple) -> dict[str, Any] | None:
+        try:
+            model = tdef.params.model_validate(raw)
+        except ValidationError as exc:
+            self.problems.extend(problems_from_validation(exc, raw, self.loaded.smap, tdef.params, prefix=path))
+            return None
+        values = model.model_dump()
+        before = len(self.problems)
+        for fname, (kind, shape) in ref_fields(tdef.params).items():
+            value = values[fname]
+            fpath = path + (fname,)
+            if shape == "optional" and value is None:
+                continue
+            if shape == "list":
+                values[fname] = [self._ref(kind.kind, v, fpath + (i,)) for i, v in enumerate(value)]
+            else:
+                values[fname] = self._ref(kind.kind, value, fpath)
+        return values if len(self.problems) == before else None
+
+    def _ref(self, kind: str, value: Any, path: tuple) -> Any:
+        if kind == "point":
+            return self.point(value, path)
+        if kind == "body":
+            return self.body(value, path)
+        if kind == "bodies":
+            return [self.body(v, path + (i,)) for i, v in enumerate(value)]
+        if kind == "joints":
+            return self.joints(value, path)
+        if kind == "particles":
+            return self.particles(value, path)
+        return value  # frame: a literal pydantic already checked
+
+    def _preferences(self, spec: TaskSpec) -> list[ResolvedTerm | None]:
+        registry = terms("preference")
+        out: list[ResolvedTerm | None] = []
+        for name, pref in spec.preferences.active.items():
+            path = ("preferences", "active", name)
+            if name not in PREFERENCE_NAMES:
+                self.problem(path, f"unknown preference '{name}'; expected one of {one_of(PREFERENCE_NAMES)}{did_you_mean(name, PREFERENCE_NAMES)}", key=True)
+                continue
+            weight = PAPER_PREFERENCE_WEIGHTS[name] if pref.weight is None else pref.weight
+            params = self._params(registry[name], pref.params, path + ("params",))
+            out.append(None if params is None else ResolvedTerm(f"preference_{name}", name, "preference", weight, params))
+        return out
+
+    def _success(self, spec: TaskSpec, reward_names: set[str]) -> float:
+        success = spec.success
+        if success.term not in reward_names:
+            self.problem(("success", "term"), f"unknown reward term '{success.term}'; expected one of {one_of(reward_names)}{did_you_mean(success.term, reward_names)}")
+        if success.relative_to is not None:
+            if self.particles(success.relative_to, ("success", "relative_to")) is None:
+                return success.threshold
+            return success.threshold * spec.particles[success.relative_to].count
+        return success.threshold
+
+
+def resolve(loaded: LoadedSpec, robot: str | None = None, library: Library | None = None) -> ResolvedTask:
+    """Resolve ``loaded`` for ``robot`` (default: the spec's default robot)."""
+    return _Resolver(loaded, library or Library(), robot or loaded.spec.robot.default).run()
+
+
+def validate_all_robots(loaded: LoadedSpec, library: Library | None = None) -> list[ResolvedTask]:
+    """Resolve the spec for every robot it supports; problems from all of them are reported together."""
+    library = library or Library()
+    resolved: list[ResolvedTask] = []
+    problems: list[Problem] = []
+    for robot in loaded.spec.robot.supported:
+        try:
+            resolved.append(resolve(loaded, robot, library))
+        except SpecError as exc:
+            problems.extend(p for p in exc.problems if p not in problems)
+    if problems:
+        raise SpecError(problems)
+    return resolved

@@ -1,0 +1,491 @@
+"""The task spec language: pydantic models, strict, one ``description=`` per field.
+
+A task spec (``specs/tasks/*.yaml``) says *what* the task is — the scene, the person, the robot's
+role, tools, named targets, particles, observations, reward terms, preferences and success — and
+never *how* to simulate it. Units are in field names (``_m``, ``_deg``, ``_kg``, ``_s``, ``_n``)
+or descriptions. World frame: Z up, gravity along −Z; the seated person faces −Y and their right
+side is −X (the reference's convention).
+
+References between parts are plain strings checked by :mod:`assistive_compiler.resolve`:
+
+* a **body**: ``robot``, ``person``, a furniture name, a tool name, a particle-set name;
+* a **link** of a body: ``body.semantic_link`` (``person.head``, ``robot.end_effector``,
+  ``spoon.tip``); a bare body name means the body's reference link;
+* a **target**: a name declared under ``targets:`` (``mouth``);
+* a **joint group**: ``robot.arm`` or ``person.<group>`` (``person.head``, ``person.right_arm``).
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal, Union
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+Name = Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]*$", max_length=64)]
+Ref = Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]*(\.[a-z][a-z0-9_]*)?$", max_length=129)]
+Vec3 = tuple[float, float, float]
+Rgba = tuple[
+    Annotated[float, Field(ge=0, le=1)],
+    Annotated[float, Field(ge=0, le=1)],
+    Annotated[float, Field(ge=0, le=1)],
+    Annotated[float, Field(ge=0, le=1)],
+]
+
+
+class Strict(BaseModel):
+    """Base of every spec model: unknown keys are errors, NaN and infinities are refused."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True, populate_by_name=False)
+
+
+# --------------------------------------------------------------------------------------------
+# Random quantities
+
+
+class Uniform(Strict):
+    """A value drawn uniformly from [low, high] at every reset."""
+
+    uniform: tuple[float, float] = Field(description="Bounds [low, high] of a uniform draw; low ≤ high.")
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "Uniform":
+        low, high = self.uniform
+        if low > high:
+            raise ValueError(f"uniform bounds are reversed: low {low} > high {high}; write [low, high]")
+        return self
+
+
+Scalar = Union[float, Uniform]
+"""A fixed number or ``{uniform: [low, high]}`` re-drawn at every reset."""
+
+
+def scalar_bounds(value: Scalar) -> tuple[float, float]:
+    """The smallest and largest value a :data:`Scalar` can take."""
+    if isinstance(value, Uniform):
+        return value.uniform
+    return (float(value), float(value))
+
+
+# --------------------------------------------------------------------------------------------
+# Simulation
+
+
+class Solver(Strict):
+    """Bullet constraint-solver settings (``setPhysicsEngineParameter``)."""
+
+    sub_steps: int = Field(0, ge=0, le=64, description="numSubSteps: extra sub-steps per physics step (0 = none).")
+    iterations: int = Field(50, ge=1, le=1000, description="numSolverIterations per physics step.")
+
+
+class Ground(Strict):
+    """The floor plane at z = 0."""
+
+    friction: Scalar = Field(
+        default_factory=lambda: Uniform(uniform=(0.025, 0.5)),
+        description="Lateral friction coefficient of the floor (the reference re-draws U(0.025, 0.5) every reset).",
+    )
+
+    @field_validator("friction")
+    @classmethod
+    def _nonnegative(cls, v: Scalar) -> Scalar:
+        if scalar_bounds(v)[0] < 0:
+            raise ValueError("friction must be ≥ 0")
+        return v
+
+
+class Sim(Strict):
+    """Timing and world physics. The paper: 0.02 s physics steps, 5 per action (10 Hz), 200 actions."""
+
+    time_step_s: float = Field(0.02, gt=0, le=0.1, description="Physics time step in seconds.")
+    frame_skip: int = Field(5, ge=1, le=100, description="Physics steps per environment step (action).")
+    episode_steps: int = Field(200, ge=1, le=100_000, description="Environment steps per episode (then truncated).")
+    gravity_mps2: float = Field(-9.81, ge=-20, le=0, description="World gravity along +Z in m/s² (negative: downwards).")
+    solver: Solver = Field(default_factory=Solver, description="Constraint-solver settings.")
+    ground: Ground = Field(default_factory=Ground, description="The floor.")
+
+
+# --------------------------------------------------------------------------------------------
+# Scene
+
+
+class FurnitureUse(Strict):
+    """One piece of furniture or a free object placed in the scene, by library part name."""
+
+    part: Name = Field(description="Furniture part from the library (specs/furniture/<part>.yaml).")
+    position_m: Vec3 = Field((0.0, 0.0, 0.0), description="Position of the part's frame in the world, metres.")
+    rpy_deg: Vec3 = Field((0.0, 0.0, 0.0), description="Orientation (roll, pitch, yaw) in degrees, world frame.")
+    position_noise_m: Vec3 = Field(
+        (0.0, 0.0, 0.0), description="Half-width of a uniform per-axis offset re-drawn at every reset, metres."
+    )
+    static: bool | None = Field(None, description="Fixed in the world (None: the part's default).")
+    friction: float | None = Field(None, ge=0, description="Lateral friction override (None: the part's value).")
+    params: dict[str, float | int | str | bool] = Field(
+        default_factory=dict, description="Template parameters of the part (e.g. a wheelchair's robot_mount side)."
+    )
+
+    @field_validator("position_noise_m")
+    @classmethod
+    def _noise_nonnegative(cls, v: Vec3) -> Vec3:
+        if any(x < 0 for x in v):
+            raise ValueError("noise half-widths must be ≥ 0")
+        return v
+
+
+class Scene(Strict):
+    """Furniture and objects, keyed by the name specs use to refer to them."""
+
+    furniture: dict[Name, FurnitureUse] = Field(default_factory=dict, description="Placed furniture by name.")
+
+
+# --------------------------------------------------------------------------------------------
+# Person
+
+
+class Tremor(Strict):
+    """Tremor: each affected joint's target oscillates by ±ε, the sign flipping every env step."""
+
+    kind: Literal["tremor"] = Field(description="Impairment kind.")
+    amplitude_deg: Scalar = Field(
+        default_factory=lambda: Uniform(uniform=(0.0, 20.0)),
+        description="Per-joint amplitude ε in degrees (paper: U(0°, 20°)), drawn per joint per episode.",
+    )
+    joints: list[Ref] = Field(default_factory=lambda: ["person.policy"], description="Joint groups affected.")
+
+
+class Weakness(Strict):
+    """Weakness: joint torque limits are scaled by a strength β."""
+
+    kind: Literal["weakness"] = Field(description="Impairment kind.")
+    strength: Scalar = Field(
+        default_factory=lambda: Uniform(uniform=(0.25, 1.0)),
+        description="Strength β ∈ (0, 1] multiplying joint torque limits (paper: U(0.25, 1)).",
+    )
+    joints: list[Ref] = Field(default_factory=lambda: ["person.policy"], description="Joint groups affected.")
+
+    @field_validator("strength")
+    @classmethod
+    def _range(cls, v: Scalar) -> Scalar:
+        low, high = scalar_bounds(v)
+        if low <= 0 or high > 1:
+            raise ValueError(f"strength must lie in (0, 1], got {low}…{high}")
+        return v
+
+
+class LimitedRange(Strict):
+    """Limited range of motion: arm and head joint limits are scaled by γ."""
+
+    kind: Literal["limited_range"] = Field(description="Impairment kind.")
+    scale: Scalar = Field(
+        default_factory=lambda: Uniform(uniform=(0.5, 1.0)),
+        description="Range scale γ ∈ (0, 1] applied to joint limits (paper: U(0.5, 1)).",
+    )
+    joints: list[Ref] = Field(
+        default_factory=lambda: ["person.right_arm", "person.left_arm", "person.head"], description="Joint groups affected."
+    )
+
+    @field_validator("scale")
+    @classmethod
+    def _range(cls, v: Scalar) -> Scalar:
+        low, high = scalar_bounds(v)
+        if low <= 0 or high > 1:
+            raise ValueError(f"scale must lie in (0, 1], got {low}…{high}")
+        return v
+
+
+class NoImpairment(Strict):
+    """No impairment."""
+
+    kind: Literal["none"] = Field(description="Impairment kind.")
+
+
+Impairment = Annotated[Union[NoImpairment, Tremor, Weakness, LimitedRange], Field(discriminator="kind")]
+
+
+class Impairments(Strict):
+    """Which impairment a person has; one choice is drawn at every reset."""
+
+    choices: list[Impairment] = Field(
+        default_factory=lambda: [NoImpairment(kind="none")],
+        min_length=1,
+        description="Impairments to draw from uniformly at each reset (one entry = a fixed impairment).",
+    )
+
+
+class CompliantHold(Strict):
+    """Joints held at their initial pose by a weak position controller (they yield to contact)."""
+
+    joints: list[Ref] = Field(description="Joint groups held compliantly, e.g. person.right_arm.")
+    max_force_nm: float = Field(gt=0, description="Motor force limit, N·m, before strength scaling.")
+    position_gain: float = Field(gt=0, le=1, description="Position gain of the hold.")
+
+
+class PersonControl(Strict):
+    """How the person's joints move. Joints not named here are static: baked into the URDF."""
+
+    policy_joints: list[Ref] = Field(
+        default_factory=list, description="Joint groups a human policy controls in co-optimisation (e.g. person.head)."
+    )
+    compliant: CompliantHold | None = Field(None, description="Joints held compliantly in the static-person task.")
+    position_gain: float = Field(0.05, gt=0, le=1, description="Position gain of policy-controlled joints.")
+    max_force_nm: float = Field(1.0, gt=0, description="Force limit of policy-controlled joints, N·m.")
+
+
+class Placement(Strict):
+    """Where the person's base (chest) goes."""
+
+    seated_on: Name | None = Field(
+        None, description="Furniture to sit on: the body is lowered onto the part's seat surface at its seat frame."
+    )
+    position_m: Vec3 | None = Field(None, description="Explicit chest position in the world, metres.")
+    rpy_deg: Vec3 = Field((0.0, 0.0, 0.0), description="Chest orientation (roll, pitch, yaw) in degrees.")
+    offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Added to the seat-derived position, metres.")
+
+    @model_validator(mode="after")
+    def _one_way(self) -> "Placement":
+        if (self.seated_on is None) == (self.position_m is None):
+            raise ValueError("give exactly one of 'seated_on' (a furniture name) or 'position_m'")
+        return self
+
+
+class Person(Strict):
+    """The person being helped: who (library people), posture, what moves, impairments."""
+
+    variants: list[Name] = Field(
+        min_length=1,
+        description="People from the library (specs/people/<name>.yaml); one is drawn at every reset.",
+    )
+    posture: Literal["seated", "supine", "standing"] = Field(description="Named base posture.")
+    placement: Placement = Field(description="Where the chest goes.")
+    joints_deg: dict[Name, float] = Field(default_factory=dict, description="Joint angles in degrees by joint name.")
+    randomize_deg: dict[Name, Uniform] = Field(
+        default_factory=dict, description="Per-reset random joint angles in degrees by joint name (replace joints_deg)."
+    )
+    gravity_mps2: float | None = Field(
+        None, ge=-20, le=0, description="Gravity acting on the person, m/s² (None: the world's). 0 = floats in place."
+    )
+    control: PersonControl = Field(default_factory=PersonControl, description="Which joints move and how.")
+    impairments: Impairments = Field(default_factory=Impairments, description="Impairments drawn per reset.")
+
+
+# --------------------------------------------------------------------------------------------
+# Robot and tools
+
+
+class RobotControl(Strict):
+    """Joint-position-delta control of the robot arm, as in the paper."""
+
+    action_scale_rad: float = Field(
+        0.05, gt=0, le=1, description="Joint target change per unit action per physics step, radians."
+    )
+    position_gain: float = Field(0.05, gt=0, le=1, description="Position gain of the arm motors.")
+    max_force_nm: float = Field(1.0, gt=0, description="Force limit of the arm motors, N·m (gravity is compensated).")
+
+
+class StartGoal(Strict):
+    """The pose the held tool (or, without a tool, the end effector) starts in at every reset.
+
+    Stated for the tool, not the end effector, so one task fits every robot: the compiler turns it
+    into each robot's end-effector pose through that robot's grip, and solves IK at compile time.
+    """
+
+    tool_position_m: Vec3 = Field(description="Tool frame position in the world, metres.")
+    tool_rpy_deg: Vec3 = Field((0.0, 0.0, 0.0), description="Tool frame orientation (roll, pitch, yaw), degrees.")
+    noise_m: float = Field(0.05, ge=0, le=0.5, description="Half-width of a uniform per-axis start noise, metres.")
+    samples: int = Field(
+        8, ge=1, le=256, description="Noisy start poses solved at compile time; reset() picks one (no IK at reset)."
+    )
+
+
+class PerRobot(Strict):
+    """Task settings that differ per robot (the reference's per-task robot tables)."""
+
+    base_offset_m: Vec3 | None = Field(None, description="Base position offset from the mount or search origin, m.")
+
+
+class RobotRole(Strict):
+    """What the robot does in this task. The robot itself is chosen at compile time (--robot)."""
+
+    default: Name = Field(description="Robot used when none is given (e.g. jaco).")
+    supported: list[Name] = Field(min_length=1, description="Robots this task is written for.")
+    arm: Literal["right", "left", "both"] = Field(description="Which arm acts (single-arm robots use their only arm).")
+    mount_on: Name | None = Field(
+        None, description="Furniture that mounts robots able to be mounted (e.g. Jaco on the wheelchair)."
+    )
+    gravity_mps2: float | None = Field(0.0, ge=-20, le=0, description="Gravity on the robot (0: compensated).")
+    control: RobotControl = Field(default_factory=RobotControl, description="Arm control.")
+    start: StartGoal = Field(description="Start pose of the end effector.")
+    per_robot: dict[Name, PerRobot] = Field(default_factory=dict, description="Per-robot settings by robot name.")
+
+    @model_validator(mode="after")
+    def _default_supported(self) -> "RobotRole":
+        if self.default not in self.supported:
+            from ..errors import did_you_mean
+
+            raise ValueError(f"default robot '{self.default}' is not in supported {self.supported}{did_you_mean(self.default, self.supported)}")
+        return self
+
+
+class ToolUse(Strict):
+    """A tool the robot holds, rigidly attached to the robot's tool-mount link."""
+
+    part: Name = Field(description="Tool part from the library (specs/tools/<part>.yaml).")
+    hand: Literal["right", "left"] = Field(description="Which hand holds it (single-arm robots: their only hand).")
+    gravity_mps2: float | None = Field(0.0, ge=-20, le=0, description="Gravity on the tool (0: weightless).")
+    mass_kg: float | None = Field(None, gt=0, description="Mass override in kg (None: the part's mass).")
+
+
+# --------------------------------------------------------------------------------------------
+# Targets and particles
+
+
+class Target(Strict):
+    """A named point attached to a link: e.g. the mouth is the head link plus an offset."""
+
+    link: Ref = Field(description="The link it is attached to, e.g. person.head.")
+    offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Offset in the link frame, metres.")
+    offset_by_variant: dict[Name, Vec3] = Field(
+        default_factory=dict, description="Per person-variant offsets replacing offset_m (e.g. female mouth)."
+    )
+    show_rgba: Rgba | None = Field(None, description="Draw a small sphere there in renders (no collision).")
+
+
+class ConsumedAt(Strict):
+    """A particle is consumed (removed, counted) when it comes within radius of a target."""
+
+    target: Ref = Field(description="The target that consumes particles, e.g. mouth.")
+    radius_m: float = Field(gt=0, le=1, description="Consumption radius, metres.")
+
+
+class LostBeyond(Strict):
+    """A particle is lost (removed, counted) when it is farther than distance from a body."""
+
+    body: Ref = Field(description="The body the particle must stay near, e.g. the spoon.")
+    distance_m: float = Field(gt=0, le=10, description="Distance beyond which it is lost, metres.")
+
+
+class Particles(Strict):
+    """A grid of small spheres (food, water) with a lifecycle: active → consumed | lost."""
+
+    grid: tuple[int, int, int] = Field(description="Particles along x, y, z of the attach frame.")
+    radius_m: float = Field(gt=0, le=0.1, description="Sphere radius, metres.")
+    mass_kg: float = Field(gt=0, le=10, description="Mass of one particle, kg.")
+    spacing_m: float = Field(gt=0, le=1, description="Grid pitch, metres.")
+    attach: Ref = Field(description="Body whose frame the grid is laid out in, e.g. the spoon.")
+    offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Position of the first grid point in that frame, metres.")
+    settle_steps: int = Field(0, ge=0, le=10_000, description="Physics steps run after placing them (compile time).")
+    colors_rgba: list[Rgba] = Field(
+        default_factory=lambda: [(0.8, 0.5, 0.2, 1.0)], min_length=1, description="Colours cycled over particles."
+    )
+    consumed_at: ConsumedAt | None = Field(None, description="When a particle is consumed.")
+    lost_beyond: LostBeyond | None = Field(None, description="When a particle is lost (spilled).")
+    hit_body: Ref | None = Field(
+        None, description="Body whose first contact with an active particle counts as a hit (food on the person)."
+    )
+
+    @field_validator("grid")
+    @classmethod
+    def _positive(cls, v: tuple[int, int, int]) -> tuple[int, int, int]:
+        if any(n < 1 for n in v):
+            raise ValueError("every grid count must be ≥ 1")
+        if v[0] * v[1] * v[2] > 2000:
+            raise ValueError("at most 2000 particles")
+        return v
+
+    @property
+    def count(self) -> int:
+        return self.grid[0] * self.grid[1] * self.grid[2]
+
+
+# --------------------------------------------------------------------------------------------
+# Terms: observations, rewards, preferences, success
+
+
+class TermUse(Strict):
+    """Use of a registered term: its kind, parameters (checked against the term's schema) and weight."""
+
+    term: Name = Field(description="Registered term kind (see `assistive-compiler schema --terms`).")
+    params: dict[str, Any] = Field(default_factory=dict, description="The term's parameters.")
+
+
+class RewardTerm(TermUse):
+    """One weighted reward term. The step reward is Σ weight·value; info reports every value."""
+
+    name: Name = Field(description="Name of this term in info and logs.")
+    weight: float = Field(description="Multiplier of the term's value (negative to penalise).")
+
+
+class Observations(Strict):
+    """Observation vectors per agent: features concatenated in order into one float32 Box."""
+
+    robot: list[TermUse] = Field(min_length=1, description="The robot's observation features, in order.")
+    human: list[TermUse] = Field(default_factory=list, description="The person's (co-optimisation) features.")
+
+
+PREFERENCE_NAMES = (
+    "velocity",
+    "force_nontarget",
+    "high_force",
+    "food_hit",
+    "food_velocity",
+    "dressing_force",
+    "pressure",
+)
+"""The paper's seven preference costs C_v, C_f, C_hf, C_fd, C_fdv, C_d, C_p, in its order."""
+
+PAPER_PREFERENCE_WEIGHTS = dict(zip(PREFERENCE_NAMES, (0.25, 0.01, 0.05, 1.0, 1.0, 0.01, 0.01)))
+
+
+class Preference(Strict):
+    """One active preference cost: its inputs and, optionally, a weight other than the paper's."""
+
+    weight: float | None = Field(None, ge=0, description="ω for this cost (None: the paper's value).")
+    params: dict[str, Any] = Field(default_factory=dict, description="The cost's inputs (which link, which forces).")
+
+
+class Preferences(Strict):
+    """The human-preference reward r_H = Σ ω_k·c_k over the costs active for this task (α_k = 1)."""
+
+    active: dict[Name, Preference] = Field(
+        default_factory=dict, description=f"Active costs by name; names are {', '.join(PREFERENCE_NAMES)}."
+    )
+
+
+class Success(Strict):
+    """Task success: an aggregate of one reward term's value over the episode against a threshold."""
+
+    term: Name = Field(description="Name of a reward term whose value is aggregated.")
+    aggregate: Literal["sum", "max", "min", "last"] = Field(description="How the per-step values are combined.")
+    threshold: float = Field(description="Success when aggregate ≥ threshold.")
+    relative_to: Name | None = Field(
+        None, description="A particle set: the threshold is then a fraction (0, 1] of its count."
+    )
+
+    @model_validator(mode="after")
+    def _fraction(self) -> "Success":
+        if self.relative_to is not None and not (0 < self.threshold <= 1):
+            raise ValueError(f"threshold {self.threshold} is a fraction of '{self.relative_to}' and must lie in (0, 1]")
+        return self
+
+
+# --------------------------------------------------------------------------------------------
+# The task
+
+
+class TaskSpec(Strict):
+    """A complete assistive task."""
+
+    name: Name = Field(description="Task name; Gymnasium ids are <TaskName><Robot>-v1.")
+    title: str = Field(description="Human-readable title, e.g. 'Feeding'.")
+    description: str = Field("", description="What the task is and where its numbers come from.")
+    extends: str | None = Field(None, description="Path of a spec this one builds on (relative to this file).")
+    sim: Sim = Field(default_factory=Sim, description="Timing and world physics.")
+    scene: Scene = Field(default_factory=Scene, description="Furniture and objects.")
+    person: Person = Field(description="The person being helped.")
+    robot: RobotRole = Field(description="The robot's role.")
+    tools: dict[Name, ToolUse] = Field(default_factory=dict, description="Tools by name.")
+    targets: dict[Name, Target] = Field(default_factory=dict, description="Named points on bodies.")
+    particles: dict[Name, Particles] = Field(default_factory=dict, description="Particle sets by name.")
+    observations: Observations = Field(description="Observation features per agent.")
+    reward: list[RewardTerm] = Field(min_length=1, description="Weighted reward terms.")
+    preferences: Preferences = Field(default_factory=Preferences, description="Human-preference costs.")
+    success: Success = Field(description="What counts as success.")

@@ -1,0 +1,117 @@
+"""Library parts: robots, tools, furniture and people, each a small YAML file under ``specs/``.
+
+A part names its xacro template, the template's parameters, and the *semantic* names specs use
+(``end_effector``, ``tip``, ``seat``) mapped to the URDF's real link and joint names. Semantic names
+are checked against the rendered URDF when the part is loaded, so a spec that validates refers
+only to links that exist.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import Field, model_validator
+
+from .models import Name, Strict, Vec3
+
+TemplateParam = float | int | str | bool
+
+
+class Template(Strict):
+    """A xacro template and the parameters it is rendered with."""
+
+    path: str = Field(description="Template path relative to the templates/ directory.")
+    params: dict[str, TemplateParam] = Field(default_factory=dict, description="xacro args (strings after rendering).")
+
+
+class Arm(Strict):
+    """One arm of a robot."""
+
+    joints: list[str] = Field(min_length=1, description="Arm joints from base to wrist (URDF names), in action order.")
+    end_effector: str = Field(description="URDF link whose pose is the end effector.")
+    tool_mount: str = Field(description="URDF link tools are attached to.")
+    rest_rad: list[float] | None = Field(None, description="Rest (tucked) configuration, radians; default zeros.")
+
+
+class Gripper(Strict):
+    """Gripper joints; their position is set per held tool."""
+
+    joints: list[str] = Field(default_factory=list, description="Finger joints (URDF names).")
+    positions: dict[Name, float] = Field(
+        default_factory=dict, description="Finger position per tool part held (radians or metres); 'none' = no tool."
+    )
+
+
+class ToolGrip(Strict):
+    """How a robot holds a tool part: the tool frame relative to the tool-mount link frame."""
+
+    position_m: Vec3 = Field((0.0, 0.0, 0.0), description="Tool frame origin in the tool-mount frame, metres.")
+    rpy_rad: Vec3 = Field((0.0, 0.0, 0.0), description="Tool frame orientation in the tool-mount frame, radians.")
+
+
+class RobotPart(Strict):
+    """A robot in the library."""
+
+    name: Name = Field(description="Robot name used on the command line and in Gymnasium ids.")
+    title: str = Field(description="Display name, e.g. 'Jaco' (used in ids: FeedingJaco-v1).")
+    template: Template | None = Field(None, description="Our xacro template (or give urdf).")
+    urdf: str | None = Field(None, description="A URDF file on disk instead of a template (bring your own robot).")
+    base_link: str = Field(description="URDF root link.")
+    arms: dict[Literal["right", "left"], Arm] = Field(
+        min_length=1, description="Arms by side; a single-arm robot lists one and uses it for either side."
+    )
+    gripper: dict[Literal["right", "left"], Gripper] = Field(default_factory=dict, description="Grippers by side.")
+    grips: dict[Name, ToolGrip] = Field(default_factory=dict, description="Tool attachment per tool part.")
+    mountable: bool = Field(False, description="Mounted on furniture (e.g. Jaco on a wheelchair) when a task offers it.")
+    base_height_m: float = Field(0.0, ge=0, description="Height of the base link above the floor when on the floor.")
+
+    @model_validator(mode="after")
+    def _one_source(self) -> "RobotPart":
+        if (self.template is None) == (self.urdf is None):
+            raise ValueError("give exactly one of 'template' or 'urdf'")
+        return self
+
+    def arm_for(self, side: str) -> tuple[str, Arm]:
+        """The arm acting as ``side``: itself, or the only arm of a single-arm robot."""
+        if side in self.arms:
+            return side, self.arms[side]  # type: ignore[index]
+        (only_side, only_arm), = self.arms.items()
+        return only_side, only_arm
+
+
+class ToolPart(Strict):
+    """A hand-held tool."""
+
+    name: Name = Field(description="Tool part name.")
+    template: Template = Field(description="The tool's xacro template.")
+    base_link: str = Field(description="URDF root link; its frame is the tool frame the robot grip refers to.")
+    links: dict[Name, str] = Field(default_factory=dict, description="Semantic link names → URDF link names.")
+    reference_link: Name = Field(description="Semantic link meant when a spec names the tool alone (e.g. tip).")
+    mass_kg: float = Field(gt=0, description="Total mass, kg.")
+
+
+class FurniturePart(Strict):
+    """Furniture or a free object."""
+
+    name: Name = Field(description="Furniture part name.")
+    template: Template = Field(description="The xacro template.")
+    base_link: str = Field(description="URDF root link.")
+    static: bool = Field(True, description="Fixed in the world by default.")
+    friction: float = Field(1.0, ge=0, description="Lateral friction.")
+    links: dict[Name, str] = Field(default_factory=dict, description="Semantic link names → URDF link names.")
+    seat_link: str | None = Field(None, description="URDF link whose frame is the seat surface (for seated people).")
+    mount_link: str | None = Field(None, description="URDF link whose frame is where a mounted robot's base goes.")
+    mount_params: dict[str, str] = Field(
+        default_factory=dict, description="Template params to set when a robot is mounted (e.g. robot_mount: right)."
+    )
+
+
+class PersonPart(Strict):
+    """A person's body: sex and size. Posture, impairments and control belong to the task."""
+
+    name: Name = Field(description="Person part name, e.g. male_50th.")
+    sex: Literal["male", "female"] = Field(description="Body model (the reference's male or female segment tables).")
+    mass_kg: float = Field(gt=20, le=250, description="Total body mass, kg (paper: 78.4 male, 62.5 female).")
+    height_scale: float = Field(1.0, gt=0.5, le=1.5, description="Multiplier of segment lengths (1.0: 50th pct).")
+    radius_scale: float = Field(1.0, gt=0.5, le=2.0, description="Multiplier of segment radii.")
+    skin_rgba: tuple[float, float, float, float] = Field((0.8, 0.6, 0.4, 1.0), description="Skin colour.")

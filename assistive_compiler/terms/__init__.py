@@ -1,0 +1,1 @@
+"""Reward terms, observation features and preference costs (see :mod:`.registry`)."""

@@ -1,0 +1,134 @@
+"""The term registry: reward terms, observation features and preference costs by name.
+
+A term is a small documented function of the per-step :class:`~assistive_compiler.runtime.snapshot.Snapshot`
+plus parameters. Its parameters are a strict pydantic model; fields annotated with a reference kind
+(:data:`PointRef`, :data:`BodyRef`, :data:`JointsRef`, :data:`ParticlesRef`, :data:`FrameRef`,
+:data:`BodiesRef`) name things in the spec. The resolver checks those names at validation time;
+the runtime replaces them with handles once, when the env is built, so a step only indexes arrays.
+
+Importing this module (and the term modules) is cheap: numpy and pydantic only.
+"""
+
+from __future__ import annotations
+
+import types
+import typing
+from dataclasses import dataclass
+from typing import Annotated, Any, Callable, Literal
+
+from pydantic import BaseModel, ConfigDict
+
+
+@dataclass(frozen=True)
+class RefKind:
+    """Marks a parameter field as a reference of a kind the resolver checks and the runtime binds."""
+
+    kind: Literal["point", "body", "bodies", "joints", "particles", "frame"]
+
+
+PointRef = Annotated[str, RefKind("point")]
+"""A point: a target name, ``body`` (its reference link) or ``body.link``."""
+BodyRef = Annotated[str, RefKind("body")]
+"""A body: robot, person, a tool, a furniture piece or a particle set."""
+BodiesRef = Annotated[list[str], RefKind("bodies")]
+"""Several bodies whose contacts are pooled, e.g. [robot, spoon]."""
+JointsRef = Annotated[str, RefKind("joints")]
+"""A joint group: ``robot.arm`` or ``person.<group>``."""
+ParticlesRef = Annotated[str, RefKind("particles")]
+"""A particle set name."""
+FrameRef = Annotated[Literal["world", "robot_base", "person_base"], RefKind("frame")]
+"""An observation frame: the world, the robot's base or the person's base (chest)."""
+
+
+class Params(BaseModel):
+    """Base of term parameter models: strict like the spec."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+
+
+class NoParams(Params):
+    """The term takes no parameters."""
+
+
+Category = Literal["reward", "observation", "preference"]
+
+
+@dataclass(frozen=True)
+class TermDef:
+    """A registered term."""
+
+    name: str
+    category: Category
+    params: type[Params]
+    fn: Callable[..., Any]
+    doc: str
+    size: Callable[[Params, "SizeContext"], int] | None = None
+
+    def summary(self) -> str:
+        return (self.doc.strip().splitlines() or [""])[0]
+
+
+@dataclass(frozen=True)
+class SizeContext:
+    """What an observation feature's size may depend on (known at compile time)."""
+
+    joint_group_sizes: dict[str, int]
+
+
+REGISTRY: dict[Category, dict[str, TermDef]] = {"reward": {}, "observation": {}, "preference": {}}
+
+
+def term(
+    name: str,
+    category: Category,
+    params: type[Params] = NoParams,
+    size: Callable[[Any, SizeContext], int] | int | None = None,
+) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """Register ``fn(snapshot, params)`` as the term ``name`` of ``category``."""
+
+    def decorate(fn: Callable[..., Any]) -> Callable[..., Any]:
+        if name in REGISTRY[category]:
+            raise ValueError(f"{category} term '{name}' registered twice")
+        size_fn = (lambda _p, _c, n=size: n) if isinstance(size, int) else size
+        REGISTRY[category][name] = TermDef(name, category, params, fn, fn.__doc__ or "", size_fn)
+        return fn
+
+    return decorate
+
+
+def terms(category: Category) -> dict[str, TermDef]:
+    """All registered terms of ``category`` (importing the built-in term modules first)."""
+    from . import observations, preferences, rewards  # noqa: F401  (registration side effects)
+
+    return REGISTRY[category]
+
+
+def ref_fields(params: type[Params]) -> dict[str, tuple[RefKind, str]]:
+    """The reference fields of a params model: name → (kind, shape), shape 'one' | 'list' | 'optional'."""
+    out: dict[str, tuple[RefKind, str]] = {}
+    for fname, field in params.model_fields.items():
+        for meta in field.metadata:
+            if isinstance(meta, RefKind):
+                out[fname] = (meta, "one")
+        if fname in out:
+            continue
+        found = _ref_inside(field.annotation)
+        if found is not None:
+            out[fname] = found
+    return out
+
+
+def _ref_inside(annotation: Any) -> tuple[RefKind, str] | None:
+    origin = typing.get_origin(annotation)
+    args = typing.get_args(annotation)
+    if origin is typing.Annotated:
+        kinds = [m for m in args[1:] if isinstance(m, RefKind)]
+        return (kinds[0], "one") if kinds else None
+    if origin is list and args:
+        inner = _ref_inside(args[0])
+        return (inner[0], "list") if inner and inner[1] == "one" else None
+    if origin in (typing.Union, types.UnionType):
+        inners = [_ref_inside(a) for a in args if a is not type(None)]
+        if len(inners) == 1 and inners[0] is not None:
+            return (inners[0][0], "optional") if inners[0][1] == "one" else inners[0]
+    return None
