@@ -186,6 +186,7 @@ class Manifest(_Model):
     observations: dict[str, list[TermUse]] = Field(description="Observation features per agent, in order.")
     reward: list[TermUse] = Field(description="Reward terms including preference costs.")
     success: Success
+    scripted: dict[str, Any] | None = Field(None, description="Scripted baseline: point moved and waypoints (normalised).")
 
     def body(self, name: str) -> Body:
         for b in self.bodies:

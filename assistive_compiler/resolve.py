@@ -60,6 +60,7 @@ class ResolvedTask:
     reward: list[ResolvedTerm]
     success_threshold: float
     points: dict[str, dict[str, Any]] = field(default_factory=dict)
+    scripted: dict[str, Any] | None = None
 
     @property
     def spec(self) -> TaskSpec:
@@ -141,12 +142,13 @@ class _Resolver:
             names_seen[t.name] = i
         reward += self._preferences(spec)
         threshold = self._success(spec, {t.name for t in spec.reward})
+        scripted = self._scripted(spec)
         if self.problems:
             raise SpecError(self.problems)
         return ResolvedTask(
             self.loaded, self.robot_name, robot, self.robot_urdf, tools, furniture, people, self.person_urdf,
             self.robot_links, self.joint_groups, {a: [t for t in ts if t] for a, ts in observations.items()},
-            [t for t in reward if t], threshold, points,
+            [t for t in reward if t], threshold, points, scripted,
         )
 
     def _bodies(self, spec: TaskSpec) -> None:
@@ -380,6 +382,16 @@ class _Resolver:
             params = self._params(registry[name], pref.params, path + ("params",))
             out.append(None if params is None else ResolvedTerm(f"preference_{name}", name, "preference", weight, params))
         return out
+
+    def _scripted(self, spec: TaskSpec) -> dict[str, Any] | None:
+        if spec.scripted is None:
+            return None
+        move = self.point(spec.scripted.move, ("scripted", "move"))
+        waypoints = []
+        for i, w in enumerate(spec.scripted.waypoints):
+            to = self.point(w.to, ("scripted", "waypoints", i, "to"))
+            waypoints.append({"to": to, "offset_m": list(w.offset_m), "tolerance_m": w.tolerance_m})
+        return {"move": move, "waypoints": waypoints}
 
     def _success(self, spec: TaskSpec, reward_names: set[str]) -> float:
         success = spec.success

@@ -498,6 +498,7 @@ def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lowe
         observations={agent: [obs_use(t) for t in ts] for agent, ts in rt.observations.items()},
         reward=[TermUse(name=t.name, term=t.term, category=t.category, weight=t.weight, params=t.params) for t in rt.reward],
         success=Success(term=spec.success.term, aggregate=spec.success.aggregate, threshold=rt.success_threshold),
+        scripted=rt.scripted,
     )
 
 

@@ -468,6 +468,27 @@ class Success(Strict):
 
 
 # --------------------------------------------------------------------------------------------
+# Scripted baseline
+
+
+class Waypoint(Strict):
+    """A goal for the scripted controller: a point near a target, reached within a tolerance."""
+
+    to: Ref = Field(description="Target or link the goal is relative to, e.g. mouth.")
+    offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Goal offset from that point, world frame, metres.")
+    tolerance_m: float = Field(0.02, ge=0, le=1, description="Distance at which the next waypoint starts, metres.")
+
+
+class Scripted(Strict):
+    """A privileged baseline controller (IK each step) that moves a point of the tool through
+    waypoints, keeping the tool's start orientation. It shows the task is solvable and checks the
+    reward wiring; it is not a learned policy."""
+
+    move: Ref = Field(description="The point moved, e.g. spoon (its reference link) or spoon.tip.")
+    waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order; the last is held.")
+
+
+# --------------------------------------------------------------------------------------------
 # The task
 
 
@@ -489,3 +510,4 @@ class TaskSpec(Strict):
     reward: list[RewardTerm] = Field(min_length=1, description="Weighted reward terms.")
     preferences: Preferences = Field(default_factory=Preferences, description="Human-preference costs.")
     success: Success = Field(description="What counts as success.")
+    scripted: Scripted | None = Field(None, description="A scripted baseline controller (optional).")

@@ -1,0 +1,322 @@
+"""The runtime commands of the CLI: ``run``, ``render``, ``bench`` and ``demo``.
+
+Each compiles the spec first (a cache hit when nothing changed), so a spec path is all they need.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .policies import POLICIES
+
+
+def _env(spec: str, robot: str | None, out: str | None = None, **kwargs):
+    from .runtime.env import AssistiveEnv
+
+    return AssistiveEnv.from_spec(spec, robot=robot, out_dir=out, **kwargs)
+
+
+# --------------------------------------------------------------------------------------------
+# run
+
+
+def rollout(env, policy, seed: int) -> dict:
+    """One episode: return, success, summed term values, mean force on the person."""
+    obs, info = env.reset(seed=seed)
+    total, terms, forces = 0.0, {}, []
+    done = False
+    while not done:
+        obs, reward, terminated, truncated, info = env.step(policy(obs))
+        total += reward
+        for name, value in info["terms"].items():
+            terms[name] = terms.get(name, 0.0) + value
+        forces.append(info["total_force_on_human"])
+        done = terminated or truncated
+    return {
+        "seed": seed,
+        "return": total,
+        "success": bool(info["task_success"]),
+        "success_metric": info["success_metric"],
+        "mean_force_on_human_n": float(np.mean(forces)),
+        "terms": terms,
+    }
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from tqdm import tqdm
+
+    from .policies import make_policy
+
+    env = _env(args.spec, args.robot, args.out)
+    weights = {t.name: t.weight for t in env.manifest.reward}
+    policy = make_policy(args.policy, env, seed=args.seed)
+    episodes = []
+    bar = tqdm(range(args.episodes), desc=f"{env.manifest.gym_id} {args.policy}", unit="ep", file=sys.stderr, disable=args.quiet)
+    for k in bar:
+        episodes.append(rollout(env, policy, args.seed + k))
+        bar.set_postfix(success=f"{sum(e['success'] for e in episodes)}/{len(episodes)}")
+    env.close()
+    rate = sum(e["success"] for e in episodes) / len(episodes)
+    if args.json:
+        print(json.dumps({"task": env.manifest.task, "robot": env.manifest.robot_name, "policy": args.policy,
+                          "episodes": episodes, "success_rate": rate,
+                          "mean_return": float(np.mean([e["return"] for e in episodes]))}, indent=1))
+        return 0
+    print(f"{env.manifest.gym_id}  policy={args.policy}  episodes={len(episodes)}  seed={args.seed}")
+    print(f"{'ep':>3} {'seed':>5} {'return':>9} {'success':>7}  largest weighted terms (episode sums)")
+    for k, e in enumerate(episodes):
+        top = sorted(e["terms"].items(), key=lambda kv: -abs(weights[kv[0]] * kv[1]))[:3]
+        shown = ", ".join(f"{name} {weights[name] * value:+.1f}" for name, value in top)
+        print(f"{k:>3} {e['seed']:>5} {e['return']:>9.1f} {'yes' if e['success'] else 'no':>7}  {shown}")
+    print(f"success rate {rate:.2f}   mean return {np.mean([e['return'] for e in episodes]):.1f}")
+    return 0
+
+
+# --------------------------------------------------------------------------------------------
+# render
+
+
+def record(env, policy, seed: int, every: int) -> tuple[list[np.ndarray], dict]:
+    """Frames of one episode (every ``every`` steps, plus the first and last) and its summary."""
+    obs, _ = env.reset(seed=seed)
+    frames, total, done, info = [env.render()], 0.0, False, {}
+    while not done:
+        obs, reward, terminated, truncated, info = env.step(policy(obs))
+        total += reward
+        done = terminated or truncated
+        if env.steps % every == 0 or done:
+            frames.append(env.render())
+    return frames, {"return": total, "success": bool(info.get("task_success")), "steps": env.steps}
+
+
+def montage(frames: list[np.ndarray], count: int = 4) -> np.ndarray:
+    """``count`` evenly spaced frames side by side (a strip that tells the episode at a glance)."""
+    idx = np.linspace(0, len(frames) - 1, count).round().astype(int)
+    return np.concatenate([frames[i] for i in idx], axis=1)
+
+
+def write_picture(frames: list[np.ndarray], out: Path, fps: int) -> None:
+    from PIL import Image
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    if out.suffix.lower() == ".gif":
+        images = [Image.fromarray(f) for f in frames]
+        images[0].save(out, save_all=True, append_images=images[1:], duration=int(1000 / fps), loop=0, optimize=False)
+    elif out.suffix.lower() == ".png":
+        Image.fromarray(montage(frames)).save(out)
+    else:
+        raise SystemExit(f"--out must end in .gif or .png, got {out}")
+
+
+def cmd_render(args: argparse.Namespace) -> int:
+    from .policies import make_policy
+
+    env = _env(args.spec, args.robot, args.out_dir, render_mode="rgb_array", render_size=(args.width, args.height))
+    policy = make_policy(args.policy, env, seed=args.seed)
+    frames, summary = record(env, policy, args.seed, args.every)
+    env.close()
+    write_picture(frames, Path(args.out), fps=max(1, 10 // args.every))
+    print(f"wrote {args.out} ({len(frames)} frames; return {summary['return']:.1f}, success {'yes' if summary['success'] else 'no'})")
+    return 0
+
+
+# --------------------------------------------------------------------------------------------
+# bench
+
+
+def _median_p95(values: list[float]) -> tuple[float, float]:
+    s = sorted(values)
+    return statistics.median(s), s[min(len(s) - 1, int(round(0.95 * (len(s) - 1))))]
+
+
+_CHILD = r"""
+import json, resource, sys, time, numpy as np
+t = time.perf_counter()
+import assistive_compiler
+import_s = time.perf_counter() - t
+heavy = sorted(m for m in ("torch", "tensorflow", "jax", "ray", "stable_baselines3", "pybullet") if m in sys.modules)
+from assistive_compiler.runtime.env import AssistiveEnv
+env = AssistiveEnv(sys.argv[1])
+env.reset(seed=0)
+for _ in range(200):
+    env.step(env.action_space.sample())
+print(json.dumps({"import_s": import_s, "heavy_modules_on_import": heavy,
+                  "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+"""
+
+
+def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int) -> dict:
+    """Speed figures of one (task, robot), all taken in this one run (medians over repeats)."""
+    import tempfile
+
+    import pybullet as pb
+
+    from .compile.compiler import compile_task
+
+    with tempfile.TemporaryDirectory() as tmp:
+        cold = compile_task(spec, robot, Path(tmp) / "cold", force=True)
+        cached = compile_task(spec, robot, Path(tmp) / "cold")
+        assert cached.cache_hit
+        from .runtime.env import AssistiveEnv
+
+        env = AssistiveEnv(cold.out_dir)
+        # Time physics inside the env's own steps: the same scene, the same motion.
+        physics = [0.0]
+        world = env.world
+        original = world.step_physics
+
+        def timed(n: int) -> None:
+            t0 = time.perf_counter()
+            original(n)
+            physics[0] += time.perf_counter() - t0
+
+        world.step_physics = timed  # type: ignore[method-assign]
+        env.action_space.seed(0)
+        env_rates, raw_rates, overhead = [], [], []
+        for r in range(repeats):
+            env.reset(seed=r)
+            physics[0] = 0.0
+            t0 = time.perf_counter()
+            for _ in range(steps):
+                env.step(env.action_space.sample())
+            total = time.perf_counter() - t0
+            env_rates.append(steps / total)
+            raw_rates.append(steps / physics[0])
+            overhead.append((total - physics[0]) / steps * 1e6)
+        # A raw loop of stepSimulation with nothing else, for reference.
+        env.reset(seed=0)
+        t0 = time.perf_counter()
+        for _ in range(steps * env.manifest.sim.frame_skip):
+            pb.stepSimulation(physicsClientId=world.client)
+        raw_loop = steps / (time.perf_counter() - t0)
+        reset_ms = []
+        for k in range(resets):
+            t0 = time.perf_counter()
+            env.reset(seed=1000 + k)
+            reset_ms.append((time.perf_counter() - t0) * 1e3)
+            env.step(env.action_space.sample())
+        m = env.manifest
+        env.close()
+        child = subprocess.run([sys.executable, "-c", _CHILD, str(cold.out_dir)], capture_output=True, text=True, check=True,
+                               env=os.environ | {"PYTHONWARNINGS": "ignore"})
+        proc = json.loads(child.stdout.strip().splitlines()[-1])
+    env_med = statistics.median(env_rates)
+    raw_med = statistics.median(raw_rates)
+    reset_med, reset_p95 = _median_p95(reset_ms)
+    return {
+        "task": m.task, "robot": m.robot_name, "gym_id": m.gym_id,
+        "obs_size": sum(t.size for t in m.observations["robot"]), "action_size": len(m.robot.arm_joints),
+        "env_steps_per_s": round(env_med, 1),
+        "raw_physics_steps_per_s": round(raw_med, 1),
+        "env_over_raw": round(env_med / raw_med, 3),
+        "env_overhead_us_per_step": round(statistics.median(overhead), 1),
+        "raw_loop_steps_per_s_at_rest": round(raw_loop, 1),
+        "reset_ms_median": round(reset_med, 3), "reset_ms_p95": round(reset_p95, 3), "resets": resets,
+        "compile_s_cold": round(cold.seconds, 3), "compile_s_cached": round(cached.seconds, 3),
+        "import_s": round(proc["import_s"], 4), "heavy_modules_on_import": proc["heavy_modules_on_import"],
+        "peak_rss_mb_one_env": round(proc["peak_rss_mb"], 1),
+        "steps_per_repeat": steps, "repeats": repeats,
+        "notes": "env/raw: the same episodes, physics timed inside env.step (stepSimulation + gravity compensation) vs the whole step; random actions; medians over repeats",
+    }
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    result = bench(args.spec, args.robot, args.steps, args.resets, args.repeats)
+    if args.json:
+        print(json.dumps(result, indent=1))
+        return 0
+    width = max(len(k) for k in result)
+    for key, value in result.items():
+        print(f"{key:<{width}}  {value}")
+    return 0
+
+
+# --------------------------------------------------------------------------------------------
+# demo: the README's main job
+
+
+def cmd_demo(args: argparse.Namespace) -> int:
+    from .compile.compiler import compile_task
+    from .policies import make_policy
+    from .runtime.env import AssistiveEnv
+
+    spec = str(Path(args.spec))
+    result = compile_task(spec, args.robot)
+    m = result.manifest
+    print(f"{'cache hit' if result.cache_hit else 'compiled'}: {m.task} for {m.robot_name} -> {result.out_dir}/ ({result.seconds:.2f} s)")
+    env = AssistiveEnv(result.out_dir, render_mode="rgb_array")
+    policy = make_policy("scripted", env)
+    outcomes = []
+    for k in range(args.episodes):
+        frames = None
+        if k == 0:
+            frames, _ = record(env, policy, args.seed, every=10)
+            env.reset(seed=args.seed)
+        e = rollout(env, policy, args.seed + k)
+        outcomes.append(e)
+        eaten = e["success_metric"]
+        print(f"episode {k}: return {e['return']:7.1f}  success {'yes' if e['success'] else 'no '}  "
+              f"{m.success.term} {eaten:g} (need {m.success.threshold:g})  mean force on person {e['mean_force_on_human_n']:.2f} N")
+        if frames is not None:
+            write_picture(frames, Path(args.picture), fps=1)
+    env.close()
+    rate = sum(o["success"] for o in outcomes) / len(outcomes)
+    print(f"scripted success {rate:.0%} over {len(outcomes)} episodes; picture: {args.picture}")
+    return 0
+
+
+def add_commands(sub) -> None:
+    def common(p, policy: bool = True):
+        p.add_argument("spec", help="task spec file")
+        p.add_argument("--robot", help="robot (default: the spec's default)")
+        if policy:
+            p.add_argument("--policy", choices=POLICIES, default="scripted", help="policy to roll out (default scripted)")
+        p.add_argument("--seed", type=int, default=0, help="first episode seed")
+
+    p = sub.add_parser("run", help="roll out a policy and report returns, success and the largest terms")
+    common(p)
+    p.add_argument("--episodes", type=int, default=5)
+    p.add_argument("--out", help="artifact directory (default generated/<task>-<robot>)")
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_run)
+
+    p = sub.add_parser("render", help="write a GIF (or a PNG strip) of one episode, headless")
+    common(p)
+    p.add_argument("--out", required=True, help="output .gif or .png")
+    p.add_argument("--every", type=int, default=4, help="record every N steps (default 4)")
+    p.add_argument("--width", type=int, default=480)
+    p.add_argument("--height", type=int, default=360)
+    p.add_argument("--out-dir", dest="out_dir", help="artifact directory")
+    p.set_defaults(func=cmd_render)
+
+    p = sub.add_parser("bench", help="speed figures taken in one run: steps/s vs raw physics, resets, compile, import, RSS")
+    common(p, policy=False)
+    p.add_argument("--steps", type=int, default=400, help="env steps per repeat")
+    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--resets", type=int, default=100)
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_bench)
+
+    p = sub.add_parser("demo", help="the main job: compile Feeding for Jaco, run the scripted policy, write a picture")
+    p.add_argument("--spec", default=str(_default_feeding()), help="task spec (default: the shipped feeding.yaml)")
+    p.add_argument("--robot", default="jaco")
+    p.add_argument("--episodes", type=int, default=3)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--picture", default="feeding.png", help="picture of the first episode (.png strip or .gif)")
+    p.set_defaults(func=cmd_demo)
+
+
+def _default_feeding() -> Path:
+    from .paths import specs_dir, display
+
+    return Path(display(specs_dir() / "tasks" / "feeding.yaml"))

@@ -1,0 +1,73 @@
+"""The scripted baseline: move a tool point through the task's waypoints by inverse kinematics.
+
+Each step it reads the world (privileged: true target positions), asks pybullet's IK for the arm
+configuration that puts the moved point at the current waypoint with the tool's start
+orientation, and returns the joint-delta action that heads there (clipped to [−1, 1]). It
+advances to the next waypoint within the waypoint's tolerance and holds the last one. Works for
+any task and robot whose manifest has a ``scripted`` section.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pybullet as pb
+
+
+class ScriptedPolicy:
+    """Callable ``obs -> action`` bound to one :class:`~assistive_compiler.runtime.env.AssistiveEnv`."""
+
+    def __init__(self, env):
+        m = env.manifest
+        if m.scripted is None:
+            raise ValueError(f"task '{m.task}' has no scripted: section, so there is no scripted policy for it")
+        self.env = env
+        snap = env.snap
+        self.move = snap.point(m.scripted["move"])
+        self.waypoints = [(snap.point(w["to"]), np.asarray(w["offset_m"]), w["tolerance_m"]) for w in m.scripted["waypoints"]]
+        robot = env.world.robot
+        self.ee_link = robot.links[m.robot.links["tool_mount"]]
+        self.ee_point = snap.point({"body": "robot", "link": m.robot.links["tool_mount"]})
+        c = env.world.client
+        movable = [j for j in range(pb.getNumJoints(robot.id, physicsClientId=c)) if pb.getJointInfo(robot.id, j, physicsClientId=c)[2] != pb.JOINT_FIXED]
+        self.movable = movable
+        self.cols = [movable.index(i) for i in env.arm_idx]
+        self.lo = [pb.getJointInfo(robot.id, j, physicsClientId=c)[8] for j in movable]
+        self.hi = [pb.getJointInfo(robot.id, j, physicsClientId=c)[9] for j in movable]
+        self.ranges = [max(h - l, 1e-3) for l, h in zip(self.lo, self.hi)]
+        self._episode_marker = None
+
+    def _start_episode(self) -> None:
+        snap = self.env.snap
+        # The moved point rides rigidly on the end effector: remember its pose in the EE frame,
+        # and the orientation to keep.
+        ee_pos, ee_orn = snap.position(self.ee_point), snap.orientation(self.ee_point)
+        pt_pos, pt_orn = snap.position(self.move), snap.orientation(self.move)
+        inv = pb.invertTransform(ee_pos.tolist(), ee_orn.tolist())
+        self.point_in_ee = pb.multiplyTransforms(inv[0], inv[1], pt_pos.tolist(), pt_orn.tolist())
+        self.keep_orn = pt_orn.tolist()
+        self.index = 0
+
+    def __call__(self, obs) -> np.ndarray:
+        env = self.env
+        if self._episode_marker is not env.snap.frames.get("robot_base") or env.steps == 0:
+            self._episode_marker = env.snap.frames.get("robot_base")
+            if env.steps == 0:
+                self._start_episode()
+        snap = env.snap
+        to, offset, tol = self.waypoints[self.index]
+        goal = snap.position(to) + offset
+        if self.index < len(self.waypoints) - 1 and np.linalg.norm(snap.position(self.move) - goal) <= tol:
+            self.index += 1
+            to, offset, tol = self.waypoints[self.index]
+            goal = snap.position(to) + offset
+        # End-effector pose that puts the moved point at the goal with the kept orientation.
+        inv_pos, inv_orn = pb.invertTransform(*self.point_in_ee)
+        ee_pos, ee_orn = pb.multiplyTransforms(goal.tolist(), self.keep_orn, inv_pos, inv_orn)
+        c = env.world.client
+        robot = env.world.robot.id
+        rest = [pb.getJointState(robot, j, physicsClientId=c)[0] for j in self.movable]
+        sol = pb.calculateInverseKinematics(robot, self.ee_link, ee_pos, ee_orn, lowerLimits=self.lo, upperLimits=self.hi,
+                                            jointRanges=self.ranges, restPoses=rest, maxNumIterations=50, physicsClientId=c)
+        q_goal = np.array([sol[k] for k in self.cols])
+        q = np.array([rest[k] for k in self.cols])
+        return np.clip((q_goal - q) / env.delta_scale, -1.0, 1.0).astype(np.float32)

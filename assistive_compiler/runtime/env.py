@@ -1,0 +1,202 @@
+"""The Gymnasium face of a compiled task: one generic environment for every task and robot.
+
+* **Action** (robot): joint-position deltas of the arm in [−1, 1]; each env step the target is
+  ``q_measured + frame_skip · action_scale · clip(a)`` clamped to the joint limits, sent as one
+  position-control command, then ``frame_skip`` physics steps run (the paper's 10 Hz control).
+* **Observation**: the spec's features concatenated (float32).
+* **Reward**: Σ weight·value over the reward terms (preference costs included);
+  ``info["terms"]`` holds every term's unweighted value, ``info["total_force_on_human"]`` the
+  contact force of robot and tools on the person (N), ``info["task_success"]`` 1 once the
+  success criterion holds (``info["success_metric"]`` its aggregate so far).
+* **Episodes** end by truncation after ``episode_steps`` (no early termination, as the paper).
+
+``reset()`` restores a saved state and applies the episode's draws — person variant, randomised
+joint angles, one of the precomputed start configurations, furniture noise, floor friction —
+without reloading anything or solving IK.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any, Callable
+
+import gymnasium as gym
+import numpy as np
+import pybullet as pb
+
+from ..artifact import Manifest, TermUse
+from ..terms.registry import ref_fields, terms
+from .particles import ParticleSystem
+from .snapshot import Snapshot
+from .world import PARK, World
+
+
+def bind_term(use: TermUse, snap: Snapshot) -> Callable[[Snapshot], Any]:
+    """The term's function with its references replaced by snapshot handles."""
+    tdef = terms(use.category)[use.term]
+    values = dict(use.params)
+    for fname, (kind, shape) in ref_fields(tdef.params).items():
+        v = values.get(fname)
+        if v is None:
+            continue
+        bind = {"point": snap.point, "joints": snap.joints}.get(kind.kind)
+        if bind is not None:
+            values[fname] = [bind(x) for x in v] if shape == "list" else bind(v)
+    params = SimpleNamespace(**values)
+    fn = tdef.fn
+    return lambda s: fn(s, params)
+
+
+class AssistiveEnv(gym.Env):
+    """A compiled assistive task as a Gymnasium environment (robot acting, person static)."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
+
+    def __init__(self, artifact_dir: str | Path, render_mode: str | None = None, render_size: tuple[int, int] = (480, 360)):
+        self.artifact_dir = Path(artifact_dir)
+        self.manifest = m = Manifest.read(self.artifact_dir)
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        self.render_mode = render_mode
+        self.render_size = render_size
+        self.world = World(self.artifact_dir, m)
+        self.snap = Snapshot(self.world)
+        self.particles = ParticleSystem(self.world, self.snap)
+        robot = self.world.robot
+        self.arm_idx = [robot.joints[j] for j in m.robot.arm_joints]
+        self.lower = np.array(m.robot.joint_lower)
+        self.upper = np.array(m.robot.joint_upper)
+        self.gripper_idx = [robot.joints[j] for j in m.robot.gripper_joints]
+        self.delta_scale = m.robot.action_scale * m.sim.frame_skip
+
+        self.obs_fns = [bind_term(t, self.snap) for t in m.observations["robot"]]
+        self.reward_fns = [(t.name, t.weight, bind_term(t, self.snap)) for t in m.reward]
+        self.tool_point = self.snap.point({"body": "robot", "link": m.robot.links["tool_mount"]})
+        person_names = [b.name for b in m.bodies if b.kind == "person"]
+        self._force_on_person = ([b.name for b in m.bodies if b.kind in ("robot", "tool")], ["person"])
+        obs_size = sum(t.size for t in m.observations["robot"])
+        self.observation_space = gym.spaces.Box(-np.inf, np.inf, (obs_size,), np.float32)
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (len(self.arm_idx),), np.float32)
+        self.steps = 0
+        self.success_values: list[float] = []
+        self._person_names = person_names
+        self._robot_base = self.world.base_frame(robot)
+
+    @classmethod
+    def from_spec(cls, spec: str | Path, robot: str | None = None, out_dir: str | Path | None = None, **kwargs) -> "AssistiveEnv":
+        """Compile ``spec`` for ``robot`` (a cache hit when unchanged) and build the env."""
+        from ..compile.compiler import compile_task
+
+        result = compile_task(spec, robot, out_dir)
+        return cls(result.out_dir, **kwargs)
+
+    # -- Gymnasium API ------------------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        rng = self.np_random
+        m, w, c = self.manifest, self.world, self.world.client
+        w.restore()
+        # Person variant: the drawn one in place, the others parked.
+        variant = m.person.variants[int(rng.integers(len(m.person.variants)))]
+        w.active_variant = variant
+        for i, v in enumerate(m.person.variants):
+            body = m.body(v.body)
+            parked = (PARK[0] + 10.0 * i, PARK[1], PARK[2])
+            w.set_base_frame(w.variant_bodies[v.name], body.position if v.name == variant.name else parked, body.orientation)
+        person = w.variant_bodies[variant.name]
+        angles = {j: variant.initial_angles[j] for j in variant.movable_joints}
+        for j, (lo, hi) in variant.randomize.items():
+            angles[j] = float(rng.uniform(lo, hi))
+        idx = [person.joints[j] for j in variant.movable_joints]
+        for i, j in zip(idx, variant.movable_joints):
+            pb.resetJointState(person.id, i, angles[j], physicsClientId=c)
+        if idx:
+            pb.setJointMotorControlArray(person.id, idx, pb.POSITION_CONTROL, targetPositions=[angles[j] for j in variant.movable_joints],
+                                         positionGains=[m.person.hold_gain] * len(idx), forces=[m.person.hold_force] * len(idx), physicsClientId=c)
+        for name, offset in variant.target_offsets.items():
+            if name in self.snap.target_offsets:
+                self.snap.target_offsets[name] = np.asarray(offset, dtype=float)
+        # Robot: one precomputed start configuration (no IK), gripper at its task position.
+        k = int(rng.integers(len(variant.start_configurations)))
+        q0 = variant.start_configurations[k]
+        for i, q in zip(self.arm_idx, q0):
+            pb.resetJointState(w.robot.id, i, q, physicsClientId=c)
+        pb.setJointMotorControlArray(w.robot.id, self.arm_idx, pb.POSITION_CONTROL, targetPositions=q0,
+                                     positionGains=[m.robot.position_gain] * len(q0), forces=[m.robot.max_force] * len(q0), physicsClientId=c)
+        if self.gripper_idx:
+            for i in self.gripper_idx:
+                pb.resetJointState(w.robot.id, i, m.robot.gripper_position, physicsClientId=c)
+            pb.setJointMotorControlArray(w.robot.id, self.gripper_idx, pb.POSITION_CONTROL, targetPositions=[m.robot.gripper_position] * len(self.gripper_idx),
+                                         positionGains=[0.05] * len(self.gripper_idx), forces=[500.0] * len(self.gripper_idx), physicsClientId=c)
+        # Tools follow the hand exactly.
+        for att in m.tools:
+            link_pos, link_orn = w.link_frame(w.robot, w.robot.links[att.parent_link])
+            pos, orn = pb.multiplyTransforms(link_pos, link_orn, att.position, att.orientation)
+            w.set_base_frame(w.bodies[att.body], pos, orn)
+            pb.resetBaseVelocity(w.bodies[att.body].id, (0, 0, 0), (0, 0, 0), physicsClientId=c)
+        # Furniture noise and floor friction.
+        for body in m.bodies:
+            if body.kind == "furniture" and any(body.position_noise):
+                noise = rng.uniform(-np.asarray(body.position_noise), np.asarray(body.position_noise))
+                w.set_base_frame(w.bodies[body.name], tuple(np.asarray(body.position) + noise), body.orientation)
+        lo, hi = m.sim.ground_friction
+        pb.changeDynamics(w.ground, -1, lateralFriction=float(rng.uniform(lo, hi)), physicsClientId=c)
+        self.particles.reset()
+
+        self.steps = 0
+        self.success_values = []
+        self.snap.actions = {"robot": np.zeros(len(self.arm_idx)), "human": np.zeros(0)}
+        self.snap.set_frame("robot_base", *w.base_frame(w.robot))
+        self.snap.set_frame("person_base", *w.base_frame(person))
+        self.snap.refresh()
+        return self._observe(), {"person_variant": variant.name, "start_configuration": k}
+
+    def step(self, action):
+        m, w, c = self.manifest, self.world, self.world.client
+        raw = np.asarray(action, dtype=np.float64).reshape(-1)
+        if raw.shape != (len(self.arm_idx),):
+            raise ValueError(f"action must have shape ({len(self.arm_idx)},), got {raw.shape}")
+        q = np.array([s[0] for s in pb.getJointStates(w.robot.id, self.arm_idx, physicsClientId=c)])
+        target = np.clip(q + self.delta_scale * np.clip(raw, -1.0, 1.0), self.lower, self.upper)
+        pb.setJointMotorControlArray(w.robot.id, self.arm_idx, pb.POSITION_CONTROL, targetPositions=target.tolist(),
+                                     positionGains=[m.robot.position_gain] * len(target), forces=[m.robot.max_force] * len(target), physicsClientId=c)
+        w.step_physics(m.sim.frame_skip)
+        self.steps += 1
+        self.snap.actions["robot"] = raw
+        self.snap.refresh()
+        self.particles.update()
+
+        values = {name: float(fn(self.snap)) for name, _, fn in self.reward_fns}
+        reward = float(sum(weight * values[name] for name, weight, _ in self.reward_fns))
+        self.success_values.append(values[m.success.term])
+        metric = self._success_metric()
+        info = {
+            "terms": values,
+            "total_force_on_human": self.snap.contact_force(*self._force_on_person),
+            "task_success": int(metric >= m.success.threshold),
+            "success_metric": metric,
+        }
+        truncated = self.steps >= m.sim.episode_steps
+        return self._observe(), reward, False, truncated, info
+
+    def render(self):
+        if self.render_mode != "rgb_array":
+            return None
+        from .camera import render_rgb
+
+        return render_rgb(self, *self.render_size)
+
+    def close(self):
+        self.world.close()
+
+    # -- helpers -------------------------------------------------------------------------------
+    def _observe(self) -> np.ndarray:
+        return np.concatenate([np.atleast_1d(fn(self.snap)) for fn in self.obs_fns]).astype(np.float32)
+
+    def _success_metric(self) -> float:
+        agg = self.manifest.success.aggregate
+        vals = self.success_values
+        if not vals:
+            return 0.0
+        return float({"sum": sum, "max": max, "min": min, "last": lambda v: v[-1]}[agg](vals))

@@ -1,0 +1,86 @@
+"""Particle lifecycles (food, water): active → consumed (reached the target) | lost (left its
+container); the first contact of an active particle with ``hit_body`` counts once as a hit.
+
+Removed particles are parked far below the floor with mass 0 (static, no solver cost) and get
+their mass back at reset. Events are evaluated once per env step, as in the reference.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pybullet as pb
+
+from ..artifact import ParticleSet
+from .snapshot import ParticleEvents, PointHandle, Snapshot
+from .world import PARK, World
+
+
+class ParticleSystem:
+    """All particle sets of a world."""
+
+    def __init__(self, world: World, snap: Snapshot):
+        self.world = world
+        self.snap = snap
+        self.sets: list[tuple[ParticleSet, list[int], PointHandle | None]] = []
+        for ps in world.m.particles:
+            target = snap.point({"target": ps.consumed_target}) if ps.consumed_target else None
+            self.sets.append((ps, world.particles[ps.name], target))
+        self.active: dict[str, np.ndarray] = {}
+        self.hit: dict[str, np.ndarray] = {}
+
+    def reset(self) -> None:
+        """Place every particle at its settled position in its holder's frame; all active."""
+        w, c = self.world, self.world.client
+        for ps, ids, _ in self.sets:
+            holder = w.bodies[ps.attach]
+            frame_pos, frame_orn = w.link_frame(holder, holder.links[ps.attach_link])
+            for pid, local in zip(ids, ps.start_positions):
+                if pid in w.parked:
+                    pb.changeDynamics(pid, -1, mass=ps.mass, physicsClientId=c)
+                    w.parked.discard(pid)
+                pos, _ = pb.multiplyTransforms(frame_pos, frame_orn, local, (0, 0, 0, 1))
+                pb.resetBasePositionAndOrientation(pid, pos, (0, 0, 0, 1), physicsClientId=c)
+                pb.resetBaseVelocity(pid, (0, 0, 0), (0, 0, 0), physicsClientId=c)
+            self.active[ps.name] = np.ones(ps.count, dtype=bool)
+            self.hit[ps.name] = np.zeros(ps.count, dtype=bool)
+            self.snap.events[ps.name] = ParticleEvents()
+
+    def _park(self, pid: int, k: int) -> None:
+        c = self.world.client
+        pb.resetBasePositionAndOrientation(pid, (PARK[0] - 5.0 - 0.1 * k, PARK[1], PARK[2]), (0, 0, 0, 1), physicsClientId=c)
+        pb.resetBaseVelocity(pid, (0, 0, 0), (0, 0, 0), physicsClientId=c)
+        pb.changeDynamics(pid, -1, mass=0.0, physicsClientId=c)
+        self.world.parked.add(pid)
+
+    def update(self) -> None:
+        """Evaluate this step's events (after physics, after the snapshot refresh)."""
+        w, c, snap = self.world, self.world.client, self.snap
+        for ps, ids, target in self.sets:
+            ev = ParticleEvents()
+            active, hit = self.active[ps.name], self.hit[ps.name]
+            centre = snap.position(target) if target is not None else None
+            hit_ids = set()
+            if ps.hit_body:
+                hb = snap.handle(snap.body_key(ps.hit_body)).id
+                hit_ids = {cp[2] for cp in pb.getContactPoints(bodyA=hb, physicsClientId=c)}
+            lost_id = snap.handle(snap.body_key(ps.lost_body)).id if ps.lost_body else None
+            for k, pid in enumerate(ids):
+                if not active[k]:
+                    continue
+                pos = np.asarray(pb.getBasePositionAndOrientation(pid, physicsClientId=c)[0])
+                if pid in hit_ids and not hit[k]:
+                    hit[k] = True
+                    ev.hit += 1
+                if centre is not None and np.linalg.norm(pos - centre) < ps.consumed_radius:
+                    ev.consumed += 1
+                    ev.consumed_speed_sum += float(np.linalg.norm(pb.getBaseVelocity(pid, physicsClientId=c)[0]))
+                    active[k] = False
+                    self._park(pid, k)
+                elif lost_id is not None and not pb.getClosestPoints(pid, lost_id, ps.lost_distance, physicsClientId=c):
+                    ev.lost += 1
+                    active[k] = False
+                    self._park(pid, k)
+            snap.events[ps.name] = ev
+
+    def remaining(self, name: str) -> int:
+        return int(self.active[name].sum())

@@ -1,0 +1,242 @@
+"""The PyBullet world of one compiled artifact, built once per environment.
+
+:class:`World` owns a private DIRECT client for its whole life. It loads every body of the
+manifest, looks every referenced link and joint up by name once, attaches tools, creates the
+particles and saves the initial state; :meth:`World.restore` brings that state back in well under
+a millisecond. It knows nothing about any particular task.
+
+Per-body gravity on stock pybullet: the world gravity is set to the value that needs the fewest
+compensated links, and every movable link of a body with a different gravity gets an external
+force m·(g_body − g_world) at its centre of mass before each physics step (forces are cleared by
+``stepSimulation``). The effect on those links is exactly the body's own gravity.
+
+Frames: pybullet reports a base's pose at its centre of mass; :meth:`base_frame` and
+:meth:`set_base_frame` convert to and from the URDF frame the manifest uses.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pybullet as pb
+
+from ..artifact import Manifest
+
+PARK = (0.0, 500.0, 50.0)  # where inactive bodies (other person variants, removed particles) wait: far away, above the infinite floor, m
+
+
+@dataclass
+class BodyHandle:
+    """A loaded body: its pybullet id and name → index tables (base link is index -1)."""
+
+    name: str
+    id: int
+    links: dict[str, int]
+    joints: dict[str, int]
+    inertial_inv: tuple  # inverse of the base's local inertial frame (COM → URDF frame)
+
+
+class World:
+    """All bodies of an artifact in one pybullet DIRECT client."""
+
+    def __init__(self, artifact_dir: str | Path, manifest: Manifest | None = None):
+        self.dir = Path(artifact_dir)
+        self.m = manifest or Manifest.read(self.dir)
+        self.client = pb.connect(pb.DIRECT)
+        c = self.client
+        sim = self.m.sim
+        pb.setTimeStep(sim.time_step, physicsClientId=c)
+        params = {"numSolverIterations": sim.solver_iterations, "deterministicOverlappingPairs": 1}
+        if sim.sub_steps:
+            params["numSubSteps"] = sim.sub_steps
+        pb.setPhysicsEngineParameter(**params, physicsClientId=c)
+
+        plane = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=c)
+        plane_visual = pb.createVisualShape(pb.GEOM_BOX, halfExtents=[5, 5, 0.0005], rgbaColor=[0.85, 0.85, 0.82, 1], physicsClientId=c)
+        self.ground = pb.createMultiBody(0, plane, plane_visual, [0, 0, 0], physicsClientId=c)
+
+        self.bodies: dict[str, BodyHandle] = {}
+        for body in self.m.bodies:
+            flags = pb.URDF_USE_INERTIA_FROM_FILE
+            bid = pb.loadURDF(str(self.dir / body.urdf), body.position, body.orientation, useFixedBase=body.fixed_base, flags=flags, physicsClientId=c)
+            self.bodies[body.name] = self._handle(body.name, bid)
+            if body.friction is not None:
+                for link in [-1, *range(pb.getNumJoints(bid, physicsClientId=c))]:
+                    pb.changeDynamics(bid, link, lateralFriction=body.friction, physicsClientId=c)
+            # Disable the default velocity motors so joints are free unless we drive them.
+            joints = list(range(pb.getNumJoints(bid, physicsClientId=c)))
+            if joints:
+                pb.setJointMotorControlArray(bid, joints, pb.VELOCITY_CONTROL, forces=[0.0] * len(joints), physicsClientId=c)
+
+        self.robot = self.bodies["robot"]
+        self.variant_bodies = {v.name: self.bodies[v.body] for v in self.m.person.variants}
+        self.active_variant = self.m.person.variants[0]
+        self._attach_tools()
+        self._create_particles()
+        self._create_markers()
+        self._set_gravity()
+        self.initial_state = pb.saveState(physicsClientId=c)
+
+    # -- construction --------------------------------------------------------------------------
+    def _handle(self, name: str, bid: int) -> BodyHandle:
+        c = self.client
+        links = {pb.getBodyInfo(bid, physicsClientId=c)[0].decode(): -1}
+        joints: dict[str, int] = {}
+        for j in range(pb.getNumJoints(bid, physicsClientId=c)):
+            info = pb.getJointInfo(bid, j, physicsClientId=c)
+            joints[info[1].decode()] = j
+            links[info[12].decode()] = j
+        ipos, iorn = pb.getDynamicsInfo(bid, -1, physicsClientId=c)[3:5]
+        return BodyHandle(name, bid, links, joints, pb.invertTransform(ipos, iorn))
+
+    def _attach_tools(self) -> None:
+        c = self.client
+        self.tool_constraints: dict[str, int] = {}
+        for att in self.m.tools:
+            tool = self.bodies[att.body]
+            parent = self.robot.links[att.parent_link]
+            # Constraint frames are relative to centres of mass: convert from URDF link frames.
+            p_inertial = pb.getDynamicsInfo(self.robot.id, parent, physicsClientId=c)[3:5]
+            p_inv = pb.invertTransform(*p_inertial)
+            parent_pos, parent_orn = pb.multiplyTransforms(p_inv[0], p_inv[1], att.position, att.orientation)
+            child_pos, child_orn = tool.inertial_inv
+            cid = pb.createConstraint(self.robot.id, parent, tool.id, -1, pb.JOINT_FIXED, [0, 0, 0], parent_pos, child_pos,
+                                      parent_orn, child_orn, physicsClientId=c)
+            pb.changeConstraint(cid, maxForce=500, physicsClientId=c)
+            self.tool_constraints[att.body] = cid
+            for link in self.robot.links.values():
+                for tl in tool.links.values():
+                    pb.setCollisionFilterPair(self.robot.id, tool.id, link, tl, 0, physicsClientId=c)
+
+    def _create_particles(self) -> None:
+        c = self.client
+        self.particles: dict[str, list[int]] = {}
+        for ps in self.m.particles:
+            shape = pb.createCollisionShape(pb.GEOM_SPHERE, radius=ps.radius, physicsClientId=c)
+            ids = []
+            for i in range(ps.count):
+                visual = pb.createVisualShape(pb.GEOM_SPHERE, radius=ps.radius, rgbaColor=list(ps.colors[i]), physicsClientId=c)
+                ids.append(pb.createMultiBody(ps.mass, shape, visual, [PARK[0] - 5.0 - 0.1 * i, PARK[1] + 1.0, PARK[2]], physicsClientId=c))
+            self.particles[ps.name] = ids
+
+    def _create_markers(self) -> None:
+        """Visual-only spheres for targets that ask to be shown (created before the state is saved)."""
+        c = self.client
+        self.markers: dict[str, int] = {}
+        for name, t in self.m.targets.items():
+            if t.show_rgba is not None:
+                vis = pb.createVisualShape(pb.GEOM_SPHERE, radius=0.012, rgbaColor=list(t.show_rgba), physicsClientId=c)
+                self.markers[name] = pb.createMultiBody(0, -1, vis, list(PARK), physicsClientId=c)
+
+    def _set_gravity(self) -> None:
+        """Choose the world gravity needing the fewest compensated links; list those links."""
+        c = self.client
+        candidates: dict[float, list[tuple[int, int, float]]] = {}
+        declared = {b.name: (self.m.sim.gravity if b.gravity is None else b.gravity) for b in self.m.bodies}
+        for ps in self.m.particles:
+            for k, pid in enumerate(self.particles[ps.name]):
+                declared[f"{ps.name}#{k}"] = self.m.sim.gravity
+        options = sorted(set(declared.values()))
+        for g_world in options:
+            comp: list[tuple[int, int, float]] = []
+            for name, g in declared.items():
+                if g == g_world:
+                    continue
+                bid = self._body_id(name)
+                for link, mass in self._moving_links(bid):
+                    comp.append((bid, link, mass * (g - g_world)))
+            candidates[g_world] = comp
+        self.world_gravity = min(options, key=lambda g: (len(candidates[g]), -abs(g)))
+        groups: dict[int, tuple[list[int], list[float]]] = {}
+        for bid, link, fz in candidates[self.world_gravity]:
+            links, forces = groups.setdefault(bid, ([], []))
+            links.append(link)
+            forces.append(fz)
+        #: Per body: (id, links, z-forces) applied before every physics step; ids in ``parked`` are skipped.
+        self.gravity_groups = [(bid, links, forces) for bid, (links, forces) in groups.items()]
+        self.parked: set[int] = set()
+        pb.setGravity(0, 0, self.world_gravity, physicsClientId=c)
+
+    def _body_id(self, name: str) -> int:
+        if "#" in name:
+            set_name, k = name.split("#")
+            return self.particles[set_name][int(k)]
+        return self.bodies[name].id
+
+    def _moving_links(self, bid: int) -> list[tuple[int, float]]:
+        """(link index, mass) of every link that can move (fixed-base chains of fixed joints can't)."""
+        c = self.client
+        fixed_base = pb.getDynamicsInfo(bid, -1, physicsClientId=c)[0] == 0 or self._is_fixed_base(bid)
+        out = [] if fixed_base else [(-1, pb.getDynamicsInfo(bid, -1, physicsClientId=c)[0])]
+        moves = {-1: not fixed_base}
+        for j in range(pb.getNumJoints(bid, physicsClientId=c)):
+            info = pb.getJointInfo(bid, j, physicsClientId=c)
+            moves[j] = moves[info[16]] or info[2] != pb.JOINT_FIXED
+            if moves[j]:
+                out.append((j, pb.getDynamicsInfo(bid, j, physicsClientId=c)[0]))
+        return out
+
+    def _is_fixed_base(self, bid: int) -> bool:
+        for b in self.m.bodies:
+            if self.bodies[b.name].id == bid:
+                return b.fixed_base
+        return False
+
+    # -- per step ------------------------------------------------------------------------------
+    def step_physics(self, n: int) -> None:
+        """Run ``n`` physics steps, applying per-body gravity compensation before each."""
+        c = self.client
+        apply, step, world = pb.applyExternalForce, pb.stepSimulation, pb.WORLD_FRAME
+        base_pose, link_states = pb.getBasePositionAndOrientation, pb.getLinkStates
+        groups, parked = self.gravity_groups, self.parked
+        for _ in range(n):
+            for bid, links, forces in groups:
+                if bid in parked:
+                    continue
+                if links == [-1]:
+                    apply(bid, -1, (0.0, 0.0, forces[0]), base_pose(bid, physicsClientId=c)[0], world, physicsClientId=c)
+                    continue
+                states = link_states(bid, [l for l in links if l >= 0], physicsClientId=c)
+                k = 0
+                for link, fz in zip(links, forces):
+                    if link == -1:
+                        pos = base_pose(bid, physicsClientId=c)[0]
+                    else:
+                        pos = states[k][0]
+                        k += 1
+                    apply(bid, link, (0.0, 0.0, fz), pos, world, physicsClientId=c)
+            step(physicsClientId=c)
+
+    # -- frames --------------------------------------------------------------------------------
+    def base_frame(self, handle: BodyHandle):
+        """World pose of a body's URDF base frame."""
+        com_pos, com_orn = pb.getBasePositionAndOrientation(handle.id, physicsClientId=self.client)
+        return pb.multiplyTransforms(com_pos, com_orn, *handle.inertial_inv)
+
+    def set_base_frame(self, handle: BodyHandle, pos, orn) -> None:
+        """Place a body so that its URDF base frame is at (pos, orn)."""
+        inv = pb.invertTransform(*handle.inertial_inv)
+        com_pos, com_orn = pb.multiplyTransforms(pos, orn, *inv)
+        pb.resetBasePositionAndOrientation(handle.id, com_pos, com_orn, physicsClientId=self.client)
+
+    def link_frame(self, handle: BodyHandle, link: int):
+        if link == -1:
+            return self.base_frame(handle)
+        s = pb.getLinkState(handle.id, link, computeForwardKinematics=True, physicsClientId=self.client)
+        return s[4], s[5]
+
+    def restore(self) -> None:
+        pb.restoreState(self.initial_state, physicsClientId=self.client)
+
+    def close(self) -> None:
+        if self.client is not None and pb.isConnected(self.client):
+            pb.disconnect(self.client)
+        self.client = None
+
+    def __del__(self):  # pragma: no cover - best effort
+        try:
+            self.close()
+        except Exception:
+            pass
