@@ -31,3 +31,14 @@ def make(spec, robot=None, **kwargs):
     from .runtime.env import AssistiveEnv
 
     return AssistiveEnv.from_spec(spec, robot=robot, **kwargs)
+
+
+def _register() -> None:
+    try:
+        from .registration import register_all
+    except ImportError:  # gymnasium missing: ids unavailable, the compiler still works
+        return
+    register_all()
+
+
+_register()

@@ -130,6 +130,7 @@ class ParticleSet(_Model):
     lost_body: str | None = Field(description="Body a particle must stay near.")
     lost_link: str | None = Field(None, description="URDF link of that body (closest-points query).")
     lost_distance: float = Field(0.0, description="Distance beyond which it is lost, m.")
+    lost_anchor: Vec3 = Field((0.0, 0.0, 0.0), description="A point inside the lost body's collision geometry (lost link frame), m: a particle nearer than lost_distance to it is certainly not lost.")
     hit_body: str | None = Field(description="Body whose first contact with an active particle is a hit.")
 
 

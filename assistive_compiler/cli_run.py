@@ -174,9 +174,9 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int) -
         world = env.world
         original = world.step_physics
 
-        def timed(n: int) -> None:
+        def timed() -> None:
             t0 = time.perf_counter()
-            original(n)
+            original()
             physics[0] += time.perf_counter() - t0
 
         world.step_physics = timed  # type: ignore[method-assign]
@@ -195,7 +195,8 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int) -
         # A raw loop of stepSimulation with nothing else, for reference.
         env.reset(seed=0)
         t0 = time.perf_counter()
-        for _ in range(steps * env.manifest.sim.frame_skip):
+        calls = steps if world.fused else steps * env.manifest.sim.frame_skip
+        for _ in range(calls):
             pb.stepSimulation(physicsClientId=world.client)
         raw_loop = steps / (time.perf_counter() - t0)
         reset_ms = []

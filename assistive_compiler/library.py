@@ -16,7 +16,7 @@ from pydantic import BaseModel, ValidationError
 
 from .compile.render import UrdfInfo, render_template, urdf_info
 from .errors import Problem, SpecError
-from .paths import display, specs_dir
+from .paths import display, specs_dir, templates_dir
 from .spec.parts import FurniturePart, PersonPart, RobotPart, ToolPart
 from .spec.validation import problems_from_validation
 from .yamlsrc import load_located
@@ -102,7 +102,20 @@ class Library:
             path = (loaded.path.parent / part.urdf).resolve()
             return urdf_info(path.read_text())
         params = dict(part.template.params) | dict(getattr(part, "mount_params", {}) or {})
-        return urdf_info(render_template(part.template.path, params))
+        return urdf_info(render_template(self.template_path(loaded), params))
+
+    def template_path(self, loaded: LoadedPart) -> Path:
+        """The part's template: absolute as written, else under the ``templates/`` beside the part's
+        library (``<root>/../templates``), else under the shipped templates."""
+        rel = Path(loaded.part.template.path)
+        if rel.is_absolute():
+            return rel
+        for root in self.roots:
+            if loaded.path.is_relative_to(root):
+                candidate = root.parent / "templates" / rel
+                if candidate.is_file():
+                    return candidate
+        return templates_dir() / rel
 
     def _check_semantics(self, kind: str, loaded: LoadedPart) -> None:
         """Every URDF name a part declares must exist in the URDF it renders."""

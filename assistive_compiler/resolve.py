@@ -230,7 +230,7 @@ class _Resolver:
         body, _, link = value.partition(".")
         if body not in self.body_names or self.body_names[body] == "particles":
             pool = [b for b, s in self.body_names.items() if s != "particles"] + (list(self.spec.targets) if allow_target else [])
-            what = "a target or body" if allow_target else "body"
+            what = "target or body" if allow_target else "body"
             self.problem(path, f"unknown {what} '{value}'; expected one of {one_of(pool)}{did_you_mean(body, pool)}")
             return None
         if not link:

@@ -162,18 +162,19 @@ def _fail(rt: ResolvedTask, path: tuple, message: str) -> SpecError:
     return SpecError([Problem(rt.loaded.smap.value(path), message)])
 
 
-def build(rt: ResolvedTask, out_tmp: Path) -> Manifest:
+def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
     """Write the URDFs of ``rt`` into ``out_tmp/urdf`` and return the manifest (without hashes)."""
     spec = rt.spec
     urdf_dir = out_tmp / "urdf"
     urdf_dir.mkdir(parents=True)
     written: dict[str, Path] = {}
 
-    def emit(body_name: str, template: str, params: dict[str, Any], shown_template: str) -> Path:
+    def emit(body_name: str, template: Path, params: dict[str, Any], where) -> Path:
+        """Render, lint and write one body; a refusal is located at ``where`` (the part's template line)."""
         xml = render_template(template, params)
-        problems = lint_urdf(xml, template=shown_template)
+        problems = lint_urdf(xml, template=display(template))
         if problems:
-            raise SpecError([Problem(rt.loaded.smap.value(()), f"generated URDF refused: {pr}") for pr in problems])
+            raise SpecError([Problem(where, f"generated URDF refused: {pr}") for pr in problems])
         path = urdf_dir / f"{body_name}.urdf"
         path.write_text(xml)
         written[body_name] = path
@@ -183,18 +184,18 @@ def build(rt: ResolvedTask, out_tmp: Path) -> Manifest:
     robot_part = rt.robot.part
     if robot_part.template is None:
         raise _fail(rt, ("robot", "default"), f"robot '{rt.robot_name}' uses an external URDF; compiling those arrives with the robot library")
-    emit("robot", robot_part.template.path, robot_part.template.params, f"templates/{robot_part.template.path}")
+    emit("robot", lib.template_path(rt.robot), robot_part.template.params, rt.robot.smap.value(("template", "path")))
     mounted_on = spec.robot.mount_on if robot_part.mountable else None
     for name, use in spec.scene.furniture.items():
         part = rt.furniture[name].part
         params = dict(part.template.params) | dict(use.params)
         if name == mounted_on:
             params |= part.mount_params
-        emit(name, part.template.path, params, f"templates/{part.template.path}")
+        emit(name, lib.template_path(rt.furniture[name]), params, rt.furniture[name].smap.value(("template", "path")))
     for name, use in spec.tools.items():
         part = rt.tools[name].part
         params = dict(part.template.params) | ({"mass_kg": use.mass_kg} if use.mass_kg else {})
-        emit(name, part.template.path, params, f"templates/{part.template.path}")
+        emit(name, lib.template_path(rt.tools[name]), params, rt.tools[name].smap.value(("template", "path")))
 
     person = spec.person
     movable = set(person.randomize_deg) | set(rt.joint_groups.get("person.policy", {}).get("joints", []))
@@ -206,12 +207,12 @@ def build(rt: ResolvedTask, out_tmp: Path) -> Manifest:
     baked = {j: math.radians(person.joints_deg.get(j, 0.0)) for j in person_joints if j not in movable}
     movable_ordered = [j for j in person_joints if j in movable]
     measurements = {}
-    for variant in person.variants:
+    for i, variant in enumerate(person.variants):
         part = rt.people[variant].part
         m = body_measurements(part.sex, part.mass_kg, part.height_scale, part.radius_scale)
         measurements[variant] = m
         args = m.xacro_args() | {"fixed_joints": format_fixed_joints(baked), "skin_rgba": " ".join(repr(float(c)) for c in part.skin_rgba)}
-        emit(f"person_{variant}", PERSON_TEMPLATE_RELPATH, args, f"templates/{PERSON_TEMPLATE_RELPATH}")
+        emit(f"person_{variant}", templates_dir() / PERSON_TEMPLATE_RELPATH, args, rt.loaded.smap.value(("person", "variants", i)))
 
     # 3. Precompute --------------------------------------------------------------------------
     pc = _Precompute()
@@ -441,16 +442,33 @@ def _settle_particles(rt, pc, name, ps, tool_ids, furniture_ids, start, tool_orn
         local, _ = p.multiplyTransforms(inv[0], inv[1], world, (0, 0, 0, 1))
         positions.append(_round(tuple(local), 6))
         p.removeBody(b, physicsClientId=c)
-    lost_link = None
+    lost_link, anchor = None, (0.0, 0.0, 0.0)
     if ps.lost_beyond:
-        lost_link = rt.points.get(ps.lost_beyond.body, {}).get("link")
+        body = ps.lost_beyond.body
+        part = rt.tools[body].part if body in rt.tools else rt.furniture[body].part
+        lost_link = part.base_link
+        anchor = _inside_point(pc, tool_ids.get(body, furniture_ids.get(body)), lost_link)
     colors = [tuple(ps.colors_rgba[i % len(ps.colors_rgba)]) for i in range(ps.count)]
     return ParticleSet(name=name, count=ps.count, radius=ps.radius_m, mass=ps.mass_kg, attach=ps.attach, attach_link=attach_link,
                        start_positions=positions, colors=colors,
                        consumed_target=ps.consumed_at.target if ps.consumed_at else None,
                        consumed_radius=ps.consumed_at.radius_m if ps.consumed_at else 0.0,
                        lost_body=ps.lost_beyond.body if ps.lost_beyond else None, lost_link=lost_link,
-                       lost_distance=ps.lost_beyond.distance_m if ps.lost_beyond else 0.0, hit_body=ps.hit_body)
+                       lost_distance=ps.lost_beyond.distance_m if ps.lost_beyond else 0.0, lost_anchor=_round(anchor),
+                       hit_body=ps.hit_body)
+
+
+def _inside_point(pc, body: int, link_name: str) -> tuple[float, float, float]:
+    """The centre of the link's first collision primitive, in the link frame: inside its geometry."""
+    p, c = pc.p, pc.client
+    link = pc.link_index(body, link_name)
+    shapes = p.getCollisionShapeData(body, link, physicsClientId=c)
+    if not shapes:
+        raise SpecError.at(link_name, f"link '{link_name}' has no collision geometry to keep particles near")
+    local_pos = shapes[0][5]  # in the link's inertial (COM) frame
+    inertial_pos, inertial_orn = p.getDynamicsInfo(body, link, physicsClientId=c)[3:5]
+    pos, _ = p.multiplyTransforms(inertial_pos, inertial_orn, local_pos, (0, 0, 0, 1))
+    return tuple(pos)
 
 
 def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lower, upper, movable) -> Manifest:
@@ -529,6 +547,7 @@ def compile_task(
     """
     t0 = time.perf_counter()
     loaded: LoadedSpec = load_spec(spec_path)
+    library = library or Library()
     rt = resolve(loaded, robot, library)
     out = Path(out_dir) if out_dir else default_out_dir(loaded.spec.name, rt.robot_name)
     ihash = input_hash(rt)
@@ -543,8 +562,11 @@ def compile_task(
 
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=out.parent))
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes it private; the artifact is an ordinary directory
     try:
-        manifest = build(rt, tmp).model_copy(update={"input_hash": ihash})
+        manifest = build(rt, tmp, library).model_copy(update={"input_hash": ihash})
         body_bytes = b"".join((tmp / b.urdf).read_bytes() for b in sorted(manifest.bodies, key=lambda b: b.urdf))
         manifest = manifest.model_copy(update={"content_hash": _sha(body_bytes + manifest.to_json().encode())})
         (tmp / "manifest.json").write_text(manifest.to_json())

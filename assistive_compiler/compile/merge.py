@@ -24,8 +24,9 @@ Chains of fixed joints collapse completely (C's own merged children travel with 
 in ``keep`` and the root link always stay.
 
 Only numbers this module computes are rewritten: they are rounded to 12 significant digits,
-components below 1e-12 of the largest one of the same vector or tensor are written as 0, and
-every float is written with ``repr``. Elements that are not touched keep their text. The output
+components below 1e-12 of the largest one of the same vector or tensor (or of the numbers they
+were computed from: the 6e-17 that 1 - 1 leaves) are written as 0, and every float is written
+with ``repr``. Elements that are not touched keep their text. The output
 is deterministic: same input, same bytes.
 
 Pure Python + numpy + ``xml.etree``; no pybullet.
@@ -124,20 +125,23 @@ def _matrix_quat(rot: np.ndarray) -> tuple[float, float, float, float]:
 
 
 class _Pose:
-    """A rigid transform (rotation ``rot``, translation ``pos``)."""
+    """A rigid transform (rotation ``rot``, translation ``pos``). ``scale`` bounds the size of
+    the translations it was computed from, so that rounding noise left by cancellation (1 - 1 =
+    6e-17) can be told from a real offset."""
 
-    __slots__ = ("rot", "pos")
+    __slots__ = ("rot", "pos", "scale")
 
-    def __init__(self, rot: np.ndarray, pos: np.ndarray) -> None:
+    def __init__(self, rot: np.ndarray, pos: np.ndarray, scale: float | None = None) -> None:
         self.rot = rot
         self.pos = pos
+        self.scale = float(np.abs(pos).max()) if scale is None else scale
 
     @staticmethod
     def identity() -> _Pose:
         return _Pose(np.eye(3), np.zeros(3))
 
     def __mul__(self, other: _Pose) -> _Pose:
-        return _Pose(self.rot @ other.rot, self.rot @ other.pos + self.pos)
+        return _Pose(self.rot @ other.rot, self.rot @ other.pos + self.pos, self.scale + other.scale)
 
 
 # --------------------------------------------------------------------------- number I/O
@@ -181,9 +185,10 @@ def _round(value: float) -> float:
     return rounded + 0.0  # -0.0 -> 0.0
 
 
-def _clean(values: Sequence[float]) -> list[float]:
-    """Round to 12 significant digits; components below 1e-12 of the largest become 0."""
-    scale = max((abs(float(v)) for v in values), default=0.0)
+def _clean(values: Sequence[float], scale: float = 0.0) -> list[float]:
+    """Round to 12 significant digits; components below 1e-12 of the largest one, or of
+    ``scale`` (the size of the numbers they were computed from), become 0."""
+    scale = max([scale] + [abs(float(v)) for v in values])
     return [0.0 if abs(float(v)) <= _RELATIVE_ZERO * scale else _round(v) for v in values]
 
 
@@ -198,7 +203,7 @@ def _write_origin(parent: ET.Element, pose: _Pose, *, index: int = 0) -> None:
         origin = ET.Element("origin")
         parent.insert(index, origin)
     origin.attrib.clear()
-    origin.set("xyz", _fmt(_clean(pose.pos)))
+    origin.set("xyz", _fmt(_clean(pose.pos, pose.scale)))
     angles = [_round(a) for a in _matrix_rpy(pose.rot)]
     origin.set("rpy", _fmt([0.0 if abs(a) <= _RELATIVE_ZERO else a for a in angles]))
 
@@ -236,17 +241,21 @@ def _combined_inertial(parts: list[tuple[float, np.ndarray, np.ndarray]]) -> ET.
         com = sum(m * c for m, c, _ in parts) / total
     else:
         com = np.zeros(3)
+    com_scale = max(float(np.abs(c).max()) for _, c, _ in parts)
     tensor = np.zeros((3, 3))
+    tensor_scale = 0.0
     for mass, centre, inertia in parts:
         d = centre - com
-        tensor += inertia + mass * (float(d @ d) * np.eye(3) - np.outer(d, d))
+        term = inertia + mass * (float(d @ d) * np.eye(3) - np.outer(d, d))
+        tensor += term
+        tensor_scale = max(tensor_scale, float(np.abs(term).max()))
     tensor = 0.5 * (tensor + tensor.T)
 
     inertial = ET.Element("inertial")
-    ET.SubElement(inertial, "origin", {"xyz": _fmt(_clean(com)), "rpy": "0.0 0.0 0.0"})
+    ET.SubElement(inertial, "origin", {"xyz": _fmt(_clean(com, com_scale)), "rpy": "0.0 0.0 0.0"})
     ET.SubElement(inertial, "mass", {"value": repr(_round(total))})
     values = [tensor[0, 0], tensor[0, 1], tensor[0, 2], tensor[1, 1], tensor[1, 2], tensor[2, 2]]
-    ET.SubElement(inertial, "inertia", dict(zip(_INERTIA_KEYS, map(repr, _clean(values)))))
+    ET.SubElement(inertial, "inertia", dict(zip(_INERTIA_KEYS, map(repr, _clean(values, tensor_scale)))))
     return inertial
 
 
@@ -311,7 +320,6 @@ def merge_fixed_links(
 
     joints = root.findall("joint")
     parent_joint: dict[str, ET.Element] = {}  # child link -> its joint
-    parent_of: dict[str, str] = {}
     child_joints: dict[str, list[ET.Element]] = {name: [] for name in links}
     joint_names: set[str] = set()
     for joint in joints:
@@ -330,7 +338,6 @@ def merge_fixed_links(
         if child in parent_joint:
             raise ValueError(f"link {child!r} is the child of two joints")
         parent_joint[child] = joint
-        parent_of[child] = ends["parent"]
         child_joints[ends["parent"]].append(joint)
     roots = [name for name in links if name not in parent_joint]
     if len(roots) != 1:
@@ -352,8 +359,6 @@ def merge_fixed_links(
         name = stack.pop()
         for joint in reversed(child_joints[name]):
             child = joint.find("child").get("link")  # type: ignore[union-attr]
-            if child in visited:
-                raise ValueError(f"the joints form a cycle through link {child!r}")
             visited.add(child)
             if merged(child):
                 jname = joint.get("name")
@@ -365,7 +370,7 @@ def merge_fixed_links(
             stack.append(child)
     if len(visited) != len(links):
         missing = [n for n in links if n not in visited]
-        raise ValueError(f"links not reachable from root {root_link!r}: {missing}")
+        raise ValueError(f"links on a cycle, not reachable from root {root_link!r}: {missing}")
 
     # Depth-first (pre-order) list of merged links per survivor, children in joint order.
     def collect(name: str, into: list[str]) -> None:

@@ -27,14 +27,17 @@ def format_param(value: object) -> str:
     return str(value)
 
 
-def render_template(relpath: str, params: Mapping[str, object]) -> str:
-    """Render ``templates/<relpath>`` with ``params``; the same inputs give the same bytes."""
-    return _render_cached(relpath, tuple(sorted((k, format_param(v)) for k, v in params.items())))
+def render_template(template: str | Path, params: Mapping[str, object]) -> str:
+    """Render a xacro template (a path, or one relative to the shipped ``templates/``) with
+    ``params``; the same inputs give the same bytes."""
+    path = Path(template)
+    if not path.is_absolute():
+        path = templates_dir() / path
+    return _render_cached(path, tuple(sorted((k, format_param(v)) for k, v in params.items())))
 
 
 @lru_cache(maxsize=256)
-def _render_cached(relpath: str, params: tuple[tuple[str, str], ...]) -> str:
-    path = templates_dir() / relpath
+def _render_cached(path: Path, params: tuple[tuple[str, str], ...]) -> str:
     if not path.is_file():
         raise SpecError.at(display(path), "template not found")
     declared = set(_declared_args(path))

@@ -34,7 +34,6 @@ class ScriptedPolicy:
         self.lo = [pb.getJointInfo(robot.id, j, physicsClientId=c)[8] for j in movable]
         self.hi = [pb.getJointInfo(robot.id, j, physicsClientId=c)[9] for j in movable]
         self.ranges = [max(h - l, 1e-3) for l, h in zip(self.lo, self.hi)]
-        self._episode_marker = None
 
     def _start_episode(self) -> None:
         snap = self.env.snap
@@ -49,10 +48,8 @@ class ScriptedPolicy:
 
     def __call__(self, obs) -> np.ndarray:
         env = self.env
-        if self._episode_marker is not env.snap.frames.get("robot_base") or env.steps == 0:
-            self._episode_marker = env.snap.frames.get("robot_base")
-            if env.steps == 0:
-                self._start_episode()
+        if env.steps == 0:  # first action of an episode
+            self._start_episode()
         snap = env.snap
         to, offset, tol = self.waypoints[self.index]
         goal = snap.position(to) + offset

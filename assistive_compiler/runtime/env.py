@@ -161,7 +161,7 @@ class AssistiveEnv(gym.Env):
         target = np.clip(q + self.delta_scale * np.clip(raw, -1.0, 1.0), self.lower, self.upper)
         pb.setJointMotorControlArray(w.robot.id, self.arm_idx, pb.POSITION_CONTROL, targetPositions=target.tolist(),
                                      positionGains=[m.robot.position_gain] * len(target), forces=[m.robot.max_force] * len(target), physicsClientId=c)
-        w.step_physics(m.sim.frame_skip)
+        w.step_physics()
         self.steps += 1
         self.snap.actions["robot"] = raw
         self.snap.refresh()

@@ -1,8 +1,11 @@
 """Particle lifecycles (food, water): active → consumed (reached the target) | lost (left its
 container); the first contact of an active particle with ``hit_body`` counts once as a hit.
 
-Removed particles are parked far below the floor with mass 0 (static, no solver cost) and get
-their mass back at reset. Events are evaluated once per env step, as in the reference.
+Removed particles are parked far away, apart from each other, at rest and without gravity
+compensation, so they touch nothing; they come back at reset. Nothing else about them changes: a
+mass of 0 would make them static objects for good, and changing collision filters re-inserts
+them in the broadphase, which reorders contact pairs — either would make an episode depend on the
+ones before it. Events are evaluated once per env step, as in the reference.
 """
 
 from __future__ import annotations
@@ -35,9 +38,7 @@ class ParticleSystem:
             holder = w.bodies[ps.attach]
             frame_pos, frame_orn = w.link_frame(holder, holder.links[ps.attach_link])
             for pid, local in zip(ids, ps.start_positions):
-                if pid in w.parked:
-                    pb.changeDynamics(pid, -1, mass=ps.mass, physicsClientId=c)
-                    w.parked.discard(pid)
+                w.parked.discard(pid)
                 pos, _ = pb.multiplyTransforms(frame_pos, frame_orn, local, (0, 0, 0, 1))
                 pb.resetBasePositionAndOrientation(pid, pos, (0, 0, 0, 1), physicsClientId=c)
                 pb.resetBaseVelocity(pid, (0, 0, 0), (0, 0, 0), physicsClientId=c)
@@ -49,7 +50,6 @@ class ParticleSystem:
         c = self.world.client
         pb.resetBasePositionAndOrientation(pid, (PARK[0] - 5.0 - 0.1 * k, PARK[1], PARK[2]), (0, 0, 0, 1), physicsClientId=c)
         pb.resetBaseVelocity(pid, (0, 0, 0), (0, 0, 0), physicsClientId=c)
-        pb.changeDynamics(pid, -1, mass=0.0, physicsClientId=c)
         self.world.parked.add(pid)
 
     def update(self) -> None:
@@ -63,7 +63,12 @@ class ParticleSystem:
             if ps.hit_body:
                 hb = snap.handle(snap.body_key(ps.hit_body)).id
                 hit_ids = {cp[2] for cp in pb.getContactPoints(bodyA=hb, physicsClientId=c)}
-            lost_id = snap.handle(snap.body_key(ps.lost_body)).id if ps.lost_body else None
+            lost_id = anchor = None
+            if ps.lost_body:
+                holder = snap.handle(snap.body_key(ps.lost_body))
+                lost_id = holder.id
+                frame = w.link_frame(holder, holder.links[ps.lost_link])
+                anchor = np.asarray(pb.multiplyTransforms(*frame, ps.lost_anchor, (0, 0, 0, 1))[0])
             for k, pid in enumerate(ids):
                 if not active[k]:
                     continue
@@ -76,7 +81,9 @@ class ParticleSystem:
                     ev.consumed_speed_sum += float(np.linalg.norm(pb.getBaseVelocity(pid, physicsClientId=c)[0]))
                     active[k] = False
                     self._park(pid, k)
-                elif lost_id is not None and not pb.getClosestPoints(pid, lost_id, ps.lost_distance, physicsClientId=c):
+                elif (lost_id is not None and np.linalg.norm(pos - anchor) >= ps.lost_distance
+                      and not pb.getClosestPoints(pid, lost_id, ps.lost_distance, physicsClientId=c)):
+                    # (within lost_distance of a point inside the holder: certainly near it; else ask)
                     ev.lost += 1
                     active[k] = False
                     self._park(pid, k)

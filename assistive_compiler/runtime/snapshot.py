@@ -155,7 +155,9 @@ class Snapshot:
         self._joint_cache.clear()
 
     def set_frame(self, name: str, pos, orn) -> None:
-        self.frames[name] = (np.asarray(pos, dtype=float), np.asarray(orn, dtype=float))
+        """Fix an observation frame for the episode (the robot's and the person's bases do not move)."""
+        rot = np.asarray(pb.getMatrixFromQuaternion(orn), dtype=float).reshape(3, 3)
+        self.frames[name] = (np.asarray(pos, dtype=float), np.asarray(orn, dtype=float), rot.T)
 
     # -- what terms read ----------------------------------------------------------------------
     def position(self, h: PointHandle) -> np.ndarray:
@@ -180,13 +182,13 @@ class Snapshot:
     def point_in_frame(self, frame: str, p: np.ndarray) -> np.ndarray:
         if frame == "world":
             return p
-        fpos, forn = self.frames[frame]
-        return quat_rotate(quat_conj(forn), p - fpos)
+        fpos, _, world_to_frame = self.frames[frame]
+        return world_to_frame @ (p - fpos)
 
     def vector_in_frame(self, frame: str, v: np.ndarray) -> np.ndarray:
         if frame == "world":
             return v
-        return quat_rotate(quat_conj(self.frames[frame][1]), v)
+        return self.frames[frame][2] @ v
 
     def quat_in_frame(self, frame: str, q: np.ndarray) -> np.ndarray:
         if frame == "world":

@@ -47,11 +47,7 @@ class World:
         self.client = pb.connect(pb.DIRECT)
         c = self.client
         sim = self.m.sim
-        pb.setTimeStep(sim.time_step, physicsClientId=c)
-        params = {"numSolverIterations": sim.solver_iterations, "deterministicOverlappingPairs": 1}
-        if sim.sub_steps:
-            params["numSubSteps"] = sim.sub_steps
-        pb.setPhysicsEngineParameter(**params, physicsClientId=c)
+        pb.setPhysicsEngineParameter(numSolverIterations=sim.solver_iterations, deterministicOverlappingPairs=1, physicsClientId=c)
 
         plane = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=c)
         plane_visual = pb.createVisualShape(pb.GEOM_BOX, halfExtents=[5, 5, 0.0005], rgbaColor=[0.85, 0.85, 0.82, 1], physicsClientId=c)
@@ -77,6 +73,12 @@ class World:
         self._create_particles()
         self._create_markers()
         self._set_gravity()
+        self._set_stepping()
+        self._all_bodies = [b for b in range(pb.getNumBodies(physicsClientId=c)) if b != self.ground]
+        # Bodies at rest would otherwise fall asleep after ~2 s; sleep is not part of a saved state,
+        # so an episode would depend on how long the previous one left something resting.
+        for bid in self._all_bodies:
+            pb.changeDynamics(bid, -1, activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING, physicsClientId=c)
         self.initial_state = pb.saveState(physicsClientId=c)
 
     # -- construction --------------------------------------------------------------------------
@@ -159,6 +161,24 @@ class World:
         self.parked: set[int] = set()
         pb.setGravity(0, 0, self.world_gravity, physicsClientId=c)
 
+    def _set_stepping(self) -> None:
+        """Fused stepping when exact: one ``stepSimulation`` of frame_skip × time_step split into
+        internal sub-steps of time_step (each further split by the spec's solver sub-steps).
+
+        External forces persist over a call's internal sub-steps, so compensation applied once is
+        exact for free bases (a force at the centre of mass). When articulated links need it (their
+        COM moves within a step) every physics step is a separate call with fresh forces.
+        """
+        sim, c = self.m.sim, self.client
+        per_step = max(1, sim.sub_steps)
+        self.fused = all(links == [-1] for _, links, _ in self.gravity_groups)
+        if self.fused:
+            pb.setTimeStep(sim.time_step * sim.frame_skip, physicsClientId=c)
+            pb.setPhysicsEngineParameter(numSubSteps=sim.frame_skip * per_step, physicsClientId=c)
+        else:
+            pb.setTimeStep(sim.time_step, physicsClientId=c)
+            pb.setPhysicsEngineParameter(numSubSteps=per_step if sim.sub_steps else 0, physicsClientId=c)
+
     def _body_id(self, name: str) -> int:
         if "#" in name:
             set_name, k = name.split("#")
@@ -185,29 +205,36 @@ class World:
         return False
 
     # -- per step ------------------------------------------------------------------------------
-    def step_physics(self, n: int) -> None:
-        """Run ``n`` physics steps, applying per-body gravity compensation before each."""
+    def step_physics(self) -> None:
+        """Advance one env step (frame_skip physics steps) with per-body gravity compensation."""
+        if self.fused:
+            self._apply_gravity_compensation()
+            pb.stepSimulation(physicsClientId=self.client)
+            return
+        for _ in range(self.m.sim.frame_skip):
+            self._apply_gravity_compensation()
+            pb.stepSimulation(physicsClientId=self.client)
+
+    def _apply_gravity_compensation(self) -> None:
         c = self.client
-        apply, step, world = pb.applyExternalForce, pb.stepSimulation, pb.WORLD_FRAME
+        apply, world = pb.applyExternalForce, pb.WORLD_FRAME
         base_pose, link_states = pb.getBasePositionAndOrientation, pb.getLinkStates
-        groups, parked = self.gravity_groups, self.parked
-        for _ in range(n):
-            for bid, links, forces in groups:
-                if bid in parked:
-                    continue
-                if links == [-1]:
-                    apply(bid, -1, (0.0, 0.0, forces[0]), base_pose(bid, physicsClientId=c)[0], world, physicsClientId=c)
-                    continue
-                states = link_states(bid, [l for l in links if l >= 0], physicsClientId=c)
-                k = 0
-                for link, fz in zip(links, forces):
-                    if link == -1:
-                        pos = base_pose(bid, physicsClientId=c)[0]
-                    else:
-                        pos = states[k][0]
-                        k += 1
-                    apply(bid, link, (0.0, 0.0, fz), pos, world, physicsClientId=c)
-            step(physicsClientId=c)
+        parked = self.parked
+        for bid, links, forces in self.gravity_groups:
+            if bid in parked:
+                continue
+            if links == [-1]:
+                apply(bid, -1, (0.0, 0.0, forces[0]), base_pose(bid, physicsClientId=c)[0], world, physicsClientId=c)
+                continue
+            states = link_states(bid, [l for l in links if l >= 0], physicsClientId=c)
+            k = 0
+            for link, fz in zip(links, forces):
+                if link == -1:
+                    pos = base_pose(bid, physicsClientId=c)[0]
+                else:
+                    pos = states[k][0]
+                    k += 1
+                apply(bid, link, (0.0, 0.0, fz), pos, world, physicsClientId=c)
 
     # -- frames --------------------------------------------------------------------------------
     def base_frame(self, handle: BodyHandle):
@@ -228,7 +255,19 @@ class World:
         return s[4], s[5]
 
     def restore(self) -> None:
-        pb.restoreState(self.initial_state, physicsClientId=self.client)
+        """Back to the saved initial state, with no contact cache left from the last episode.
+
+        ``restoreState`` restores poses and velocities but not the collision pipeline's cached
+        contact manifolds, and a manifold carried over from the previous episode makes the next one
+        differ (slightly) from a fresh one. So every body is first moved apart, one collision pass
+        drops every pair, and the state is restored again: an episode depends only on its seed.
+        """
+        c = self.client
+        pb.restoreState(self.initial_state, physicsClientId=c)
+        for k, bid in enumerate(self._all_bodies):
+            pb.resetBasePositionAndOrientation(bid, (PARK[0] + 1000.0 + 10.0 * k, PARK[1], PARK[2]), (0, 0, 0, 1), physicsClientId=c)
+        pb.performCollisionDetection(physicsClientId=c)
+        pb.restoreState(self.initial_state, physicsClientId=c)
 
     def close(self) -> None:
         if self.client is not None and pb.isConnected(self.client):

@@ -51,12 +51,18 @@ class Uniform(Strict):
     def _ordered(self) -> "Uniform":
         low, high = self.uniform
         if low > high:
-            raise ValueError(f"uniform bounds are reversed: low {low} > high {high}; write [low, high]")
+            raise ValueError(f"@uniform: bounds are reversed: low {low:g} > high {high:g}; write [low, high]")
         return self
 
 
 Scalar = Union[float, Uniform]
 """A fixed number or ``{uniform: [low, high]}`` re-drawn at every reset."""
+
+
+def describe(value: Scalar) -> str:
+    """``1.5`` or ``U(0.2, 0.9)`` for messages."""
+    low, high = scalar_bounds(value)
+    return f"{low:g}" if low == high else f"U({low:g}, {high:g})"
 
 
 def scalar_bounds(value: Scalar) -> tuple[float, float]:
@@ -167,7 +173,7 @@ class Weakness(Strict):
     def _range(cls, v: Scalar) -> Scalar:
         low, high = scalar_bounds(v)
         if low <= 0 or high > 1:
-            raise ValueError(f"strength must lie in (0, 1], got {low}…{high}")
+            raise ValueError(f"strength must lie in (0, 1], got {describe(v)}")
         return v
 
 
@@ -188,7 +194,7 @@ class LimitedRange(Strict):
     def _range(cls, v: Scalar) -> Scalar:
         low, high = scalar_bounds(v)
         if low <= 0 or high > 1:
-            raise ValueError(f"scale must lie in (0, 1], got {low}…{high}")
+            raise ValueError(f"scale must lie in (0, 1], got {describe(v)}")
         return v
 
 
@@ -321,7 +327,7 @@ class RobotRole(Strict):
         if self.default not in self.supported:
             from ..errors import did_you_mean
 
-            raise ValueError(f"default robot '{self.default}' is not in supported {self.supported}{did_you_mean(self.default, self.supported)}")
+            raise ValueError(f"@default: default robot '{self.default}' is not in supported {self.supported}{did_you_mean(self.default, self.supported)}")
         return self
 
 
@@ -463,7 +469,7 @@ class Success(Strict):
     @model_validator(mode="after")
     def _fraction(self) -> "Success":
         if self.relative_to is not None and not (0 < self.threshold <= 1):
-            raise ValueError(f"threshold {self.threshold} is a fraction of '{self.relative_to}' and must lie in (0, 1]")
+            raise ValueError(f"@threshold: threshold {self.threshold:g} is a fraction of '{self.relative_to}' and must lie in (0, 1]")
         return self
 
 

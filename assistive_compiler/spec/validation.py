@@ -33,12 +33,19 @@ def _data_path(loc: tuple, data: Any) -> tuple[DataPath, list[str]]:
         elif isinstance(node, list) and isinstance(element, int) and 0 <= element < len(node):
             path.append(element)
             node = node[element]
+        elif isinstance(node, dict) and isinstance(element, str) and node.get("kind") == element:
+            tags.append(element)  # the branch of a discriminated union, chosen by 'kind'
         elif isinstance(node, dict) and isinstance(element, str) and not _looks_like_tag(element):
             path.append(element)  # a key that is absent (missing / extra at the end)
             node = None
         else:
             tags.append(str(element))
     return tuple(path), tags
+
+
+def _is_model_tag(tag: str) -> bool:
+    """A union branch that is a model (``Uniform``, ``function-after[..., Uniform]``), not a scalar."""
+    return tag not in ("float", "int", "str", "bool", "none") and any(ch.isupper() for ch in tag)
 
 
 def _looks_like_tag(element: str) -> bool:
@@ -107,6 +114,18 @@ def model_at(root: type[BaseModel], path: DataPath, data: Any) -> type[BaseModel
     return models[0] if models else None
 
 
+def _tuple_size(root: type[BaseModel], path: DataPath, data: Any) -> int | None:
+    """The fixed length of the tuple field at ``path`` (None when not a fixed-length tuple)."""
+    model = model_at(root, path[:-1], data)
+    if model is None or not isinstance(path[-1], str) or path[-1] not in model.model_fields:
+        return None
+    for typ in _unwrap(model.model_fields[path[-1]].annotation):
+        args = typing.get_args(typ)
+        if typing.get_origin(typ) is tuple and args and args[-1] is not Ellipsis:
+            return len(args)
+    return None
+
+
 def _section(path: DataPath) -> str:
     """``reward[0].weight``-style name of a data path."""
     out = ""
@@ -152,8 +171,8 @@ def _pick_union_branch(errs: list[tuple[dict, list[str]]], value: Any) -> list[t
     """Where a union reported one error per branch, keep the branch the input was meant for."""
     if len(errs) < 2:
         return errs
-    model_branch = [e for e in errs if any(t[:1].isupper() for t in e[1])]
-    scalar_branch = [e for e in errs if not any(t[:1].isupper() for t in e[1])]
+    model_branch = [e for e in errs if any(_is_model_tag(t) for t in e[1])]
+    scalar_branch = [e for e in errs if not any(_is_model_tag(t) for t in e[1])]
     if isinstance(value, dict) and model_branch:
         return model_branch
     if not isinstance(value, dict) and scalar_branch and model_branch:
@@ -174,6 +193,10 @@ def _one(err: dict, path: DataPath, data: Any, smap: SourceMap, root: type[BaseM
         hint = did_you_mean(str(key), allowed)
         expected = f"; expected one of {one_of(allowed)}" if allowed else ""
         return Problem(smap.key(full), f"unknown key '{key}' in {_section(full[:-1])}{expected}{hint}")
+    if kind == "missing" and isinstance(_value_at(data, path), list):
+        size = _tuple_size(root, path, data)
+        expected = f"{size} values" if size else "more values"
+        return Problem(smap.value(full), f"{_section(full)}: expected {expected}, got {len(_value_at(data, path))}")
     if kind == "missing":
         key = path[-1]
         return Problem(smap.key(full[:-1]) if full[:-1] else smap.value(()), f"missing required key '{key}' in {_section(full[:-1])}")
@@ -189,6 +212,17 @@ def _one(err: dict, path: DataPath, data: Any, smap: SourceMap, root: type[BaseM
     if kind == "scalar_or_uniform":
         return Problem(smap.value(full), f"{_section(full)}: {err['msg']}")
     message = _strip(err["msg"])
+    if kind in ("value_error", "assertion_error") and message.startswith("@"):
+        # A model-level check that names the field at fault: "@threshold: message".
+        field, _, message = message[1:].partition(": ")
+        full, path = full + (field,), path + (field,)
+        return Problem(smap.value(full), f"{_section(full)}: {message}")
+    if kind == "literal_error":
+        expected = [e.strip().strip("'") for e in str(err.get("ctx", {}).get("expected", "")).replace(" or ", ", ").split(",") if e.strip()]
+        got = err.get("input")
+        return Problem(smap.value(full), f"{_section(full)}: expected one of {one_of(expected)}, got {_describe_input(got)}{did_you_mean(str(got), expected)}")
+    if kind == "string_pattern_mismatch":
+        return Problem(smap.value(full), f"{_section(full)}: {_describe_input(err.get('input'))} is not a valid name; expected lowercase letters, digits and underscores, starting with a letter (e.g. 'my_task')")
     if kind in ("model_type", "model_attributes_type", "dict_type"):
         message = f"expected a mapping, got {_describe_input(err.get('input'))}"
     elif kind in ("list_type", "tuple_type"):

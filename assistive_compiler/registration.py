@@ -1,0 +1,57 @@
+"""Gymnasium ids for the shipped tasks: ``assistive_compiler/<Task><Robot>-v1``.
+
+Registration reads only each task's name, title and supported robots (and each robot's title)
+with plain YAML, so ``import assistive_compiler`` stays light. An env made by id is compiled on
+first use into the artifact cache (``$ASSISTIVE_COMPILER_CACHE``, default
+``~/.cache/assistive-compiler``) and reused while its inputs are unchanged.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import yaml
+
+from .paths import specs_dir
+
+NAMESPACE = "assistive_compiler"
+
+
+def cache_dir() -> Path:
+    root = os.environ.get("ASSISTIVE_COMPILER_CACHE") or Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "assistive-compiler"
+    return Path(root)
+
+
+def shipped_ids() -> dict[str, tuple[Path, str]]:
+    """Gymnasium id → (task spec path, robot name) for every shipped task and supported robot."""
+    out: dict[str, tuple[Path, str]] = {}
+    robots_dir = specs_dir() / "robots"
+    for spec in sorted((specs_dir() / "tasks").glob("*.yaml")):
+        data = yaml.safe_load(spec.read_text()) or {}
+        title = str(data.get("title", spec.stem)).replace(" ", "")
+        for robot in (data.get("robot") or {}).get("supported", []):
+            robot_file = robots_dir / f"{robot}.yaml"
+            robot_title = (yaml.safe_load(robot_file.read_text()) or {}).get("title", robot) if robot_file.is_file() else robot
+            out[f"{NAMESPACE}/{title}{robot_title}-v1"] = (spec, robot)
+    return out
+
+
+def make_env(spec: str, robot: str, **kwargs):
+    """Entry point of registered ids: compile (cached) into the artifact cache and build the env."""
+    from .runtime.env import AssistiveEnv
+
+    name = Path(spec).stem
+    return AssistiveEnv.from_spec(spec, robot=robot, out_dir=cache_dir() / f"{name}-{robot}", **kwargs)
+
+
+def register_all() -> list[str]:
+    import gymnasium
+
+    ids = []
+    for env_id, (spec, robot) in shipped_ids().items():
+        if env_id not in gymnasium.registry:
+            gymnasium.register(id=env_id, entry_point="assistive_compiler.registration:make_env",
+                               kwargs={"spec": str(spec), "robot": robot}, disable_env_checker=True)
+        ids.append(env_id)
+    return ids

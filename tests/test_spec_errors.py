@@ -1,0 +1,531 @@
+"""Bad task specs are refused with located, readable messages — never a traceback.
+
+Every case writes a small spec into ``tmp_path`` (most ``extends:`` the shipped feeding spec by
+absolute path, so a two-line file changes one thing) and runs the real CLI in-process through
+``assistive_compiler.cli.main``. Each asserts exit status 2, no traceback, and the exact
+``PATH:LINE:COL: message`` line(s) on stderr. Paths are shown the way the CLI shows them
+(:func:`assistive_compiler.paths.display`); line and column are computed from the text written,
+so the expected location is visibly the place in the file the message is about.
+
+Tests marked ``xfail(strict=True)`` assert the *correct* behaviour of a known bug.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from assistive_compiler.cli import main
+from assistive_compiler.paths import display
+from assistive_compiler.spec.load import load_spec
+from assistive_compiler.yamlsrc import loads_located
+
+REPO = Path(__file__).resolve().parents[1]
+FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
+EXTENDS = f"extends: {FEEDING}\n"
+
+# The food reward term, for specs that replace the reward list (lists are replaced, not merged)
+# and must keep the success term 'food_eaten' defined.
+FOOD_EATEN = "  - {name: food_eaten, term: particles_consumed, weight: 20.0, params: {particles: food}}\n"
+
+
+# --------------------------------------------------------------------------------------------
+# helpers
+
+
+def at(text: str, needle: str, occurrence: int = 1) -> str:
+    """``LINE:COL`` (1-based) of the ``occurrence``-th ``needle`` in ``text``."""
+    index = -1
+    for _ in range(occurrence):
+        index = text.index(needle, index + 1)
+    line = text.count("\n", 0, index) + 1
+    column = index - (text.rfind("\n", 0, index) + 1) + 1
+    return f"{line}:{column}"
+
+
+def write(tmp_path: Path, text: str, name: str = "spec.yaml") -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def run_cli(capsys, *argv: str) -> tuple[int, str, str]:
+    rc = main(list(argv))
+    captured = capsys.readouterr()
+    return rc, captured.out, captured.err
+
+
+def problems(capsys, path: Path) -> list[str]:
+    """Validate ``path``; require exit 2, no traceback and nothing on stdout; return stderr lines."""
+    rc, out, err = run_cli(capsys, "validate", str(path))
+    assert "Traceback" not in out + err
+    assert rc == 2, f"expected exit 2, got {rc}; stdout={out!r} stderr={err!r}"
+    assert out == ""
+    return err.splitlines()
+
+
+def check(capsys, path: Path, *expected: str) -> None:
+    """The stderr lines of validating ``path`` are exactly ``expected`` (each ``LINE:COL: message``)."""
+    shown = display(path)
+    assert problems(capsys, path) == [f"{shown}:{e}" for e in expected]
+
+
+def feeding_location(needle: str, offset: int = 0) -> str:
+    """``PATH:LINE:COL`` of ``needle`` (plus ``offset`` columns) in the shipped feeding spec, as the CLI shows it."""
+    line, column = at(FEEDING.read_text(encoding="utf-8"), needle).split(":")
+    return f"{display(FEEDING)}:{line}:{int(column) + offset}"
+
+
+# --------------------------------------------------------------------------------------------
+# the good spec
+
+
+def test_feeding_validates(capsys, monkeypatch):
+    monkeypatch.chdir(REPO)
+    rc, out, err = run_cli(capsys, "validate", "specs/tasks/feeding.yaml")
+    assert (rc, err) == (0, "")
+    assert out == "specs/tasks/feeding.yaml: ok (task 'feeding', robots: jaco)\n"
+
+
+def test_extending_spec_without_changes_validates(tmp_path, capsys):
+    path = write(tmp_path, EXTENDS)
+    rc, out, err = run_cli(capsys, "validate", str(path))
+    assert (rc, err) == (0, "")
+    assert out == f"{path}: ok (task 'feeding', robots: jaco)\n"
+
+
+def test_on_key_stays_a_name(tmp_path, capsys):
+    """YAML 1.1 reads a bare ``on`` as ``True``; as a key it must stay the name "on"."""
+    data, _ = loads_located("on: 1\nno: 2\ny: 3\noff: 4\n", "keys.yaml")
+    assert list(data) == ["on", "no", "y", "off"]
+
+    text = EXTENDS + "preferences:\n  active:\n    force_nontarget: {params: {on: [person], by: [robot]}}\n"
+    path = write(tmp_path, text)
+    rc, out, err = run_cli(capsys, "validate", str(path))
+    assert (rc, err) == (0, "")
+    assert out == f"{path}: ok (task 'feeding', robots: jaco)\n"
+    params = load_spec(path).data["preferences"]["active"]["force_nontarget"]["params"]
+    assert params == {"on": ["person"], "by": ["robot"]}
+
+
+# --------------------------------------------------------------------------------------------
+# YAML-level problems
+
+
+def test_yaml_syntax_error(tmp_path, capsys):
+    text = EXTENDS + "sim:\n  frame_skip: 5\n   episode_steps: 100\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, ': 100')}: YAML syntax error: mapping values are not allowed here")
+
+
+def test_duplicate_key_names_first_definition(tmp_path, capsys):
+    text = EXTENDS + "sim:\n  frame_skip: 5\n  episode_steps: 100\n  frame_skip: 6\n"
+    path = write(tmp_path, text)
+    first = at(text, "frame_skip").split(":")
+    check(capsys, path, f"{at(text, 'frame_skip', 2)}: duplicate key 'frame_skip' (first defined at line {first[0]}, column {first[1]})")
+    assert first == ["3", "3"]
+
+
+def test_missing_spec_file(tmp_path, capsys):
+    check(capsys, tmp_path / "nowhere.yaml", "1:1: file not found")
+
+
+def test_empty_file(tmp_path, capsys):
+    path = write(tmp_path, "# nothing here\n")
+    check(capsys, path, "1:1: file is empty; expected a mapping of spec fields (e.g. 'name: my_task')")
+
+
+def test_top_level_list(tmp_path, capsys):
+    path = write(tmp_path, "# a list\n- name: feeding\n- title: Feeding\n")
+    check(capsys, path, "2:1: top level is a list; expected a mapping of spec fields (e.g. 'name: my_task')")
+
+
+def test_top_level_scalar(tmp_path, capsys):
+    path = write(tmp_path, "feeding\n")
+    check(capsys, path, "1:1: top level is a single value ('feeding'); expected a mapping of spec fields (e.g. 'name: my_task')")
+
+
+# --------------------------------------------------------------------------------------------
+# extends
+
+
+def test_extends_cycle(tmp_path, capsys):
+    a = write(tmp_path, "extends: b.yaml\nname: a\n", "a.yaml")
+    b = write(tmp_path, "# b builds on a, which builds on b\nextends: a.yaml\nname: b\n", "b.yaml")
+    lines = problems(capsys, a)
+    cycle = f"{display(a)} -> {display(b)} -> {display(a)}"
+    assert lines == [f"{display(b)}:2:10: extends forms a cycle: {cycle}"]
+
+
+def test_extends_missing_file(tmp_path, capsys):
+    text = "name: x\nextends: base/missing.yaml\n"
+    path = write(tmp_path, text)
+    missing = display(tmp_path / "base" / "missing.yaml")
+    check(capsys, path, f"{at(text, 'base/')}: extends: file not found: {missing} (paths are relative to {display(tmp_path)}/)")
+
+
+# --------------------------------------------------------------------------------------------
+# shape and type problems
+
+
+def test_unknown_key_did_you_mean(tmp_path, capsys):
+    text = EXTENDS + "person:\n  postur: seated\n"
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, 'postur')}: unknown key 'postur' in person; expected one of 'control', 'gravity_mps2', "
+        "'impairments', 'joints_deg', 'placement', 'posture', 'randomize_deg', 'variants' (did you mean 'posture'?)",
+    )
+
+
+def test_wrong_type(tmp_path, capsys):
+    text = EXTENDS + "sim:\n  frame_skip: five\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, 'five')}: sim.frame_skip: must be a valid integer, unable to parse string as an integer, got 'five'")
+
+
+def test_list_where_mapping_expected(tmp_path, capsys):
+    text = EXTENDS + "person:\n  placement: [wheelchair]\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, '[wheelchair]')}: person.placement: expected a mapping, got a list of 1")
+
+
+def test_section_given_as_list(tmp_path, capsys):
+    text = EXTENDS + "sim:\n  - frame_skip: 5\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, '- frame_skip')}: sim: expected a mapping, got a list of 1")
+
+
+def test_vector_of_wrong_length(tmp_path, capsys):
+    text = EXTENDS + "scene:\n  furniture:\n    table: {position_m: [1, 2]}\n"
+    path = write(tmp_path, text)
+    lines = problems(capsys, path)
+    assert len(lines) == 1
+    assert lines[0].startswith(f"{display(path)}:{at(text, '[1, 2]')}: scene.furniture.table.position_m: ")
+    assert "missing required key" not in lines[0]
+
+
+def test_number_or_uniform_given_a_word(tmp_path, capsys):
+    text = EXTENDS + "sim:\n  ground: {friction: slippery}\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, 'slippery')}: sim.ground.friction: expected a number or {{uniform: [low, high]}}, got 'slippery'")
+
+
+# --------------------------------------------------------------------------------------------
+# numbers out of range
+
+
+def test_negative_particle_mass(tmp_path, capsys):
+    text = EXTENDS + "particles:\n  food:\n    mass_kg: -0.001\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, '-0.001')}: particles.food.mass_kg: must be greater than 0, got -0.001")
+
+
+def test_nan_weight(tmp_path, capsys):
+    text = EXTENDS + "reward:\n  - {name: action, term: action_norm, weight: .nan}\n" + FOOD_EATEN
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, '.nan')}: reward[0].weight: must be a finite number, got nan")
+
+
+def test_success_fraction_out_of_range(tmp_path, capsys):
+    text = EXTENDS + "success:\n  aggregate: sum\n  threshold: 1.5\n"
+    path = write(tmp_path, text)
+    lines = problems(capsys, path)
+    assert len(lines) == 1
+    assert lines[0].startswith(f"{display(path)}:{at(text, '1.5')}: ")
+    assert lines[0].endswith("threshold 1.5 is a fraction of 'food' and must lie in (0, 1]")
+
+
+def test_success_fraction_out_of_range_message(tmp_path, capsys):
+    """The message (and the line, when the mapping starts on the threshold's line) is right today."""
+    text = EXTENDS + "success: {threshold: 1.5}\n"
+    path = write(tmp_path, text)
+    [line] = problems(capsys, path)
+    assert line.endswith(": success.threshold: threshold 1.5 is a fraction of 'food' and must lie in (0, 1]")
+
+
+def test_success_threshold_absolute_without_relative_to(tmp_path, capsys):
+    """Without relative_to the threshold is absolute: 1.5 is fine."""
+    text = EXTENDS + "success: {term: food_eaten, aggregate: sum, threshold: 1.5, relative_to: null}\n"
+    path = write(tmp_path, text)
+    rc, out, err = run_cli(capsys, "validate", str(path))
+    assert (rc, err) == (0, "")
+
+
+def test_joint_angle_beyond_limits(tmp_path, capsys):
+    text = EXTENDS + "person:\n  joints_deg:\n    right_elbow: -190\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, '-190')}: right_elbow = -190° is outside the joint's limits [-128°, 0°]")
+
+
+def test_randomized_joint_range_beyond_limits(tmp_path, capsys):
+    text = EXTENDS + "person:\n  randomize_deg:\n    right_elbow: {uniform: [-90, 10]}\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, '{uniform')}: right_elbow = 10° is outside the joint's limits [-128°, 0°]")
+
+
+def test_reversed_uniform_bounds(tmp_path, capsys):
+    text = EXTENDS + "person:\n  randomize_deg:\n    head_x: {uniform: [30, -30]}\n"
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, '[30, -30]')}: person.randomize_deg.head_x.uniform: bounds are reversed: low 30 > high -30; write [low, high]",
+    )
+
+
+def test_impairment_field_out_of_range(tmp_path, capsys):
+    text = EXTENDS + "person:\n  impairments:\n    choices:\n      - {kind: weakness, strength: 1.5}\n"
+    path = write(tmp_path, text)
+    lines = problems(capsys, path)
+    assert len(lines) == 1
+    assert lines[0].startswith(f"{display(path)}:{at(text, '1.5')}: person.impairments.choices[0].strength: ")
+    assert "strength must lie in (0, 1]" in lines[0]
+
+
+# --------------------------------------------------------------------------------------------
+# unknown names, each with a "did you mean"
+
+
+def test_unknown_robot_on_command_line(tmp_path, capsys):
+    out_dir = tmp_path / "out"
+    rc, out, err = run_cli(capsys, "compile", str(FEEDING), "--robot", "jacco", "--out", str(out_dir))
+    assert "Traceback" not in out + err
+    assert (rc, out) == (2, "")
+    # The robot is not written in the spec; the message points at the task's default robot.
+    assert err.splitlines() == [
+        f"{feeding_location('default: jaco', len('default: '))}: robot 'jacco' is not supported by task 'feeding'; supported: 'jaco' (did you mean 'jaco'?)"
+    ]
+    assert not out_dir.exists()
+
+
+def test_unknown_robot_in_supported(tmp_path, capsys):
+    text = EXTENDS + "robot:\n  default: jacco\n  supported: [jacco]\n"
+    path = write(tmp_path, text)
+    message = "unknown robot 'jacco'; expected one of 'jaco' (did you mean 'jaco'?)"
+    check(capsys, path, f"{at(text, 'jacco')}: {message}", f"{at(text, 'jacco', 2)}: {message}")
+
+
+def test_default_robot_not_supported(tmp_path, capsys):
+    text = EXTENDS + "robot:\n  arm: right\n  default: jacco\n"
+    path = write(tmp_path, text)
+    lines = problems(capsys, path)
+    assert len(lines) == 1
+    assert lines[0].startswith(f"{display(path)}:{at(text, 'jacco')}: ")
+    assert lines[0].endswith("default robot 'jacco' is not in supported ['jaco'] (did you mean 'jaco'?)")
+
+
+def test_default_robot_not_supported_message(tmp_path, capsys):
+    """The message (and the line, when 'default' is the mapping's first key) is right today."""
+    text = EXTENDS + "robot:\n  default: jacco\n"
+    path = write(tmp_path, text)
+    [line] = problems(capsys, path)
+    assert line.endswith(": robot.default: default robot 'jacco' is not in supported ['jaco'] (did you mean 'jaco'?)")
+
+
+def test_unknown_tool_part(tmp_path, capsys):
+    text = EXTENDS + "tools:\n  spoon: {part: spon}\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, 'spon}')}: unknown tool 'spon'; expected one of 'spoon' (did you mean 'spoon'?)")
+
+
+def test_unknown_furniture_part(tmp_path, capsys):
+    text = EXTENDS + "scene:\n  furniture:\n    table: {part: table_tal}\n"
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, 'table_tal')}: unknown furniture part 'table_tal'; expected one of 'bowl', 'table_tall', 'wheelchair' (did you mean 'table_tall'?)",
+    )
+
+
+def test_unknown_reward_term_kind(tmp_path, capsys):
+    text = EXTENDS + "reward:\n  - {name: action, term: action_nrom, weight: -0.01}\n" + FOOD_EATEN
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, 'action_nrom')}: unknown reward term 'action_nrom'; expected one of 'action_norm', 'contact_force', "
+        "'distance', 'particles_consumed', 'particles_lost' (did you mean 'action_norm'?)",
+    )
+
+
+def test_unknown_observation_term(tmp_path, capsys):
+    text = EXTENDS + "observations:\n  robot:\n    - {term: positon, params: {of: spoon}}\n"
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, 'positon')}: unknown observation term 'positon'; expected one of 'contact_force', 'displacement', "
+        "'joint_angles', 'orientation', 'position' (did you mean 'position'?)",
+    )
+
+
+def test_unknown_person_link(tmp_path, capsys):
+    text = EXTENDS + "targets:\n  mouth:\n    link: person.haed\n"
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, 'person.haed')}: unknown link 'haed' of person; expected one of 'chest', 'head', 'head_x_link', "
+        "'head_y_link', 'left_ankle', 'left_ankle_x_link', 'left_ankle_y_link', 'left_elbow', 'left_elbow_link', "
+        "'left_hip', 'left_hip_x_link', 'left_hip_y_link', ... (43 in all) (did you mean 'head'?)",
+    )
+
+
+def test_unknown_robot_link_in_term_param(tmp_path, capsys):
+    text = EXTENDS + "observations:\n  robot:\n    - {term: position, params: {of: robot.end_efector}}\n"
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, 'robot.end_efector')}: unknown link 'end_efector' of robot; expected one of 'base', 'end_effector', "
+        "'left_end_effector', 'left_tool_mount', 'right_end_effector', 'right_tool_mount', 'tool_mount' "
+        "(did you mean 'end_effector'?)",
+    )
+
+
+def test_unknown_target_in_term_param(tmp_path, capsys):
+    text = EXTENDS + "reward:\n  - {name: to_mouth, term: distance, weight: -1.0, params: {a: spoon, b: mouht}}\n" + FOOD_EATEN
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, 'mouht')}: unknown target or body 'mouht'; expected one of 'bowl', 'mouth', 'person', 'robot', "
+        "'spoon', 'table', 'wheelchair' (did you mean 'mouth'?)",
+    )
+
+
+def test_unknown_target_in_term_param_is_located(tmp_path, capsys):
+    """Whatever its wording, the problem is located at the misspelt target and suggests 'mouth'."""
+    text = EXTENDS + "reward:\n  - {name: to_mouth, term: distance, weight: -1.0, params: {a: spoon, b: mouht}}\n" + FOOD_EATEN
+    path = write(tmp_path, text)
+    [line] = problems(capsys, path)
+    assert line.startswith(f"{display(path)}:{at(text, 'mouht')}: unknown ")
+    assert line.endswith("'mouht'; expected one of 'bowl', 'mouth', 'person', 'robot', 'spoon', 'table', 'wheelchair' (did you mean 'mouth'?)")
+
+
+def test_unknown_preference(tmp_path, capsys):
+    text = EXTENDS + "preferences:\n  active:\n    velocty: {params: {of: [robot.end_effector]}}\n"
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, 'velocty')}: unknown preference 'velocty'; expected one of 'dressing_force', 'food_hit', "
+        "'food_velocity', 'force_nontarget', 'high_force', 'pressure', 'velocity' (did you mean 'velocity'?)",
+    )
+
+
+def test_unknown_particle_set(tmp_path, capsys):
+    text = EXTENDS + "reward:\n  - {name: food_eaten, term: particles_consumed, weight: 20.0, params: {particles: fod}}\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, 'fod}')}: unknown particle set 'fod'; expected one of 'food' (did you mean 'food'?)")
+
+
+def test_unknown_joint_group(tmp_path, capsys):
+    text = EXTENDS + "person:\n  control:\n    policy_joints: [person.haed]\n"
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, 'person.haed')}: unknown joint group 'person.haed'; expected one of 'person.head', 'person.left_arm', "
+        "'person.left_leg', 'person.policy', 'person.right_arm', 'person.right_leg', 'person.waist', 'robot.arm', "
+        "'robot.left_arm', 'robot.right_arm' (did you mean 'person.head'?)",
+    )
+
+
+def test_unknown_impairment_kind(tmp_path, capsys):
+    text = EXTENDS + "person:\n  impairments:\n    choices:\n      - {kind: tremer}\n"
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, 'tremer')}: unknown kind 'tremer' in person.impairments.choices[0]; expected one of "
+        "'limited_range', 'none', 'tremor', 'weakness' (did you mean 'tremor'?)",
+    )
+
+
+def test_unknown_key_in_impairment(tmp_path, capsys):
+    text = EXTENDS + "person:\n  impairments:\n    choices:\n      - {kind: tremor, amplitude: 5}\n"
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, 'amplitude')}: unknown key 'amplitude' in person.impairments.choices[0]; expected one of "
+        "'amplitude_deg', 'joints', 'kind' (did you mean 'amplitude_deg'?)",
+    )
+
+
+def test_unknown_seat_furniture(tmp_path, capsys):
+    text = EXTENDS + "person:\n  placement: {seated_on: wheelchar}\n"
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, 'wheelchar')}: unknown furniture 'wheelchar'; expected one of 'bowl', 'table', 'wheelchair' (did you mean 'wheelchair'?)",
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# several problems at once
+
+
+def test_several_schema_problems_all_reported_sorted(tmp_path, capsys):
+    # Written in the opposite order to the model's fields (sim, person, ..., particles).
+    text = EXTENDS + "particles:\n  food:\n    mass_kg: -0.001\nperson:\n  postur: seated\nsim:\n  frame_skip: five\n"
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, '-0.001')}: particles.food.mass_kg: must be greater than 0, got -0.001",
+        f"{at(text, 'postur')}: unknown key 'postur' in person; expected one of 'control', 'gravity_mps2', "
+        "'impairments', 'joints_deg', 'placement', 'posture', 'randomize_deg', 'variants' (did you mean 'posture'?)",
+        f"{at(text, 'five')}: sim.frame_skip: must be a valid integer, unable to parse string as an integer, got 'five'",
+    )
+
+
+def test_several_reference_problems_all_reported_sorted(tmp_path, capsys):
+    # Written in the opposite order to the resolver's passes (targets are checked before rewards).
+    text = (
+        EXTENDS
+        + "reward:\n"
+        + "  - {name: action, term: action_nrom, weight: -0.01}\n"
+        + "  - {name: food_eaten, term: particles_consumed, weight: 20.0, params: {particles: fod}}\n"
+        + "targets:\n  mouth:\n    link: person.haed\n"
+        + "tools:\n  spoon: {part: spoon, hand: right}\n"
+    )
+    path = write(tmp_path, text)
+    lines = problems(capsys, path)
+    shown = display(path)
+    assert [line.split(": ")[0] for line in lines] == [
+        f"{shown}:{at(text, 'action_nrom')}",
+        f"{shown}:{at(text, 'fod}')}",
+        f"{shown}:{at(text, 'person.haed')}",
+    ]
+    assert "unknown reward term 'action_nrom'" in lines[0]
+    assert "unknown particle set 'fod'" in lines[1]
+    assert "unknown link 'haed' of person" in lines[2]
+
+
+def test_several_part_problems_all_reported(tmp_path, capsys):
+    text = EXTENDS + "tools:\n  spoon: {part: spon}\nscene:\n  furniture:\n    table: {part: table_tal}\n"
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, 'spon}')}: unknown tool 'spon'; expected one of 'spoon' (did you mean 'spoon'?)",
+        f"{at(text, 'table_tal')}: unknown furniture part 'table_tal'; expected one of 'bowl', 'table_tall', 'wheelchair' (did you mean 'table_tall'?)",
+    )
+
+
+def test_validate_reports_every_file(tmp_path, capsys):
+    """validate takes several files: the good one is ok, the bad one reported, exit 2."""
+    good = write(tmp_path, EXTENDS, "good.yaml")
+    bad = write(tmp_path, EXTENDS + "sim:\n  frame_skip: five\n", "bad.yaml")
+    rc, out, err = run_cli(capsys, "validate", str(bad), str(good))
+    assert rc == 2
+    assert "Traceback" not in out + err
+    assert out == f"{good}: ok (task 'feeding', robots: jaco)\n"
+    assert err == f"{display(bad)}:3:15: sim.frame_skip: must be a valid integer, unable to parse string as an integer, got 'five'\n"
