@@ -69,6 +69,8 @@ class AssistiveEnv(gym.Env):
         self.upper = np.array(m.robot.joint_upper)
         self.gripper_idx = [robot.joints[j] for j in m.robot.gripper_joints]
         self.delta_scale = m.robot.action_scale * m.sim.frame_skip
+        self._gains = [m.robot.position_gain] * len(self.arm_idx)
+        self._forces = [m.robot.max_force] * len(self.arm_idx)
 
         self.obs_fns = [bind_term(t, self.snap) for t in m.observations["robot"]]
         self.reward_fns = [(t.name, t.weight, bind_term(t, self.snap)) for t in m.reward]
@@ -76,6 +78,8 @@ class AssistiveEnv(gym.Env):
         person_names = [b.name for b in m.bodies if b.kind == "person"]
         self._force_on_person = ([b.name for b in m.bodies if b.kind in ("robot", "tool")], ["person"])
         obs_size = sum(t.size for t in m.observations["robot"])
+        bounds = np.cumsum([0] + [t.size for t in m.observations["robot"]])
+        self._obs_slices = [slice(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
         self.observation_space = gym.spaces.Box(-np.inf, np.inf, (obs_size,), np.float32)
         self.action_space = gym.spaces.Box(-1.0, 1.0, (len(self.arm_idx),), np.float32)
         self.steps = 0
@@ -160,7 +164,7 @@ class AssistiveEnv(gym.Env):
         q = np.array([s[0] for s in pb.getJointStates(w.robot.id, self.arm_idx, physicsClientId=c)])
         target = np.clip(q + self.delta_scale * np.clip(raw, -1.0, 1.0), self.lower, self.upper)
         pb.setJointMotorControlArray(w.robot.id, self.arm_idx, pb.POSITION_CONTROL, targetPositions=target.tolist(),
-                                     positionGains=[m.robot.position_gain] * len(target), forces=[m.robot.max_force] * len(target), physicsClientId=c)
+                                     positionGains=self._gains, forces=self._forces, physicsClientId=c)
         w.step_physics()
         self.steps += 1
         self.snap.actions["robot"] = raw
@@ -192,7 +196,10 @@ class AssistiveEnv(gym.Env):
 
     # -- helpers -------------------------------------------------------------------------------
     def _observe(self) -> np.ndarray:
-        return np.concatenate([np.atleast_1d(fn(self.snap)) for fn in self.obs_fns]).astype(np.float32)
+        obs = np.empty(self.observation_space.shape, dtype=np.float32)
+        for fn, where in zip(self.obs_fns, self._obs_slices):
+            obs[where] = fn(self.snap)
+        return obs
 
     def _success_metric(self) -> float:
         agg = self.manifest.success.aggregate

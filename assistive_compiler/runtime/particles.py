@@ -10,6 +10,8 @@ ones before it. Events are evaluated once per env step, as in the reference.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pybullet as pb
 
@@ -55,11 +57,12 @@ class ParticleSystem:
     def update(self) -> None:
         """Evaluate this step's events (after physics, after the snapshot refresh)."""
         w, c, snap = self.world, self.world.client, self.snap
+        base_pose, base_velocity, closest = pb.getBasePositionAndOrientation, pb.getBaseVelocity, pb.getClosestPoints
         for ps, ids, target in self.sets:
             ev = ParticleEvents()
             active, hit = self.active[ps.name], self.hit[ps.name]
-            centre = snap.position(target) if target is not None else None
-            hit_ids = set()
+            centre = tuple(snap.position(target)) if target is not None else None
+            hit_ids: set[int] = set()
             if ps.hit_body:
                 hb = snap.handle(snap.body_key(ps.hit_body)).id
                 hit_ids = {cp[2] for cp in pb.getContactPoints(bodyA=hb, physicsClientId=c)}
@@ -68,22 +71,23 @@ class ParticleSystem:
                 holder = snap.handle(snap.body_key(ps.lost_body))
                 lost_id = holder.id
                 frame = w.link_frame(holder, holder.links[ps.lost_link])
-                anchor = np.asarray(pb.multiplyTransforms(*frame, ps.lost_anchor, (0, 0, 0, 1))[0])
+                anchor = pb.multiplyTransforms(*frame, ps.lost_anchor, (0, 0, 0, 1))[0]
             for k, pid in enumerate(ids):
                 if not active[k]:
                     continue
-                pos = np.asarray(pb.getBasePositionAndOrientation(pid, physicsClientId=c)[0])
+                pos = base_pose(pid, physicsClientId=c)[0]
                 if pid in hit_ids and not hit[k]:
                     hit[k] = True
                     ev.hit += 1
-                if centre is not None and np.linalg.norm(pos - centre) < ps.consumed_radius:
+                if centre is not None and math.dist(pos, centre) < ps.consumed_radius:
                     ev.consumed += 1
-                    ev.consumed_speed_sum += float(np.linalg.norm(pb.getBaseVelocity(pid, physicsClientId=c)[0]))
+                    ev.consumed_speed_sum += math.hypot(*base_velocity(pid, physicsClientId=c)[0])
                     active[k] = False
                     self._park(pid, k)
-                elif (lost_id is not None and np.linalg.norm(pos - anchor) >= ps.lost_distance
-                      and not pb.getClosestPoints(pid, lost_id, ps.lost_distance, physicsClientId=c)):
-                    # (within lost_distance of a point inside the holder: certainly near it; else ask)
+                elif (lost_id is not None and math.dist(pos, anchor) >= ps.lost_distance
+                      and not closest(pid, lost_id, ps.lost_distance, physicsClientId=c)):
+                    # Within lost_distance of a point inside the holder means certainly near it;
+                    # only otherwise is the exact closest-points query needed.
                     ev.lost += 1
                     active[k] = False
                     self._park(pid, k)
