@@ -195,8 +195,7 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int) -
         # A raw loop of stepSimulation with nothing else, for reference.
         env.reset(seed=0)
         t0 = time.perf_counter()
-        calls = steps if world.fused else steps * env.manifest.sim.frame_skip
-        for _ in range(calls):
+        for _ in range(steps * env.manifest.sim.frame_skip):
             pb.stepSimulation(physicsClientId=world.client)
         raw_loop = steps / (time.perf_counter() - t0)
         reset_ms = []

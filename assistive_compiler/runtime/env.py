@@ -83,7 +83,7 @@ class AssistiveEnv(gym.Env):
         self.observation_space = gym.spaces.Box(-np.inf, np.inf, (obs_size,), np.float32)
         self.action_space = gym.spaces.Box(-1.0, 1.0, (len(self.arm_idx),), np.float32)
         self.steps = 0
-        self.success_values: list[float] = []
+        self.success_metric: float | None = None
         self._person_names = person_names
         self._robot_base = self.world.base_frame(robot)
 
@@ -104,6 +104,7 @@ class AssistiveEnv(gym.Env):
         # Person variant: the drawn one in place, the others parked.
         variant = m.person.variants[int(rng.integers(len(m.person.variants)))]
         w.active_variant = variant
+        self.snap.begin_episode()
         for i, v in enumerate(m.person.variants):
             body = m.body(v.body)
             parked = (PARK[0] + 10.0 * i, PARK[1], PARK[2])
@@ -149,7 +150,7 @@ class AssistiveEnv(gym.Env):
         self.particles.reset()
 
         self.steps = 0
-        self.success_values = []
+        self.success_metric = None
         self.snap.actions = {"robot": np.zeros(len(self.arm_idx)), "human": np.zeros(0)}
         self.snap.set_frame("robot_base", *w.base_frame(w.robot))
         self.snap.set_frame("person_base", *w.base_frame(person))
@@ -173,8 +174,7 @@ class AssistiveEnv(gym.Env):
 
         values = {name: float(fn(self.snap)) for name, _, fn in self.reward_fns}
         reward = float(sum(weight * values[name] for name, weight, _ in self.reward_fns))
-        self.success_values.append(values[m.success.term])
-        metric = self._success_metric()
+        metric = self._aggregate(values[m.success.term])
         info = {
             "terms": values,
             "total_force_on_human": self.snap.contact_force(*self._force_on_person),
@@ -201,9 +201,16 @@ class AssistiveEnv(gym.Env):
             obs[where] = fn(self.snap)
         return obs
 
-    def _success_metric(self) -> float:
-        agg = self.manifest.success.aggregate
-        vals = self.success_values
-        if not vals:
-            return 0.0
-        return float({"sum": sum, "max": max, "min": min, "last": lambda v: v[-1]}[agg](vals))
+    def _aggregate(self, value: float) -> float:
+        """Fold this step's value of the success term into the episode's aggregate."""
+        agg, metric = self.manifest.success.aggregate, self.success_metric
+        if metric is None or agg == "last":
+            metric = value
+        elif agg == "sum":
+            metric += value
+        elif agg == "max":
+            metric = max(metric, value)
+        else:
+            metric = min(metric, value)
+        self.success_metric = metric
+        return metric

@@ -89,8 +89,9 @@ class Snapshot:
         self.events: dict[str, ParticleEvents] = {}
         self._contacts: dict[tuple[int, int], tuple] = {}
         self._joint_cache: dict[JointsHandle, np.ndarray] = {}
-        self.pos = self.orn = self.vel = np.zeros((0, 3))
-        self.frames: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        self.pos, self.orn, self.vel = np.zeros((0, 3)), np.zeros((0, 4)), np.zeros((0, 3))
+        self.frames: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        self._ids: dict[tuple[str, ...], tuple[int, ...]] = {}
 
     # -- binding ------------------------------------------------------------------------------
     def body_key(self, name: str) -> str:
@@ -124,8 +125,10 @@ class Snapshot:
             else:
                 reads.links.append(link)
                 reads.slots.append(slot)
-            n = len(self._slots)
-            self.pos, self.orn, self.vel = np.zeros((n, 3)), np.tile([0.0, 0, 0, 1], (n, 1)), np.zeros((n, 3))
+            # Grow the arrays by one row, keeping what has been read already.
+            self.pos = np.vstack([self.pos, np.zeros((1, 3))])
+            self.orn = np.vstack([self.orn, [[0.0, 0.0, 0.0, 1.0]]])
+            self.vel = np.vstack([self.vel, np.zeros((1, 3))])
         return self._slots[(key, link)]
 
     def joints(self, ref: dict) -> JointsHandle:
@@ -209,8 +212,17 @@ class Snapshot:
             self._contacts[key] = pb.getContactPoints(bodyA=a, bodyB=b, physicsClientId=self.world.client)
         return self._contacts[key]
 
-    def body_ids(self, names) -> list[int]:
-        return [self.handle(self.body_key(n)).id for n in names]
+    def body_ids(self, names) -> tuple[int, ...]:
+        """pybullet ids of named bodies ('person' = the active variant), cached for the episode."""
+        key = tuple(names)
+        ids = self._ids.get(key)
+        if ids is None:
+            ids = self._ids[key] = tuple(self.handle(self.body_key(n)).id for n in names)
+        return ids
+
+    def begin_episode(self) -> None:
+        """Forget what depended on the last episode's person variant."""
+        self._ids.clear()
 
     def contact_force(self, a, b, near: PointHandle | None = None, radius: float = 0.0) -> float:
         """Σ normal force (N) of contacts between any body of ``a`` and any of ``b``; with ``near``,

@@ -162,22 +162,16 @@ class World:
         pb.setGravity(0, 0, self.world_gravity, physicsClientId=c)
 
     def _set_stepping(self) -> None:
-        """Fused stepping when exact: one ``stepSimulation`` of frame_skip × time_step split into
-        internal sub-steps of time_step (each further split by the spec's solver sub-steps).
+        """One ``stepSimulation`` per physics step (each split into the spec's solver sub-steps).
 
-        External forces persist over a call's internal sub-steps, so compensation applied once is
-        exact for free bases (a force at the centre of mass). When articulated links need it (their
-        COM moves within a step) every physics step is a separate call with fresh forces.
+        Not fused into one call of frame_skip × time_step: pybullet turns motor force limits into
+        impulse limits and contact impulses into reported forces with the call's time step, so a
+        fused call would make motors frame_skip times stronger and contact forces frame_skip times
+        weaker than the spec says.
         """
         sim, c = self.m.sim, self.client
-        per_step = max(1, sim.sub_steps)
-        self.fused = all(links == [-1] for _, links, _ in self.gravity_groups)
-        if self.fused:
-            pb.setTimeStep(sim.time_step * sim.frame_skip, physicsClientId=c)
-            pb.setPhysicsEngineParameter(numSubSteps=sim.frame_skip * per_step, physicsClientId=c)
-        else:
-            pb.setTimeStep(sim.time_step, physicsClientId=c)
-            pb.setPhysicsEngineParameter(numSubSteps=per_step if sim.sub_steps else 0, physicsClientId=c)
+        pb.setTimeStep(sim.time_step, physicsClientId=c)
+        pb.setPhysicsEngineParameter(numSubSteps=sim.sub_steps, physicsClientId=c)
 
     def _body_id(self, name: str) -> int:
         if "#" in name:
@@ -207,10 +201,6 @@ class World:
     # -- per step ------------------------------------------------------------------------------
     def step_physics(self) -> None:
         """Advance one env step (frame_skip physics steps) with per-body gravity compensation."""
-        if self.fused:
-            self._apply_gravity_compensation()
-            pb.stepSimulation(physicsClientId=self.client)
-            return
         for _ in range(self.m.sim.frame_skip):
             self._apply_gravity_compensation()
             pb.stepSimulation(physicsClientId=self.client)

@@ -147,6 +147,14 @@ class Scene(Strict):
 # Person
 
 
+def _in_unit_interval(value: Scalar, name: str) -> Scalar:
+    """Check a fixed or random factor lies in (0, 1]."""
+    low, high = scalar_bounds(value)
+    if low <= 0 or high > 1:
+        raise ValueError(f"{name} must lie in (0, 1], got {describe(value)}")
+    return value
+
+
 class Tremor(Strict):
     """Tremor: each affected joint's target oscillates by ±ε, the sign flipping every env step."""
 
@@ -168,13 +176,7 @@ class Weakness(Strict):
     )
     joints: list[Ref] = Field(default_factory=lambda: ["person.policy"], description="Joint groups affected.")
 
-    @field_validator("strength")
-    @classmethod
-    def _range(cls, v: Scalar) -> Scalar:
-        low, high = scalar_bounds(v)
-        if low <= 0 or high > 1:
-            raise ValueError(f"strength must lie in (0, 1], got {describe(v)}")
-        return v
+    _range = field_validator("strength")(lambda v: _in_unit_interval(v, "strength"))
 
 
 class LimitedRange(Strict):
@@ -189,13 +191,7 @@ class LimitedRange(Strict):
         default_factory=lambda: ["person.right_arm", "person.left_arm", "person.head"], description="Joint groups affected."
     )
 
-    @field_validator("scale")
-    @classmethod
-    def _range(cls, v: Scalar) -> Scalar:
-        low, high = scalar_bounds(v)
-        if low <= 0 or high > 1:
-            raise ValueError(f"scale must lie in (0, 1], got {describe(v)}")
-        return v
+    _range = field_validator("scale")(lambda v: _in_unit_interval(v, "scale"))
 
 
 class NoImpairment(Strict):

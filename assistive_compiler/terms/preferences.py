@@ -7,7 +7,7 @@ active cost into a reward term named ``preference_<name>`` so ``info`` reports i
 
 from __future__ import annotations
 
-import numpy as np
+import math
 from pydantic import Field
 
 from .registry import BodiesRef, BodyRef, Params, ParticlesRef, PointRef, term
@@ -57,7 +57,7 @@ def _tool_force(snap, tool, on, target, radius) -> float:
 @term("velocity", "preference", Velocity)
 def velocity(snap, p) -> float:
     """C_v = −Σ‖v‖ over the listed points' linear speeds (m/s): move slowly near a person."""
-    return -float(sum(np.linalg.norm(snap.velocity(point)) for point in p.of))
+    return -sum(math.hypot(*snap.velocity(point)) for point in p.of)
 
 
 @term("force_nontarget", "preference", ForceNonTarget)

@@ -4,9 +4,8 @@ sign and scale (e.g. a distance in metres with weight −1 penalises distance). 
 
 from __future__ import annotations
 
+import math
 from typing import Literal
-
-import numpy as np
 
 from .registry import BodiesRef, Params, ParticlesRef, PointRef, term
 
@@ -32,13 +31,13 @@ class ContactForce(Params):
 @term("distance", "reward", Distance)
 def distance(snap, p) -> float:
     """Euclidean distance between two points (m)."""
-    return float(np.linalg.norm(snap.position(p.a) - snap.position(p.b)))
+    return math.dist(snap.position(p.a), snap.position(p.b))
 
 
 @term("action_norm", "reward", ActionNorm)
 def action_norm(snap, p) -> float:
     """‖a‖₂ of the raw (unclipped) action of ``agent`` — the paper's action penalty input."""
-    return float(np.linalg.norm(snap.action(p.agent)))
+    return math.hypot(*snap.action(p.agent))
 
 
 @term("particles_consumed", "reward", ParticleSet)
