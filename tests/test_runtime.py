@@ -148,6 +148,23 @@ def test_two_fresh_envs_give_identical_episodes(make_env):
     assert a_info == b_info
 
 
+def test_a_seeded_reset_replays_the_episode_whatever_came_before(make_env):
+    """reset(seed=s) replays bit for bit after any history (seeded or not) of the same env, and
+    equals the episode of a fresh env."""
+    env = make_env()
+    actions = np.random.default_rng(99).uniform(-1.0, 1.0, (60, 7)).astype(np.float32)
+    first, first_rew, _ = rollout(env, 0, actions)
+    noise = np.random.default_rng(7)
+    env.reset()
+    for _ in range(40):  # unseeded history
+        env.step(noise.uniform(-1, 1, 7))
+    rollout(env, 3, noise.uniform(-1, 1, (30, 7)))  # seeded history
+    again, again_rew, _ = rollout(env, 0, actions)
+    fresh, fresh_rew, _ = rollout(make_env(), 0, actions)
+    assert np.array_equal(first, again) and np.array_equal(first_rew, again_rew)
+    assert np.array_equal(first, fresh) and np.array_equal(first_rew, fresh_rew)
+
+
 def test_reset_with_the_same_seed_repeats_the_reset(env):
     rng = np.random.default_rng(5)
     for seed in (0, 3, 11):

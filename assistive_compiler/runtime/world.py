@@ -44,6 +44,19 @@ class World:
     def __init__(self, artifact_dir: str | Path, manifest: Manifest | None = None):
         self.dir = Path(artifact_dir)
         self.m = manifest or Manifest.read(self.dir)
+        self._build()
+
+    def rebuild(self) -> None:
+        """A fresh physics client with the same bodies under the same ids.
+
+        ``restoreState`` brings back every pose and velocity but not all of Bullet's solver and
+        collision caches, so after some history an episode can drift from the same seed's
+        episode in a fresh world. Rebuilding (tens of milliseconds) makes it bit-identical.
+        """
+        self.close()
+        self._build()
+
+    def _build(self) -> None:
         self.client = pb.connect(pb.DIRECT)
         c = self.client
         sim = self.m.sim
@@ -245,12 +258,11 @@ class World:
         return s[4], s[5]
 
     def restore(self) -> None:
-        """Back to the saved initial state, with no contact cache left from the last episode.
+        """Back to the saved initial state (poses, velocities), without the previous episode's contacts.
 
-        ``restoreState`` restores poses and velocities but not the collision pipeline's cached
-        contact manifolds, and a manifold carried over from the previous episode makes the next one
-        differ (slightly) from a fresh one. So every body is first moved apart, one collision pass
-        drops every pair, and the state is restored again: an episode depends only on its seed.
+        ``restoreState`` does not drop the collision pipeline's cached contact manifolds, so every
+        body is first moved apart and one collision pass drops the pairs before restoring again.
+        Some solver state still survives (see :meth:`rebuild` for bit-exact replay).
         """
         c = self.client
         pb.restoreState(self.initial_state, physicsClientId=c)
