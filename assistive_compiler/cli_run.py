@@ -98,9 +98,14 @@ def record(env, policy, seed: int, every: int) -> tuple[list[np.ndarray], dict]:
     return frames, {"return": total, "success": bool(info.get("task_success")), "steps": env.steps}
 
 
-def montage(frames: list[np.ndarray], count: int = 4) -> np.ndarray:
-    """``count`` evenly spaced frames side by side (a strip that tells the episode at a glance)."""
-    idx = np.linspace(0, len(frames) - 1, count).round().astype(int)
+MONTAGE_AT = (0.0, 0.1, 0.25, 1.0)
+"""Where in an episode the PNG strip's frames are taken: the start, the approach (most motion in
+these tasks happens early), and the end."""
+
+
+def montage(frames: list[np.ndarray], at: tuple[float, ...] = MONTAGE_AT) -> np.ndarray:
+    """Frames at fractions ``at`` of the episode, side by side: the episode at a glance."""
+    idx = [round(f * (len(frames) - 1)) for f in at]
     return np.concatenate([frames[i] for i in idx], axis=1)
 
 
