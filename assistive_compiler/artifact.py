@@ -47,6 +47,16 @@ class Body(_Model):
     position_noise: Vec3 = Field((0.0, 0.0, 0.0), description="Per-reset uniform position noise half-widths, m.")
 
 
+class StartState(_Model):
+    """One precomputed start: a robot base pose and the arm configuration that puts the tool at a
+    (noisy) start pose from it, collision-free."""
+
+    base_position: Vec3 = Field(description="Robot base frame position, world, m.")
+    base_orientation: Quat = Field(description="Robot base frame orientation, world.")
+    joints: list[float] = Field(description="Arm joint angles in action order, rad.")
+    tool_position: Vec3 = Field(description="Where the tool frame (or end effector) starts, world, m.")
+
+
 class PersonVariant(_Model):
     """One person body the task may draw at reset."""
 
@@ -59,8 +69,7 @@ class PersonVariant(_Model):
     initial_angles: dict[str, float] = Field(description="Initial angle of each movable joint, rad.")
     randomize: dict[str, tuple[float, float]] = Field(description="Per-reset uniform angle ranges, rad.")
     target_offsets: dict[str, Vec3] = Field(description="Offset of each person-attached target in its link, m.")
-    start_configurations: list[list[float]] = Field(description="Robot arm start configurations for this variant, rad.")
-    start_tool_positions: list[Vec3] = Field(description="Tool position each start configuration reaches, m.")
+    starts: list[StartState] = Field(description="Robot starts for this variant; reset() draws one.")
 
 
 class Person(_Model):
@@ -93,6 +102,7 @@ class Robot(_Model):
     max_force: float = Field(description="Arm force limit, N·m.")
     gripper_joints: list[str] = Field(description="Gripper joints, held at gripper_position.")
     gripper_position: float = Field(description="Gripper joint target (rad or m).")
+    placement: dict[str, Any] = Field(default_factory=dict, description="How the base was placed: mount, or the search's kept poses with goals reached and JLWKI.")
 
 
 class ToolAttachment(_Model):

@@ -99,10 +99,23 @@ class Library:
             m = body_measurements(part.sex, part.mass_kg, part.height_scale, part.radius_scale)
             return urdf_info(render_template(PERSON_TEMPLATE_RELPATH, m.xacro_args()))
         if getattr(part, "urdf", None):
-            path = (loaded.path.parent / part.urdf).resolve()
-            return urdf_info(path.read_text())
+            return urdf_info(self.urdf_path(loaded).read_text())
         params = dict(part.template.params) | dict(getattr(part, "mount_params", {}) or {})
         return urdf_info(render_template(self.template_path(loaded), params))
+
+    def urdf_path(self, loaded: LoadedPart) -> Path:
+        """A bring-your-own robot's URDF: relative to its part file, or inside an installed package."""
+        ref = loaded.part.urdf
+        prefix = "python-package:"
+        if ref.startswith(prefix):
+            package, _, rel = ref[len(prefix):].partition("/")
+            import importlib.util
+
+            spec = importlib.util.find_spec(package)
+            if spec is None or not spec.submodule_search_locations:
+                raise SpecError([Problem(loaded.smap.value(("urdf",)), f"Python package '{package}' is not installed")])
+            return Path(list(spec.submodule_search_locations)[0]) / rel
+        return (loaded.path.parent / ref).resolve()
 
     def template_path(self, loaded: LoadedPart) -> Path:
         """The part's template: absolute as written, else under the ``templates/`` beside the part's
@@ -124,7 +137,7 @@ class Library:
         part = loaded.part
         smap = loaded.smap
         if getattr(part, "urdf", None):
-            urdf_path = (loaded.path.parent / part.urdf).resolve()
+            urdf_path = self.urdf_path(loaded)
             if not urdf_path.is_file():
                 raise SpecError([Problem(smap.value(("urdf",)), f"URDF file not found: {urdf_path}")])
         info = self._urdf_of(kind, loaded)

@@ -61,6 +61,7 @@ class ResolvedTask:
     success_threshold: float
     points: dict[str, dict[str, Any]] = field(default_factory=dict)
     scripted: dict[str, Any] | None = None
+    base_goals: list[dict[str, Any]] = field(default_factory=list)
 
     @property
     def spec(self) -> TaskSpec:
@@ -143,12 +144,17 @@ class _Resolver:
         reward += self._preferences(spec)
         threshold = self._success(spec, {t.name for t in spec.reward})
         scripted = self._scripted(spec)
+        base_goals = [
+            {"point": self.point(g.point, ("robot", "base_search", "goals", i, "point")), "offset_m": list(g.offset_m),
+             "oriented": g.oriented, "required": g.required}
+            for i, g in enumerate(spec.robot.base_search.goals)
+        ]
         if self.problems:
             raise SpecError(self.problems)
         return ResolvedTask(
             self.loaded, self.robot_name, robot, self.robot_urdf, tools, furniture, people, self.person_urdf,
             self.robot_links, self.joint_groups, {a: [t for t in ts if t] for a, ts in observations.items()},
-            [t for t in reward if t], threshold, points, scripted,
+            [t for t in reward if t], threshold, points, scripted, base_goals,
         )
 
     def _bodies(self, spec: TaskSpec) -> None:

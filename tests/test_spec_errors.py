@@ -304,7 +304,10 @@ def test_unknown_robot_on_command_line(tmp_path, capsys):
 def test_unknown_robot_in_supported(tmp_path, capsys):
     text = EXTENDS + "robot:\n  default: jacco\n  supported: [jacco]\n"
     path = write(tmp_path, text)
-    message = "unknown robot 'jacco'; expected one of 'jaco' (did you mean 'jaco'?)"
+    from assistive_compiler.errors import one_of
+    from assistive_compiler.library import Library
+
+    message = f"unknown robot 'jacco'; expected one of {one_of(Library().names('robots'))} (did you mean 'jaco'?)"
     check(capsys, path, f"{at(text, 'jacco')}: {message}", f"{at(text, 'jacco', 2)}: {message}")
 
 

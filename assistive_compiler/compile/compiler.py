@@ -39,6 +39,7 @@ from ..artifact import (
     PersonVariant,
     Robot,
     Sim,
+    StartState,
     Success,
     Target,
     TermUse,
@@ -155,6 +156,13 @@ class _Precompute:
         p, c = self.p, self.client
         return {p.getJointInfo(body, j, physicsClientId=c)[1].decode(): j for j in range(p.getNumJoints(body, physicsClientId=c))}
 
+    def place(self, body: int, pos, orn) -> None:
+        """Put a body's URDF base frame (not its centre of mass) at (pos, orn)."""
+        p, c = self.p, self.client
+        inertial_pos, inertial_orn = p.getDynamicsInfo(body, -1, physicsClientId=c)[3:5]
+        com_pos, com_orn = p.multiplyTransforms(pos, orn, inertial_pos, inertial_orn)
+        p.resetBasePositionAndOrientation(body, com_pos, com_orn, physicsClientId=c)
+
     def touching(self, a: int, b: int, margin: float = 0.0) -> bool:
         return bool(self.p.getClosestPoints(a, b, margin, physicsClientId=self.client))
 
@@ -184,8 +192,15 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
     # 1-2. Render and lint ------------------------------------------------------------------
     robot_part = rt.robot.part
     if robot_part.template is None:
-        raise _fail(rt, ("robot", "default"), f"robot '{rt.robot_name}' uses an external URDF; compiling those arrives with the robot library")
-    emit("robot", lib.template_path(rt.robot), robot_part.template.params, rt.robot.smap.value(("template", "path")))
+        source = lib.urdf_path(rt.robot)
+        xml = absolute_mesh_paths(source.read_text(), source.parent)
+        problems = lint_urdf(xml, template=display(source), static_root=True)
+        if problems:
+            raise SpecError([Problem(rt.robot.smap.value(("urdf",)), f"URDF refused: {pr}") for pr in problems])
+        written["robot"] = urdf_dir / "robot.urdf"
+        written["robot"].write_text(xml)
+    else:
+        emit("robot", lib.template_path(rt.robot), robot_part.template.params, rt.robot.smap.value(("template", "path")))
     mounted_on = spec.robot.mount_on if robot_part.mountable else None
     for name, use in spec.scene.furniture.items():
         part = rt.furniture[name].part
@@ -256,6 +271,19 @@ def _referenced_person_links(rt: ResolvedTask) -> set[str]:
     return found
 
 
+def absolute_mesh_paths(urdf_xml: str, base: Path) -> str:
+    """A URDF with every relative ``<mesh filename>`` made absolute (relative to ``base``), so it
+    works from the artifact directory. ``package://`` paths are left for the lint to refuse."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.fromstring(urdf_xml)
+    for mesh in root.iter("mesh"):
+        name = mesh.get("filename", "")
+        if name and "://" not in name and not Path(name).is_absolute():
+            mesh.set("filename", str((base / name).resolve()))
+    return ET.tostring(root, encoding="unicode")
+
+
 def _policy_joints(rt: ResolvedTask) -> list[str]:
     out: list[str] = []
     for ref in rt.spec.person.control.policy_joints:
@@ -299,25 +327,17 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, baked, movable, measureme
             pos = tuple(a + b for a, b in zip(pos, person_spec.placement.offset_m))
         else:
             pos = tuple(person_spec.placement.position_m)
-        p.resetBasePositionAndOrientation(probe, pos, person_orn, physicsClientId=c)
+        pc.place(probe, pos, person_orn)
         jidx = pc.joint_index(probe)
         for j in movable:
             p.resetJointState(probe, jidx[j], math.radians(person_spec.joints_deg.get(j, 0.0)), physicsClientId=c)
         person_ids[variant], person_pos[variant] = probe, _round(pos)
 
-    # Robot: on the mount, or at a stated base offset.
+    # Robot: loaded once; its base is placed per candidate pose below.
     robot_part = rt.robot.part
     per_robot = spec.robot.per_robot.get(rt.robot_name)
     offset = per_robot.base_offset_m if per_robot and per_robot.base_offset_m else (0.0, 0.0, 0.0)
-    if mounted_on:
-        fpart = rt.furniture[mounted_on].part
-        mpos, morn = pc.link_pose(furniture_ids[mounted_on], pc.link_index(furniture_ids[mounted_on], fpart.mount_link))
-        base_pos, base_orn = tuple(a + b for a, b in zip(mpos, offset)), tuple(morn)
-    elif per_robot and per_robot.base_offset_m:
-        base_pos, base_orn = tuple(offset), (0.0, 0.0, 0.0, 1.0)
-    else:
-        raise _fail(rt, ("robot", "default"), f"robot '{rt.robot_name}' is not mountable and task '{spec.name}' gives no per_robot.{rt.robot_name}.base_offset_m; floor base-pose search is not available yet")
-    robot_id = pc.load(written["robot"], base_pos, base_orn, True)
+    robot_id = pc.load(written["robot"], (0, 0, 0), (0, 0, 0, 1), True)
     robot_joints = pc.joint_index(robot_id)
     side = spec.robot.arm if spec.robot.arm != "both" else "right"
     _, arm = robot_part.arm_for(side)
@@ -325,6 +345,11 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, baked, movable, measureme
     infos = {j: p.getJointInfo(robot_id, robot_joints[j], physicsClientId=c) for j in arm_joints}
     lower = [infos[j][8] for j in arm_joints]
     upper = [infos[j][9] for j in arm_joints]
+    mount_pose = None
+    if mounted_on:
+        fpart = rt.furniture[mounted_on].part
+        mpos, morn = pc.link_pose(furniture_ids[mounted_on], pc.link_index(furniture_ids[mounted_on], fpart.mount_link))
+        mount_pose = (tuple(a + b for a, b in zip(mpos, offset)), tuple(morn))
 
     # Tools and the grip transform.
     tool_ids: dict[str, int] = {}
@@ -341,7 +366,7 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, baked, movable, measureme
         bodies.append(Body(name=name, kind="tool", urdf=rel(written[name]), position=(0.0, 0.0, 0.0), orientation=(0.0, 0.0, 0.0, 1.0),
                            fixed_base=False, gravity=use.gravity_mps2))
 
-    # 3b. Start configurations: IK for noisy tool poses, per person variant ------------------
+    # 3b. Base poses and start configurations, per person variant -----------------------------
     start = spec.robot.start
     tool_orn = _quat_from_rpy(tuple(math.radians(a) for a in start.tool_rpy_deg))
     if tool_name:
@@ -349,36 +374,38 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, baked, movable, measureme
         inv_pos, inv_orn = p.invertTransform(att.position, att.orientation)
     else:
         inv_pos, inv_orn = (0, 0, 0), (0, 0, 0, 1)
-    ee_link = pc.link_index(robot_id, arm.tool_mount)
-    movable_idx = [j for j in range(p.getNumJoints(robot_id, physicsClientId=c)) if p.getJointInfo(robot_id, j, physicsClientId=c)[2] != p.JOINT_FIXED]
-    arm_idx = [robot_joints[j] for j in arm_joints]
-    ik_pos_in_movable = [movable_idx.index(i) for i in arm_idx]
-    rng = np.random.default_rng(int(rt.loaded.spec.name.encode().hex(), 16) % (2**32))
-    obstacles = list(furniture_ids.values())
+    arm_kin = _ArmKinematics(pc, robot_id, pc.link_index(robot_id, arm.tool_mount), [robot_joints[j] for j in arm_joints], lower, upper,
+                             (inv_pos, inv_orn), tool_ids, list(furniture_ids.values()), robot_part.arm_for(side)[1].rest_rad)
     variants_out: list[PersonVariant] = []
     particle_sets: list[ParticleSet] = []
+    placements: dict[str, Any] = {}
     for vi, variant in enumerate(person_spec.variants):
         for other, pid in person_ids.items():  # only this variant in the scene
-            p.resetBasePositionAndOrientation(pid, person_pos[other] if other == variant else (0, 0, -20), person_orn, physicsClientId=c)
-        configs: list[list[float]] = []
-        reached: list[tuple] = []
-        for s in range(start.samples):
-            noise = np.zeros(3) if s == 0 else rng.uniform(-start.noise_m, start.noise_m, 3)
-            goal = tuple(np.asarray(start.tool_position_m) + noise)
-            ee_pos, ee_orn = p.multiplyTransforms(goal, tool_orn, inv_pos, inv_orn)
-            q = _solve_ik(pc, robot_id, ee_link, ee_pos, ee_orn, arm_idx, ik_pos_in_movable, lower, upper, rng)
-            if q is None:
-                continue
-            if any(pc.touching(robot_id, o) for o in obstacles + [person_ids[variant]]):
-                continue
-            tool_ok = True
-            for name, tid in tool_ids.items():
-                p.resetBasePositionAndOrientation(tid, goal, tool_orn, physicsClientId=c)
-                tool_ok &= not pc.touching(tid, person_ids[variant])
-            if tool_ok:
-                configs.append(_round(list(q)))
-                reached.append(_round(goal))
-        if not configs:
+            pc.place(pid, person_pos[other] if other == variant else (0, 0, -20), person_orn)
+        rng = np.random.default_rng(_seed(rt, variant))
+        arm_kin.person = person_ids[variant]
+        goals = [(tuple(start.tool_position_m), tool_orn, True, "the start pose")]
+        for g in rt.base_goals:
+            where = np.asarray(_point_world(pc, rt, g["point"], person_ids[variant], variant, furniture_ids, tool_ids)) + g["offset_m"]
+            goals.append((tuple(where), tool_orn if g["oriented"] else None, g["required"], _describe_point(g["point"])))
+        if mount_pose is not None:
+            bases = [(mount_pose, len(goals), 0.0)]
+            placements[variant] = {"mounted_on": mounted_on}
+        else:
+            bases = _search_base(rt, arm_kin, goals, offset, rng)
+            placements[variant] = {"base_poses": [{"position": list(_round(b[0][0])), "yaw_rad": _round(_yaw(b[0][1])),
+                                                   "goals_reached": b[1], "goals": len(goals), "jlwki": _round(b[2])} for b in bases]}
+        starts: list[StartState] = []
+        per_base = max(1, math.ceil(start.samples / len(bases)))
+        for (base_pos, base_orn), _, _ in bases:
+            arm_kin.place(base_pos, base_orn)
+            for s in range(per_base):
+                noise = np.zeros(3) if s == 0 else rng.uniform(-start.noise_m, start.noise_m, 3)
+                goal = tuple(np.asarray(start.tool_position_m) + noise)
+                q = arm_kin.reach(goal, tool_orn, rng, tries=24)
+                if q is not None:
+                    starts.append(StartState(base_position=_round(base_pos), base_orientation=_round(base_orn), joints=_round(list(q)), tool_position=_round(goal)))
+        if not starts:
             raise _fail(rt, ("robot", "start", "tool_position_m"),
                         f"robot '{rt.robot_name}' cannot reach the start pose {tuple(start.tool_position_m)} (tool rpy {tuple(start.tool_rpy_deg)}°) without collision for person '{variant}'")
         m = measurements[variant]
@@ -390,10 +417,14 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, baked, movable, measureme
         randomize = {j: _round(tuple(math.radians(a) for a in person_spec.randomize_deg[j].uniform)) for j in movable if j in person_spec.randomize_deg}
         variants_out.append(PersonVariant(name=variant, body=f"person_{variant}", sex=m.sex, mass_kg=_round(m.mass_kg),
                                           standing_height_m=_round(m.standing_height_m), movable_joints=movable,
-                                          initial_angles=initial, randomize=randomize, target_offsets=offsets,
-                                          start_configurations=configs, start_tool_positions=reached))
+                                          initial_angles=initial, randomize=randomize, target_offsets=offsets, starts=starts))
         bodies.append(Body(name=f"person_{variant}", kind="person", urdf=rel(written[f"person_{variant}"]), position=person_pos[variant],
                            orientation=_round(person_orn), fixed_base=True, gravity=person_spec.gravity_mps2))
+    first = variants_out[0].starts[0]
+    base_pos, base_orn = first.base_position, first.base_orientation
+    arm_kin.place(base_pos, base_orn)
+    for i, q in zip(arm_kin.arm_idx, first.joints):
+        p.resetJointState(robot_id, i, q, physicsClientId=c)
 
     # 3c. Particles settle in their container at the nominal start pose ---------------------
     for name, ps in spec.particles.items():
@@ -401,7 +432,7 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, baked, movable, measureme
 
     bodies.insert(0, Body(name="robot", kind="robot", urdf=rel(written["robot"]), position=_round(base_pos), orientation=_round(base_orn),
                           fixed_base=True, gravity=spec.robot.gravity_mps2))
-    return _manifest(rt, bodies, variants_out, attachments, particle_sets, arm_joints, lower, upper, movable)
+    return _manifest(rt, bodies, variants_out, attachments, particle_sets, arm_joints, lower, upper, movable, placements)
 
 
 def _seat_links(rt: ResolvedTask) -> list[str]:
@@ -413,39 +444,150 @@ def _seat_links(rt: ResolvedTask) -> list[str]:
     return [child[j] for j in joints]
 
 
-def _solve_ik(pc, robot, ee_link, pos, orn, arm_idx, ik_cols, lower, upper, rng, tries: int = 40):
-    """Arm configuration reaching (pos, orn) within 1 cm and 3°, or None.
+def _seed(rt: ResolvedTask, variant: str) -> int:
+    """A deterministic seed per (task, robot, variant) for compile-time sampling."""
+    digest = hashlib.sha256(f"{rt.spec.name}/{rt.robot_name}/{variant}".encode()).digest()
+    return int.from_bytes(digest[:4], "little")
 
-    Null-space IK over every movable joint (limits, ranges, random rest poses after the first
-    try); deterministic for a given ``rng`` state.
-    """
-    p, c = pc.p, pc.client
-    movable = [j for j in range(p.getNumJoints(robot, physicsClientId=c)) if p.getJointInfo(robot, j, physicsClientId=c)[2] != p.JOINT_FIXED]
-    lo_all = [p.getJointInfo(robot, j, physicsClientId=c)[8] for j in movable]
-    hi_all = [p.getJointInfo(robot, j, physicsClientId=c)[9] for j in movable]
-    ranges = [max(h - l, 1e-3) for l, h in zip(lo_all, hi_all)]
-    current = [p.getJointState(robot, j, physicsClientId=c)[0] for j in movable]
-    for attempt in range(tries):
-        rest = list(current)
-        arm_rest = [0.5 * (l + u) for l, u in zip(lower, upper)] if attempt == 0 else list(rng.uniform(lower, upper))
-        for col, q in zip(ik_cols, arm_rest):
-            rest[col] = q
-        for j, q in zip(movable, rest):
-            p.resetJointState(robot, j, q, physicsClientId=c)
-        q = arm_rest
-        for _ in range(4):  # refine from the last solution
-            sol = p.calculateInverseKinematics(robot, ee_link, pos, orn, lowerLimits=lo_all, upperLimits=hi_all,
-                                               jointRanges=ranges, restPoses=rest, maxNumIterations=100,
-                                               residualThreshold=1e-6, physicsClientId=c)
-            q = [min(max(sol[k], l), u) for k, l, u in zip(ik_cols, lower, upper)]
-            for i, v in zip(arm_idx, q):
-                p.resetJointState(robot, i, v, physicsClientId=c)
-        got_pos, got_orn = pc.link_pose(robot, ee_link)
-        err = float(np.linalg.norm(np.subtract(got_pos, pos)))
-        dot = min(1.0, abs(float(np.dot(got_orn, orn))))
-        if err < 0.01 and 2 * math.acos(dot) < math.radians(3):
+
+def _yaw(orn) -> float:
+    x, y, z, w = orn
+    return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+
+
+def _describe_point(ref: dict) -> str:
+    return f"target '{ref['target']}'" if "target" in ref else f"{ref['body']}.{ref['link']}"
+
+
+def _point_world(pc, rt, ref, person_id, variant, furniture_ids, tool_ids) -> tuple[float, float, float]:
+    """World position of a normalised point reference in the compile-time scene."""
+    if "target" in ref:
+        target = rt.spec.targets[ref["target"]]
+        base = rt.points[ref["target"]]
+        offset = target.offset_by_variant.get(variant, target.offset_m)
+    else:
+        base, offset = ref, (0.0, 0.0, 0.0)
+    body = {"person": person_id} | furniture_ids | tool_ids
+    bid = body[base["body"]]
+    pos, orn = pc.link_pose(bid, pc.link_index(bid, base["link"]))
+    return tuple(pc.p.multiplyTransforms(pos, orn, tuple(offset), (0, 0, 0, 1))[0])
+
+
+class _ArmKinematics:
+    """IK, collision checks and JLWKI for one arm in the compile-time world."""
+
+    def __init__(self, pc, robot, ee_link, arm_idx, lower, upper, tool_from_ee, tool_ids, obstacles, rest):
+        p, c = pc.p, pc.client
+        self.pc, self.robot, self.ee_link, self.arm_idx = pc, robot, ee_link, arm_idx
+        self.lower, self.upper = lower, upper
+        self.tool_inv = tool_from_ee  # inverse grip: tool frame -> end-effector frame
+        self.tool_ids, self.obstacles = tool_ids, obstacles
+        self.person: int | None = None
+        self.rest = rest or [0.0] * len(arm_idx)
+        self.movable = [j for j in range(p.getNumJoints(robot, physicsClientId=c)) if p.getJointInfo(robot, j, physicsClientId=c)[2] != p.JOINT_FIXED]
+        self.lo_all = [p.getJointInfo(robot, j, physicsClientId=c)[8] for j in self.movable]
+        self.hi_all = [p.getJointInfo(robot, j, physicsClientId=c)[9] for j in self.movable]
+        self.ranges = [max(h - l, 1e-3) for l, h in zip(self.lo_all, self.hi_all)]
+        self.cols = [self.movable.index(i) for i in arm_idx]
+
+    def place(self, pos, orn) -> None:
+        self.pc.place(self.robot, pos, orn)
+
+    def set_arm(self, q) -> None:
+        for i, v in zip(self.arm_idx, q):
+            self.pc.p.resetJointState(self.robot, i, v, physicsClientId=self.pc.client)
+
+    def reach(self, tool_pos, tool_orn, rng, tries: int = 2, tool_may_touch: bool = False):
+        """Arm configuration putting the tool at ``tool_pos`` (with ``tool_orn`` unless None) within
+        1 cm (and 3°), the arm free of collisions with person and furniture, and the tool too unless
+        ``tool_may_touch`` (a goal at the mouth puts the spoon against the face); None if none found."""
+        p, c = self.pc.p, self.pc.client
+        orn = tool_orn if tool_orn is not None else (0, 0, 0, 1)
+        ee_pos, ee_orn = p.multiplyTransforms(tool_pos, orn, *self.tool_inv)
+        for attempt in range(tries):
+            arm_rest = list(self.rest) if attempt == 0 else list(rng.uniform(self.lower, self.upper))
+            rest = [p.getJointState(self.robot, j, physicsClientId=c)[0] for j in self.movable]
+            for col, q in zip(self.cols, arm_rest):
+                rest[col] = q
+            self.set_arm(arm_rest)
+            q = arm_rest
+            for _ in range(4):  # refine from the last solution
+                kwargs = dict(lowerLimits=self.lo_all, upperLimits=self.hi_all, jointRanges=self.ranges, restPoses=rest,
+                              maxNumIterations=100, residualThreshold=1e-6, physicsClientId=c)
+                sol = (p.calculateInverseKinematics(self.robot, self.ee_link, ee_pos, ee_orn, **kwargs) if tool_orn is not None
+                       else p.calculateInverseKinematics(self.robot, self.ee_link, ee_pos, **kwargs))
+                q = [min(max(sol[k], l), u) for k, l, u in zip(self.cols, self.lower, self.upper)]
+                self.set_arm(q)
+            got_pos, got_orn = self.pc.link_pose(self.robot, self.ee_link)
+            if np.linalg.norm(np.subtract(got_pos, ee_pos)) >= 0.01:
+                continue
+            if tool_orn is not None and 2 * math.acos(min(1.0, abs(float(np.dot(got_orn, ee_orn))))) >= math.radians(3):
+                continue
+            if self.collides(tool_pos, orn, check_tool=not tool_may_touch):
+                continue
             return q
-    return None
+        return None
+
+    def collides(self, tool_pos, tool_orn, check_tool: bool = True) -> bool:
+        touching = self.pc.touching
+        if any(touching(self.robot, o) for o in self.obstacles) or (self.person is not None and touching(self.robot, self.person)):
+            return True
+        for tid in self.tool_ids.values() if check_tool else ():
+            self.pc.place(tid, tool_pos, tool_orn)
+            if self.person is not None and touching(tid, self.person):
+                return True
+        return False
+
+    def jlwki(self, q) -> float:
+        """Joint-limit-weighted kinematic isotropy at ``q`` (facts §5: φ = 0.5, λ = 0.05)."""
+        p, c = self.pc.p, self.pc.client
+        all_q = [p.getJointState(self.robot, j, physicsClientId=c)[0] for j in self.movable]
+        zeros = [0.0] * len(self.movable)
+        lin, ang = p.calculateJacobian(self.robot, self.ee_link, [0, 0, 0], all_q, zeros, zeros, physicsClientId=c)
+        J = np.vstack([np.asarray(lin)[:, self.cols], np.asarray(ang)[:, self.cols]])
+        w = []
+        for qi, l, u in zip(q, self.lower, self.upper):
+            qr = (u - l) / 2
+            w.append(max(0.001, 1 - 0.5 ** ((qr - abs(qr - qi + l)) / (0.05 * qr) + 1)))
+        M = J @ np.diag(w) @ J.T
+        return float(max(np.linalg.det(M), 0.0) ** (1 / 6) / (np.trace(M) / 6))
+
+
+def _search_base(rt: ResolvedTask, arm: _ArmKinematics, goals, offset, rng):
+    """The paper's base-pose search, bounded: exactly ``attempts`` samples; the ``keep`` best by
+    (goals reached, Σ JLWKI), each reaching every required goal. Raises with the goal that no
+    sampled pose reached."""
+    search = rt.spec.robot.base_search
+    anchor = np.asarray(search.origin_m[:2]) + np.asarray(offset[:2])
+    z = rt.robot.part.base_height_m + (offset[2] if len(offset) > 2 else 0.0)
+    found = []
+    required_misses = np.zeros(len(goals), dtype=int)
+    for _ in range(search.attempts):
+        xy = anchor + [rng.uniform(*search.x_range_m), rng.uniform(*search.y_range_m)]
+        yaw = math.radians(search.yaw_deg + rng.uniform(-search.yaw_noise_deg, search.yaw_noise_deg))
+        pos, orn = (float(xy[0]), float(xy[1]), float(z)), _quat_from_rpy((0.0, 0.0, yaw))
+        arm.place(pos, orn)
+        arm.set_arm(arm.rest)
+        if any(arm.pc.touching(arm.robot, o) for o in arm.obstacles) or arm.pc.touching(arm.robot, arm.person):
+            continue
+        reached, score, ok = 0, 0.0, True
+        for k, (gpos, gorn, required, _name) in enumerate(goals):
+            q = arm.reach(gpos, gorn, rng, tries=2, tool_may_touch=k > 0)  # goal 0 is the start pose
+            if q is None:
+                if required:
+                    required_misses[k] += 1
+                    ok = False
+                    break
+                continue
+            reached += 1
+            score += arm.jlwki(q)
+        if ok:
+            found.append(((pos, orn), reached, score))
+    if not found:
+        worst = int(np.argmax(required_misses))
+        raise _fail(rt, ("robot", "base_search"), f"robot '{rt.robot_name}' reaches {goals[worst][3]} from none of {search.attempts} sampled base poses (set robot.per_robot.{rt.robot_name}.base_offset_m or widen base_search)")
+    found.sort(key=lambda f: (-f[1], -f[2]))
+    return found[: search.keep]
 
 
 def _settle_particles(rt, pc, name, ps, tool_ids, furniture_ids, start, tool_orn) -> ParticleSet:
@@ -453,7 +595,7 @@ def _settle_particles(rt, pc, name, ps, tool_ids, furniture_ids, start, tool_orn
     attach_ref = rt.points.get(ps.attach) or {}
     if ps.attach in tool_ids:
         holder = tool_ids[ps.attach]
-        p.resetBasePositionAndOrientation(holder, start.tool_position_m, tool_orn, physicsClientId=c)
+        pc.place(holder, start.tool_position_m, tool_orn)
         attach_link = rt.tools[ps.attach].part.base_link
     else:
         holder = furniture_ids[ps.attach]
@@ -505,7 +647,7 @@ def _inside_point(pc, body: int, link_name: str) -> tuple[float, float, float]:
     return tuple(pos)
 
 
-def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lower, upper, movable) -> Manifest:
+def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lower, upper, movable, placements) -> Manifest:
     spec = rt.spec
     robot_part = rt.robot.part
     gripper = robot_part.gripper.get(robot_part.arm_for(spec.robot.arm if spec.robot.arm != "both" else "right")[0])
@@ -545,7 +687,8 @@ def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lowe
                       impairments=[_impairment_json(ch) for ch in spec.person.impairments.choices]),
         robot=Robot(name=rt.robot_name, title=robot_part.title, arm_joints=arm_joints, joint_lower=_round(lower), joint_upper=_round(upper),
                     links=rt.robot_links, action_scale=spec.robot.control.action_scale_rad, position_gain=spec.robot.control.position_gain,
-                    max_force=spec.robot.control.max_force_nm, gripper_joints=list(gripper.joints) if gripper else [], gripper_position=grip_pos),
+                    max_force=spec.robot.control.max_force_nm, gripper_joints=list(gripper.joints) if gripper else [], gripper_position=grip_pos,
+                    placement=placements),
         tools=attachments, targets=targets, particles=particle_sets, joint_groups=rt.joint_groups | {"person.policy": {"body": "person", "group": "policy", "joints": _policy_joints(rt)}},
         observations={agent: [obs_use(t) for t in ts] for agent, ts in rt.observations.items()},
         reward=[TermUse(name=t.name, term=t.term, category=t.category, weight=t.weight, params=t.params) for t in rt.reward],

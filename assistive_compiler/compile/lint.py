@@ -157,7 +157,9 @@ class _Linter:
         template: str,
         base_dir: Path | None,
         require_collision: Callable[[str], bool] | None,
+        static_root: bool = False,
     ) -> None:
+        self.static_root = static_root
         self.template = template
         self.base_dir = base_dir
         self.require_collision = require_collision
@@ -185,6 +187,8 @@ class _Linter:
 
         links = root.findall("link")
         joints = root.findall("joint")
+        children = {c.get("link") for j in joints for c in j.findall("child")}
+        self.roots = {l.get("name") for l in links} - children
         for index, link in enumerate(links, start=1):
             self.lint_link(link, self.label("link", link, index))
         for index, joint in enumerate(joints, start=1):
@@ -220,7 +224,8 @@ class _Linter:
         for child in link:
             if child.tag not in ("visual", "collision"):
                 self.check_finite(child, owner)
-        self.lint_inertial(link, owner)
+        if not (self.static_root and link.get("name") in self.roots and len(self.roots) == 1):
+            self.lint_inertial(link, owner)
 
         visuals = link.findall("visual")
         collisions = link.findall("collision")
@@ -598,6 +603,7 @@ def lint_urdf(
     template: str,
     base_dir: Path | None = None,
     require_collision: Callable[[str], bool] | None = None,
+    static_root: bool = False,
 ) -> list[LintProblem]:
     """Check a rendered URDF document; return its problems in document order (empty = clean).
 
@@ -605,9 +611,12 @@ def lint_urdf(
     ``base_dir`` is the folder relative mesh filenames resolve against (the folder the URDF is
     written to; the current directory when None). ``require_collision(link_name)`` says which
     links must have a ``<collision>``; by default every link with a ``<visual>`` must.
-    A malformed document is reported as one problem.
+    A malformed document is reported as one problem. ``static_root``: the document will be loaded
+    with a fixed base, so its root link may be massless (a common convention in robot URDFs such as
+    pybullet_data's KUKA iiwa; a fixed base never moves, so its mass plays no part). Our own
+    templates are linted without it.
     """
-    return _Linter(template, base_dir, require_collision).run(urdf_xml)
+    return _Linter(template, base_dir, require_collision, static_root).run(urdf_xml)
 
 
 def pybullet_crash_risks(urdf_xml: str, *, template: str = "") -> list[LintProblem]:

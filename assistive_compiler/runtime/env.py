@@ -92,7 +92,6 @@ class AssistiveEnv(gym.Env):
         self.success_metric: float | None = None
         self._stepped = False
         self._person_names = person_names
-        self._robot_base = self.world.base_frame(robot)
 
     @classmethod
     def from_spec(cls, spec: str | Path, robot: str | None = None, out_dir: str | Path | None = None, **kwargs) -> "AssistiveEnv":
@@ -132,13 +131,15 @@ class AssistiveEnv(gym.Env):
         for name, offset in variant.target_offsets.items():
             if name in self.snap.target_offsets:
                 self.snap.target_offsets[name] = np.asarray(offset, dtype=float)
-        # Robot: one precomputed start configuration (no IK), gripper at its task position.
-        k = int(rng.integers(len(variant.start_configurations)))
-        q0 = variant.start_configurations[k]
+        # Robot: one precomputed start — base pose and arm configuration (no IK), gripper at its task position.
+        k = int(rng.integers(len(variant.starts)))
+        start = variant.starts[k]
+        w.set_base_frame(w.robot, start.base_position, start.base_orientation)
+        q0 = start.joints
         for i, q in zip(self.arm_idx, q0):
             pb.resetJointState(w.robot.id, i, q, physicsClientId=c)
         pb.setJointMotorControlArray(w.robot.id, self.arm_idx, pb.POSITION_CONTROL, targetPositions=q0,
-                                     positionGains=[m.robot.position_gain] * len(q0), forces=[m.robot.max_force] * len(q0), physicsClientId=c)
+                                     positionGains=self._gains, forces=self._forces, physicsClientId=c)
         if self.gripper_idx:
             for i in self.gripper_idx:
                 pb.resetJointState(w.robot.id, i, m.robot.gripper_position, physicsClientId=c)
@@ -165,7 +166,7 @@ class AssistiveEnv(gym.Env):
         self.snap.set_frame("robot_base", *w.base_frame(w.robot))
         self.snap.set_frame("person_base", *w.base_frame(person))
         self.snap.refresh()
-        return self._observe(), {"person_variant": variant.name, "start_configuration": k}
+        return self._observe(), {"person_variant": variant.name, "start": k}
 
     def step(self, action):
         m, w, c = self.manifest, self.world, self.world.client

@@ -298,10 +298,36 @@ class StartGoal(Strict):
     )
 
 
+class Goal(Strict):
+    """A pose the robot should be able to reach from its base: the tool (or, without a tool, the end
+    effector) at a point, optionally with the tool's start orientation."""
+
+    point: Ref = Field(description="Target or link the goal is at, e.g. mouth.")
+    offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Offset from that point, world frame, metres.")
+    oriented: bool = Field(False, description="Also reach the tool's start orientation (else position only).")
+    required: bool = Field(False, description="A base pose that cannot reach this goal is discarded.")
+
+
+class BaseSearch(Strict):
+    """Compile-time base-pose optimisation for robots standing on the floor (facts §5): sample base
+    poses, solve IK to each goal with collision checks, keep the poses that reach the most goals,
+    ties broken by joint-limit-weighted kinematic isotropy (JLWKI). The start pose is always a
+    required, oriented goal. Deterministic and bounded: exactly ``attempts`` samples."""
+
+    origin_m: Vec3 = Field((-0.85, -0.4, 0.0), description="Anchor of the sampling box in the world (x, y), m; z is ignored.")
+    x_range_m: tuple[float, float] = Field((-0.5, 0.0), description="Uniform x offset from the anchor, m.")
+    y_range_m: tuple[float, float] = Field((-0.5, 0.5), description="Uniform y offset from the anchor, m.")
+    yaw_deg: float = Field(0.0, ge=-360, le=360, description="Base yaw before noise, degrees.")
+    yaw_noise_deg: float = Field(30.0, ge=0, le=180, description="Half-width of the uniform yaw noise, degrees.")
+    attempts: int = Field(100, ge=1, le=5000, description="Base poses sampled (the paper: 100).")
+    keep: int = Field(4, ge=1, le=32, description="Best base poses stored in the artifact; reset() picks among them.")
+    goals: list[Goal] = Field(default_factory=list, description="Goals scored besides the start pose.")
+
+
 class PerRobot(Strict):
     """Task settings that differ per robot (the reference's per-task robot tables)."""
 
-    base_offset_m: Vec3 | None = Field(None, description="Base position offset from the mount or search origin, m.")
+    base_offset_m: Vec3 | None = Field(None, description="Base position offset from the mount or the search anchor, m (the reference's toc_base_pos_offset).")
 
 
 class RobotRole(Strict):
@@ -316,6 +342,7 @@ class RobotRole(Strict):
     gravity_mps2: float | None = Field(0.0, ge=-20, le=0, description="Gravity on the robot (0: compensated).")
     control: RobotControl = Field(default_factory=RobotControl, description="Arm control.")
     start: StartGoal = Field(description="Start pose of the end effector.")
+    base_search: BaseSearch = Field(default_factory=BaseSearch, description="Base placement of robots that are not mounted.")
     per_robot: dict[Name, PerRobot] = Field(default_factory=dict, description="Per-robot settings by robot name.")
 
     @model_validator(mode="after")

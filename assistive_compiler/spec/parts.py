@@ -55,7 +55,11 @@ class RobotPart(Strict):
     name: Name = Field(description="Robot name used on the command line and in Gymnasium ids.")
     title: str = Field(description="Display name, e.g. 'Jaco' (used in ids: FeedingJaco-v1).")
     template: Template | None = Field(None, description="Our xacro template (or give urdf).")
-    urdf: str | None = Field(None, description="A URDF file on disk instead of a template (bring your own robot).")
+    urdf: str | None = Field(
+        None,
+        description="A URDF instead of a template (bring your own robot): a path relative to this file, "
+        "or 'python-package:<package>/<path>' for one shipped inside an installed package (e.g. pybullet_data).",
+    )
     base_link: str = Field(description="URDF root link.")
     arms: dict[Literal["right", "left"], Arm] = Field(
         min_length=1, description="Arms by side; a single-arm robot lists one and uses it for either side."
