@@ -101,7 +101,7 @@ class Robot(_Model):
     position_gain: float = Field(description="Arm position gain.")
     max_force: float = Field(description="Arm force limit, N·m.")
     gripper_joints: list[str] = Field(description="Gripper joints, held at gripper_position.")
-    gripper_position: float = Field(description="Gripper joint target (rad or m).")
+    gripper_position: list[float] = Field(description="Target of each gripper joint (rad or m).")
     placement: dict[str, Any] = Field(default_factory=dict, description="How the base was placed: mount, or the search's kept poses with goals reached and JLWKI.")
 
 

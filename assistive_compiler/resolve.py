@@ -114,9 +114,10 @@ class _Resolver:
         furniture = {n: p for n, use in spec.scene.furniture.items() if (p := self.part("furniture", use.part, ("scene", "furniture", n, "part"), "furniture part"))}
         tools = {n: p for n, use in spec.tools.items() if (p := self.part("tools", use.part, ("tools", n, "part"), "tool"))}
         people = {n: p for i, n in enumerate(spec.person.variants) if (p := self.part("people", n, ("person", "variants", i), "person"))}
-        for name in spec.robot.per_robot:
-            if name not in spec.robot.supported:
-                self.problem(("robot", "per_robot", name), f"per_robot names '{name}', which is not in supported {spec.robot.supported}{did_you_mean(name, spec.robot.supported)}", key=True)
+        known = self.lib.names("robots")
+        for name in spec.robot.per_robot:  # may name robots a spec extending this one supports
+            if name not in known:
+                self.problem(("robot", "per_robot", name), f"per_robot names unknown robot '{name}'; expected one of {one_of(known)}{did_you_mean(name, known)}", key=True)
         if self.problems or robot is None or not people:
             raise SpecError(self.problems)
 

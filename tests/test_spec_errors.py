@@ -15,14 +15,18 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+import yaml
 
 from assistive_compiler.cli import main
+from assistive_compiler.errors import one_of
 from assistive_compiler.paths import display
 from assistive_compiler.spec.load import load_spec
 from assistive_compiler.yamlsrc import loads_located
 
 REPO = Path(__file__).resolve().parents[1]
 FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
+SUPPORTED = yaml.safe_load(FEEDING.read_text())["robot"]["supported"]  # the shipped spec's robots, in order
+ROBOTS = ", ".join(SUPPORTED)
 EXTENDS = f"extends: {FEEDING}\n"
 
 # The food reward term, for specs that replace the reward list (lists are replaced, not merged)
@@ -85,14 +89,14 @@ def test_feeding_validates(capsys, monkeypatch):
     monkeypatch.chdir(REPO)
     rc, out, err = run_cli(capsys, "validate", "specs/tasks/feeding.yaml")
     assert (rc, err) == (0, "")
-    assert out == "specs/tasks/feeding.yaml: ok (task 'feeding', robots: jaco)\n"
+    assert out == f"specs/tasks/feeding.yaml: ok (task 'feeding', robots: {ROBOTS})\n"
 
 
 def test_extending_spec_without_changes_validates(tmp_path, capsys):
     path = write(tmp_path, EXTENDS)
     rc, out, err = run_cli(capsys, "validate", str(path))
     assert (rc, err) == (0, "")
-    assert out == f"{path}: ok (task 'feeding', robots: jaco)\n"
+    assert out == f"{path}: ok (task 'feeding', robots: {ROBOTS})\n"
 
 
 def test_on_key_stays_a_name(tmp_path, capsys):
@@ -104,7 +108,7 @@ def test_on_key_stays_a_name(tmp_path, capsys):
     path = write(tmp_path, text)
     rc, out, err = run_cli(capsys, "validate", str(path))
     assert (rc, err) == (0, "")
-    assert out == f"{path}: ok (task 'feeding', robots: jaco)\n"
+    assert out == f"{path}: ok (task 'feeding', robots: {ROBOTS})\n"
     params = load_spec(path).data["preferences"]["active"]["force_nontarget"]["params"]
     assert params == {"on": ["person"], "by": ["robot"]}
 
@@ -296,7 +300,7 @@ def test_unknown_robot_on_command_line(tmp_path, capsys):
     assert (rc, out) == (2, "")
     # The robot is not written in the spec; the message points at the task's default robot.
     assert err.splitlines() == [
-        f"{feeding_location('default: jaco', len('default: '))}: robot 'jacco' is not supported by task 'feeding'; supported: 'jaco' (did you mean 'jaco'?)"
+        f"{feeding_location('default: jaco', len('default: '))}: robot 'jacco' is not supported by task 'feeding'; supported: {one_of(SUPPORTED)} (did you mean 'jaco'?)"
     ]
     assert not out_dir.exists()
 
@@ -317,7 +321,7 @@ def test_default_robot_not_supported(tmp_path, capsys):
     lines = problems(capsys, path)
     assert len(lines) == 1
     assert lines[0].startswith(f"{display(path)}:{at(text, 'jacco')}: ")
-    assert lines[0].endswith("default robot 'jacco' is not in supported ['jaco'] (did you mean 'jaco'?)")
+    assert lines[0].endswith(f"default robot 'jacco' is not in supported {SUPPORTED} (did you mean 'jaco'?)")
 
 
 def test_default_robot_not_supported_message(tmp_path, capsys):
@@ -325,7 +329,7 @@ def test_default_robot_not_supported_message(tmp_path, capsys):
     text = EXTENDS + "robot:\n  default: jacco\n"
     path = write(tmp_path, text)
     [line] = problems(capsys, path)
-    assert line.endswith(": robot.default: default robot 'jacco' is not in supported ['jaco'] (did you mean 'jaco'?)")
+    assert line.endswith(f": robot.default: default robot 'jacco' is not in supported {SUPPORTED} (did you mean 'jaco'?)")
 
 
 def test_unknown_tool_part(tmp_path, capsys):
@@ -530,5 +534,5 @@ def test_validate_reports_every_file(tmp_path, capsys):
     rc, out, err = run_cli(capsys, "validate", str(bad), str(good))
     assert rc == 2
     assert "Traceback" not in out + err
-    assert out == f"{good}: ok (task 'feeding', robots: jaco)\n"
+    assert out == f"{good}: ok (task 'feeding', robots: {ROBOTS})\n"
     assert err == f"{display(bad)}:3:15: sim.frame_skip: must be a valid integer, unable to parse string as an integer, got 'five'\n"

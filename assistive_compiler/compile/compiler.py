@@ -653,6 +653,10 @@ def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lowe
     gripper = robot_part.gripper.get(robot_part.arm_for(spec.robot.arm if spec.robot.arm != "both" else "right")[0])
     tool_part = rt.tools[next(iter(spec.tools))].part.name if spec.tools else "none"
     grip_pos = gripper.positions.get(tool_part, gripper.positions.get("none", 0.0)) if gripper else 0.0
+    n_fingers = len(gripper.joints) if gripper else 0
+    grip_pos = [float(v) for v in grip_pos] if isinstance(grip_pos, list) else [float(grip_pos)] * n_fingers
+    if len(grip_pos) != n_fingers:
+        raise _fail(rt, ("tools",), f"robot '{rt.robot_name}' gives {len(grip_pos)} finger positions for '{tool_part}' but has {n_fingers} finger joints")
     sizes = {name: len(g["joints"]) for name, g in rt.joint_groups.items()} | {"person.policy": len(_policy_joints(rt))}
     ctx = SizeContext(sizes)
     obs_defs = terms("observation")

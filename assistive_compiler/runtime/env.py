@@ -141,9 +141,9 @@ class AssistiveEnv(gym.Env):
         pb.setJointMotorControlArray(w.robot.id, self.arm_idx, pb.POSITION_CONTROL, targetPositions=q0,
                                      positionGains=self._gains, forces=self._forces, physicsClientId=c)
         if self.gripper_idx:
-            for i in self.gripper_idx:
-                pb.resetJointState(w.robot.id, i, m.robot.gripper_position, physicsClientId=c)
-            pb.setJointMotorControlArray(w.robot.id, self.gripper_idx, pb.POSITION_CONTROL, targetPositions=[m.robot.gripper_position] * len(self.gripper_idx),
+            for i, q in zip(self.gripper_idx, m.robot.gripper_position):
+                pb.resetJointState(w.robot.id, i, q, physicsClientId=c)
+            pb.setJointMotorControlArray(w.robot.id, self.gripper_idx, pb.POSITION_CONTROL, targetPositions=m.robot.gripper_position,
                                          positionGains=[0.05] * len(self.gripper_idx), forces=[500.0] * len(self.gripper_idx), physicsClientId=c)
         # Tools follow the hand exactly.
         for att in m.tools:

@@ -37,8 +37,10 @@ class Gripper(Strict):
     """Gripper joints; their position is set per held tool."""
 
     joints: list[str] = Field(default_factory=list, description="Finger joints (URDF names).")
-    positions: dict[Name, float] = Field(
-        default_factory=dict, description="Finger position per tool part held (radians or metres); 'none' = no tool."
+    positions: dict[Name, float | list[float]] = Field(
+        default_factory=dict,
+        description="Finger position per tool part held ('none' = no tool), radians or metres: one value for "
+        "every finger joint, or one per joint in the order of joints (fingers that open in opposite directions).",
     )
 
 
