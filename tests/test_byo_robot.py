@@ -73,3 +73,22 @@ def test_unreachable_goals_fail_naming_robot_and_goal(tmp_path):
     [problem] = info.value.problems
     assert problem.message.startswith("robot 'kuka_iiwa' reaches the start pose from none of 10 sampled base poses")
     assert not (tmp_path / "out").exists()
+
+
+def test_robot_control_defaults_apply_unless_the_task_sets_them(tmp_path):
+    lib_dir = tmp_path / "lib" / "robots"
+    lib_dir.mkdir(parents=True)
+    part = (DATA / "specs" / "robots" / "kuka_iiwa.yaml").read_text()
+    (lib_dir / "kuka_iiwa.yaml").write_text(part + "control: {position_gain: 0.04, max_force_nm: 7.5}\n")
+    library = Library([tmp_path / "lib", specs_dir()])
+    own = compile_task(task(tmp_path), "kuka_iiwa", tmp_path / "a", library=library).manifest.robot
+    assert (own.position_gain, own.max_force) == (0.025, 1.0)  # feeding sets both explicitly: the task wins
+    control_line = "  control: {action_scale_rad: 0.05, position_gain: 0.025, max_force_nm: 1.0}\n"
+    text = FEEDING.read_text()
+    assert control_line in text
+    text = text.replace(control_line, "").replace("supported: [", "supported: [kuka_iiwa, ")
+    text = text.replace("  per_robot:", "  per_robot:\n    kuka_iiwa: {base_offset_m: [0.3, 0.1, 0.0]}")
+    loose = tmp_path / "loose.yaml"
+    loose.write_text(text)  # Feeding without its control line: the robot's defaults apply
+    robot = compile_task(loose, "kuka_iiwa", tmp_path / "b", library=library).manifest.robot
+    assert (robot.position_gain, robot.max_force) == (0.04, 7.5)

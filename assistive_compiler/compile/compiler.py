@@ -657,6 +657,12 @@ def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lowe
     grip_pos = [float(v) for v in grip_pos] if isinstance(grip_pos, list) else [float(grip_pos)] * n_fingers
     if len(grip_pos) != n_fingers:
         raise _fail(rt, ("tools",), f"robot '{rt.robot_name}' gives {len(grip_pos)} finger positions for '{tool_part}' but has {n_fingers} finger joints")
+    control = spec.robot.control
+    chosen = {field: getattr(control, field) for field in ("position_gain", "max_force_nm")}
+    for field in chosen:  # the task's explicit value, else the robot's default, else the spec default
+        own = getattr(robot_part.control, field)
+        if field not in control.model_fields_set and own is not None:
+            chosen[field] = own
     sizes = {name: len(g["joints"]) for name, g in rt.joint_groups.items()} | {"person.policy": len(_policy_joints(rt))}
     ctx = SizeContext(sizes)
     obs_defs = terms("observation")
@@ -690,8 +696,8 @@ def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lowe
                       compliant_gain=compliant.position_gain if compliant else 0.0, compliant_force=compliant.max_force_nm if compliant else 0.0,
                       impairments=[_impairment_json(ch) for ch in spec.person.impairments.choices]),
         robot=Robot(name=rt.robot_name, title=robot_part.title, arm_joints=arm_joints, joint_lower=_round(lower), joint_upper=_round(upper),
-                    links=rt.robot_links, action_scale=spec.robot.control.action_scale_rad, position_gain=spec.robot.control.position_gain,
-                    max_force=spec.robot.control.max_force_nm, gripper_joints=list(gripper.joints) if gripper else [], gripper_position=grip_pos,
+                    links=rt.robot_links, action_scale=control.action_scale_rad, position_gain=chosen["position_gain"],
+                    max_force=chosen["max_force_nm"], gripper_joints=list(gripper.joints) if gripper else [], gripper_position=grip_pos,
                     placement=placements),
         tools=attachments, targets=targets, particles=particle_sets, joint_groups=rt.joint_groups | {"person.policy": {"body": "person", "group": "policy", "joints": _policy_joints(rt)}},
         observations={agent: [obs_use(t) for t in ts] for agent, ts in rt.observations.items()},

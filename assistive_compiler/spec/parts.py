@@ -51,6 +51,13 @@ class ToolGrip(Strict):
     rpy_rad: Vec3 = Field((0.0, 0.0, 0.0), description="Tool frame orientation in the tool-mount frame, radians.")
 
 
+class RobotControlDefaults(Strict):
+    """The robot's own control defaults; a task's ``robot.control`` values, where it sets them, win."""
+
+    position_gain: float | None = Field(None, gt=0, le=1, description="Arm position gain.")
+    max_force_nm: float | None = Field(None, gt=0, description="Arm motor force limit, N·m.")
+
+
 class RobotPart(Strict):
     """A robot in the library."""
 
@@ -69,6 +76,7 @@ class RobotPart(Strict):
     gripper: dict[Literal["right", "left"], Gripper] = Field(default_factory=dict, description="Grippers by side.")
     grips: dict[Name, ToolGrip] = Field(default_factory=dict, description="Tool attachment per tool part.")
     mountable: bool = Field(False, description="Mounted on furniture (e.g. Jaco on a wheelchair) when a task offers it.")
+    control: RobotControlDefaults = Field(default_factory=RobotControlDefaults, description="Control defaults for tasks that do not set them.")
     base_height_m: float = Field(0.0, ge=0, description="Height of the base link above the floor when on the floor.")
 
     @model_validator(mode="after")
