@@ -22,18 +22,16 @@ The issue's tolerance is 3 mm; the achieved error is below 1e-6 m.
 
 from __future__ import annotations
 
-import ctypes
 import math
-import os
 import subprocess
 import sys
-import tempfile
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 import pybullet as pb
 import pytest
+
+from assistive_compiler.compile.external_checks import captured_c_output
 import xacro
 import yourdfpy
 
@@ -182,32 +180,6 @@ def render(path: Path, **args) -> str:
     return xacro.process_file(str(path), mappings={k: str(v) for k, v in args.items()}).toprettyxml(indent="  ")
 
 
-_libc = ctypes.CDLL(None)
-
-
-@contextmanager
-def captured_c_output():
-    """Redirect fd 1 and 2 (where Bullet's C code prints) into a temp file; yields a list that
-    receives the captured text on exit."""
-    result: list[str] = []
-    sys.stdout.flush()
-    sys.stderr.flush()
-    with tempfile.TemporaryFile(mode="w+b") as tmp:
-        saved = [os.dup(1), os.dup(2)]
-        try:
-            os.dup2(tmp.fileno(), 1)
-            os.dup2(tmp.fileno(), 2)
-            yield result
-        finally:
-            _libc.fflush(None)
-            sys.stdout.flush()
-            sys.stderr.flush()
-            os.dup2(saved[0], 1)
-            os.dup2(saved[1], 2)
-            os.close(saved[0])
-            os.close(saved[1])
-            tmp.seek(0)
-            result.append(tmp.read().decode(errors="replace"))
 
 
 def indices(cid: int, body: int) -> tuple[dict[str, int], dict[str, int]]:

@@ -12,18 +12,16 @@ reference's tucked pose, which puts the right tool frame at (0.1179, -0.6055, 0.
 
 from __future__ import annotations
 
-import ctypes
 import math
-import os
 import subprocess
 import sys
-import tempfile
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 import pybullet as pb
 import pytest
+
+from assistive_compiler.compile.external_checks import captured_c_output
 import xacro
 import yourdfpy
 
@@ -175,29 +173,6 @@ def facts_tool(s: str, q) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------- fixtures
-_libc = ctypes.CDLL(None)
-
-
-@contextmanager
-def captured_c_output():
-    """Capture what Bullet's C code prints on fd 1 and 2."""
-    result: list[str] = []
-    sys.stdout.flush()
-    sys.stderr.flush()
-    with tempfile.TemporaryFile(mode="w+b") as tmp:
-        saved = [os.dup(1), os.dup(2)]
-        try:
-            os.dup2(tmp.fileno(), 1)
-            os.dup2(tmp.fileno(), 2)
-            yield result
-        finally:
-            _libc.fflush(None)
-            os.dup2(saved[0], 1)
-            os.dup2(saved[1], 2)
-            os.close(saved[0])
-            os.close(saved[1])
-            tmp.seek(0)
-            result.append(tmp.read().decode(errors="replace"))
 
 
 @pytest.fixture(scope="module")

@@ -23,7 +23,6 @@ import numpy as np
 import pybullet as pb
 import pytest
 
-from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.runtime.env import AssistiveEnv
 
 REPO = Path(__file__).resolve().parents[1]
@@ -32,21 +31,6 @@ SPEC = REPO / "specs" / "tasks" / "feeding.yaml"
 
 # ---------------------------------------------------------------------------------------------
 # fixtures and helpers
-
-
-@pytest.fixture(scope="session")
-def artifact(tmp_path_factory) -> Path:
-    """Feeding compiled for Jaco, once per session (shared path: the other module hits the cache)."""
-    out = tmp_path_factory.getbasetemp() / "feeding-artifact" / "feeding-jaco"
-    return compile_task(SPEC, "jaco", out).out_dir
-
-
-@pytest.fixture(scope="module")
-def env(artifact):
-    """One env shared by the tests that only reset and step it."""
-    e = AssistiveEnv(artifact)
-    yield e
-    e.close()
 
 
 @pytest.fixture

@@ -20,18 +20,16 @@ Relation between the URDF and the DH table (worked out for this test):
 
 from __future__ import annotations
 
-import ctypes
 import math
-import os
 import subprocess
 import sys
-import tempfile
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 import pybullet as pb
 import pytest
+
+from assistive_compiler.compile.external_checks import captured_c_output
 import xacro
 import yourdfpy
 
@@ -149,32 +147,6 @@ def dh_fk(q, d) -> np.ndarray:
     return t @ fix
 
 
-_libc = ctypes.CDLL(None)
-
-
-@contextmanager
-def captured_c_output():
-    """Redirect fd 1 and 2 (where Bullet's C code prints) into a temp file; yields a list that
-    receives the captured text on exit."""
-    result: list[str] = []
-    sys.stdout.flush()
-    sys.stderr.flush()
-    with tempfile.TemporaryFile(mode="w+b") as tmp:
-        saved = [os.dup(1), os.dup(2)]
-        try:
-            os.dup2(tmp.fileno(), 1)
-            os.dup2(tmp.fileno(), 2)
-            yield result
-        finally:
-            _libc.fflush(None)
-            sys.stdout.flush()
-            sys.stderr.flush()
-            os.dup2(saved[0], 1)
-            os.dup2(saved[1], 2)
-            os.close(saved[0])
-            os.close(saved[1])
-            tmp.seek(0)
-            result.append(tmp.read().decode(errors="replace"))
 
 
 def random_configs(n=30, seed=0):

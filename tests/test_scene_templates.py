@@ -5,19 +5,17 @@ Real xacro, PyBullet and check_urdf; no mocks."""
 
 from __future__ import annotations
 
-import ctypes
 import math
-import os
 import subprocess
 import sys
-import tempfile
 import xml.etree.ElementTree as ET
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 import pybullet as pb
 import pytest
+
+from assistive_compiler.compile.external_checks import captured_c_output
 import xacro
 import yourdfpy
 
@@ -62,32 +60,6 @@ def render(template: str, out_dir: Path, **args) -> Path:
     return path
 
 
-_libc = ctypes.CDLL(None)
-
-
-@contextmanager
-def captured_c_output():
-    """Redirect the process's fd 1 and fd 2 (where Bullet's C code prints) into a temp file.
-    Yields a list that receives the captured text on exit."""
-    result: list[str] = []
-    sys.stdout.flush()
-    sys.stderr.flush()
-    with tempfile.TemporaryFile(mode="w+b") as tmp:
-        saved = [os.dup(1), os.dup(2)]
-        try:
-            os.dup2(tmp.fileno(), 1)
-            os.dup2(tmp.fileno(), 2)
-            yield result
-        finally:
-            _libc.fflush(None)
-            sys.stdout.flush()
-            sys.stderr.flush()
-            os.dup2(saved[0], 1)
-            os.dup2(saved[1], 2)
-            os.close(saved[0])
-            os.close(saved[1])
-            tmp.seek(0)
-            result.append(tmp.read().decode(errors="replace"))
 
 
 def load_quiet(cid: int, path: Path, pos=(0, 0, 0), orn=(0, 0, 0, 1), fixed=True, flags=0):

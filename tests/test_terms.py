@@ -22,8 +22,7 @@ import pybullet as pb
 import pytest
 
 from assistive_compiler.artifact import TermUse
-from assistive_compiler.compile.compiler import compile_task
-from assistive_compiler.runtime.env import AssistiveEnv, bind_term
+from assistive_compiler.runtime.env import bind_term
 from assistive_compiler.runtime.snapshot import ParticleEvents, Snapshot
 from assistive_compiler.terms.registry import terms
 
@@ -40,20 +39,6 @@ MOUTH_OFFSET = (0.0, -0.11, 0.03)
 
 # ---------------------------------------------------------------------------------------------
 # fixtures and helpers
-
-
-@pytest.fixture(scope="session")
-def artifact(tmp_path_factory) -> Path:
-    """Feeding compiled for Jaco, once per session (shared path: the other module hits the cache)."""
-    out = tmp_path_factory.getbasetemp() / "feeding-artifact" / "feeding-jaco"
-    return compile_task(SPEC, "jaco", out).out_dir
-
-
-@pytest.fixture(scope="module")
-def env(artifact):
-    e = AssistiveEnv(artifact)
-    yield e
-    e.close()
 
 
 @pytest.fixture
@@ -353,7 +338,7 @@ def test_bind_term_replaces_references_with_handles(snap):
 
 def test_reward_is_the_weighted_sum_on_a_constructed_state(env):
     env.reset(seed=0)
-    snap, c = env.snap, env.world.client
+    snap = env.snap
     # nothing touches the person after a reset
     for body in ("robot", "spoon"):
         assert not contacts(env, body, "person")

@@ -55,7 +55,7 @@ from ..spec.models import Uniform, scalar_bounds
 from ..terms.registry import SizeContext, terms
 from .lint import lint_urdf
 from .merge import merge_fixed_links
-from .render import render_template, urdf_info
+from .render import render_template
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 
@@ -592,7 +592,6 @@ def _search_base(rt: ResolvedTask, arm: _ArmKinematics, goals, offset, rng):
 
 def _settle_particles(rt, pc, name, ps, tool_ids, furniture_ids, start, tool_orn) -> ParticleSet:
     p, c = pc.p, pc.client
-    attach_ref = rt.points.get(ps.attach) or {}
     if ps.attach in tool_ids:
         holder = tool_ids[ps.attach]
         pc.place(holder, start.tool_position_m, tool_orn)

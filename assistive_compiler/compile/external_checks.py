@@ -13,6 +13,7 @@ Heavy libraries (yourdfpy, pybullet) are imported inside the functions that use 
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import logging
 import os
@@ -22,6 +23,7 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+from typing import Iterator
 
 __all__ = [
     "check_with_urdfdom",
@@ -135,6 +137,39 @@ def _describe(err: BaseException) -> str:
     return text if text.startswith(name) else f"{name}: {text}"
 
 
+@contextlib.contextmanager
+def captured_c_output() -> Iterator[list[str]]:
+    """Capture what C code prints to fd 1 and fd 2 (Bullet prints its warnings there, past
+    Python's sys.stdout). Yields a list that holds the captured text once the block exits; the
+    descriptors are restored even on exceptions. fd 1/2 are process-wide: don't overlap it with
+    other threads' output."""
+    result: list[str] = []
+    sys.stdout.flush()
+    sys.stderr.flush()
+    _c_fflush()
+    with tempfile.TemporaryFile(mode="w+b") as capture:
+        saved_out = os.dup(1)
+        try:
+            saved_err = os.dup(2)
+        except OSError:
+            os.close(saved_out)
+            raise
+        try:
+            os.dup2(capture.fileno(), 1)
+            os.dup2(capture.fileno(), 2)
+            yield result
+        finally:
+            _c_fflush()
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os.dup2(saved_out, 1)
+            os.dup2(saved_err, 2)
+            os.close(saved_out)
+            os.close(saved_err)
+            capture.seek(0)
+            result.append(capture.read().decode("utf-8", errors="replace"))
+
+
 def _c_fflush() -> None:
     """Flush C stdio buffers, so that text the C library printed reaches its fd now."""
     try:
@@ -201,40 +236,19 @@ def pybullet_load_warnings(
             f"{problem.element}: {problem.message}"
             for problem in risks
         ]
-    sys.stdout.flush()
-    sys.stderr.flush()
-    _c_fflush()
     load_failure: str | None = None
-    with tempfile.TemporaryFile(mode="w+b") as capture:
-        saved_out = os.dup(1)
-        try:
-            saved_err = os.dup(2)
-        except OSError:
-            os.close(saved_out)
-            raise
-        try:
-            os.dup2(capture.fileno(), 1)
-            os.dup2(capture.fileno(), 2)
-            client = pybullet.connect(pybullet.DIRECT)
-            if client < 0:
-                load_failure = "pybullet.connect(DIRECT) failed"
-            else:
-                try:
-                    pybullet.loadURDF(
-                        str(file), useFixedBase=use_fixed_base, physicsClientId=client
-                    )
-                except pybullet.error as exc:
-                    load_failure = f"loadURDF failed: {exc}"
-                finally:
-                    pybullet.disconnect(physicsClientId=client)
-        finally:
-            _c_fflush()
-            os.dup2(saved_out, 1)
-            os.dup2(saved_err, 2)
-            os.close(saved_out)
-            os.close(saved_err)
-        capture.seek(0)
-        text = capture.read().decode("utf-8", errors="replace")
+    with captured_c_output() as printed:
+        client = pybullet.connect(pybullet.DIRECT)
+        if client < 0:
+            load_failure = "pybullet.connect(DIRECT) failed"
+        else:
+            try:
+                pybullet.loadURDF(str(file), useFixedBase=use_fixed_base, physicsClientId=client)
+            except pybullet.error as exc:
+                load_failure = f"loadURDF failed: {exc}"
+            finally:
+                pybullet.disconnect(physicsClientId=client)
+    text = printed[0]
     lines = _warning_lines(text)
     if load_failure is not None:
         lines.append(load_failure)
