@@ -18,6 +18,7 @@ import yaml
 
 from assistive_compiler.cli import main
 from assistive_compiler.errors import one_of
+from assistive_compiler.library import Library
 from assistive_compiler.paths import display
 from assistive_compiler.spec.load import load_spec
 from assistive_compiler.yamlsrc import loads_located
@@ -26,6 +27,7 @@ REPO = Path(__file__).resolve().parents[1]
 FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
 SUPPORTED = yaml.safe_load(FEEDING.read_text())["robot"]["supported"]  # the shipped spec's robots, in order
 ROBOTS = ", ".join(SUPPORTED)
+FURNITURE_PARTS = one_of(Library().names("furniture"))  # the library's furniture, as messages list it
 EXTENDS = f"extends: {FEEDING}\n"
 
 # The food reward term, for specs that replace the reward list (lists are replaced, not merged)
@@ -343,7 +345,7 @@ def test_unknown_furniture_part(tmp_path, capsys):
     check(
         capsys,
         path,
-        f"{at(text, 'table_tal')}: unknown furniture part 'table_tal'; expected one of 'bowl', 'table_tall', 'wheelchair' (did you mean 'table_tall'?)",
+        f"{at(text, 'table_tal')}: unknown furniture part 'table_tal'; expected one of {FURNITURE_PARTS} (did you mean 'table_tall'?)",
     )
 
 
@@ -522,7 +524,7 @@ def test_several_part_problems_all_reported(tmp_path, capsys):
         capsys,
         path,
         f"{at(text, 'spon}')}: unknown tool 'spon'; expected one of 'spoon' (did you mean 'spoon'?)",
-        f"{at(text, 'table_tal')}: unknown furniture part 'table_tal'; expected one of 'bowl', 'table_tall', 'wheelchair' (did you mean 'table_tall'?)",
+        f"{at(text, 'table_tal')}: unknown furniture part 'table_tal'; expected one of {FURNITURE_PARTS} (did you mean 'table_tall'?)",
     )
 
 
