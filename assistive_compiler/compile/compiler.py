@@ -83,14 +83,18 @@ def _sha(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def input_hash(rt: ResolvedTask) -> str:
-    """sha256 over every input that can change the output: spec files, part files, all templates,
-    the compiler's own source, and the robot chosen."""
-    h = hashlib.sha256(f"assistive-compiler {__version__} robot={rt.robot_name}\n".encode())
-    files = list(rt.loaded.files) + [rt.robot.path] + [p.path for p in (*rt.tools.values(), *rt.furniture.values(), *rt.people.values())]
+def input_hash(loaded: LoadedSpec, robot: str, library: Library) -> str:
+    """sha256 over every input that can change the output, known before resolving: the spec files,
+    every part file of the library, every template (ours and those beside user libraries), the
+    compiler's own source, and the robot. Conservative — editing any part invalidates every
+    artifact — so a cache hit never needs resolution."""
+    h = hashlib.sha256(f"assistive-compiler {__version__} robot={robot}\n".encode())
+    files = list(loaded.files)
+    for root in library.roots:
+        files += sorted(root.rglob("*.yaml")) + sorted((root.parent / "templates").rglob("*.xacro"))
     files += sorted(templates_dir().rglob("*.xacro")) + sorted(PACKAGE_DIR.rglob("*.py"))
     for path in files:
-        h.update(str(path.name).encode() + b"\0" + Path(path).read_bytes() + b"\0")
+        h.update(str(path).encode() + b"\0" + Path(path).read_bytes() + b"\0")
     return h.hexdigest()
 
 
@@ -734,9 +738,9 @@ def compile_task(
     t0 = time.perf_counter()
     loaded: LoadedSpec = load_spec(spec_path)
     library = library or Library()
-    rt = resolve(loaded, robot, library)
-    out = Path(out_dir) if out_dir else default_out_dir(loaded.spec.name, rt.robot_name)
-    ihash = input_hash(rt)
+    robot = robot or loaded.spec.robot.default
+    out = Path(out_dir) if out_dir else default_out_dir(loaded.spec.name, robot)
+    ihash = input_hash(loaded, robot, library)
     manifest_path = out / "manifest.json"
     if not force and manifest_path.is_file():
         try:
@@ -746,6 +750,7 @@ def compile_task(
         if existing is not None and existing.input_hash == ihash and all((out / b.urdf).is_file() for b in existing.bodies):
             return CompileResult(out, existing, True, time.perf_counter() - t0)
 
+    rt = resolve(loaded, robot, library)
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=out.parent))
     umask = os.umask(0)
