@@ -252,6 +252,61 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 
 # --------------------------------------------------------------------------------------------
+# render-person: the person variants a spec declares, side by side
+
+
+def render_people(artifact_dir: Path, width: int = 360, height: int = 480) -> np.ndarray:
+    """One frontal picture per person variant of an artifact (in the task's posture, on its seat),
+    side by side and labelled with name, sex, mass and standing height."""
+    import pybullet as pb
+    from PIL import Image, ImageDraw
+
+    from .runtime.world import PARK, World
+
+    world = World(artifact_dir)
+    m, c = world.m, world.client
+    world.set_base_frame(world.robot, (PARK[0], PARK[1] - 20, PARK[2]), (0, 0, 0, 1))  # the robot is not the subject
+    for att in m.tools:
+        world.set_base_frame(world.bodies[att.body], (PARK[0], PARK[1] - 25, PARK[2]), (0, 0, 0, 1))
+    seat_xy = np.asarray(m.body(m.person.variants[0].body).position[:2])
+    for k, body in enumerate(b for b in m.bodies if b.kind == "furniture"):
+        if np.linalg.norm(np.asarray(body.position[:2]) - seat_xy) > 0.5:  # keep only what they sit on
+            world.set_base_frame(world.bodies[body.name], (PARK[0], PARK[1] - 30 - 5 * k, PARK[2]), body.orientation)
+    panels = []
+    for i, variant in enumerate(m.person.variants):
+        for j, other in enumerate(m.person.variants):
+            body = m.body(other.body)
+            away = (PARK[0] + 10.0 * j, PARK[1], PARK[2])
+            world.set_base_frame(world.variant_bodies[other.name], body.position if j == i else away, body.orientation)
+        pos = np.asarray(m.body(variant.body).position)
+        target = pos + [0.0, 0.0, -0.3]
+        eye = target + [0.0, -2.6, 0.35]  # in front of the person, who faces -Y
+        view = pb.computeViewMatrix(eye.tolist(), target.tolist(), [0, 0, 1], physicsClientId=c)
+        proj = pb.computeProjectionMatrixFOV(40, width / height, 0.05, 10, physicsClientId=c)
+        rgba = pb.getCameraImage(width, height, view, proj, renderer=pb.ER_TINY_RENDERER, lightDirection=[1, -2, 2], physicsClientId=c)[2]
+        image = Image.fromarray(np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3])
+        label = f"{variant.name}\n{variant.sex}, {variant.mass_kg:g} kg, {variant.standing_height_m:.3f} m"
+        ImageDraw.Draw(image).multiline_text((8, 8), label, fill=(0, 0, 0))
+        panels.append(np.asarray(image))
+    world.close()
+    return np.concatenate(panels, axis=1)
+
+
+def cmd_render_person(args: argparse.Namespace) -> int:
+    from PIL import Image
+
+    from .compile.compiler import compile_task
+
+    result = compile_task(args.spec, args.robot, args.out_dir)
+    picture = render_people(result.out_dir)
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    Image.fromarray(picture).save(args.out)
+    names = ", ".join(v.name for v in result.manifest.person.variants)
+    print(f"wrote {args.out} ({names})")
+    return 0
+
+
+# --------------------------------------------------------------------------------------------
 # compare: one task, several robots
 
 
@@ -375,6 +430,13 @@ def add_commands(sub) -> None:
     p.add_argument("--resets", type=int, default=100)
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_bench)
+
+    p = sub.add_parser("render-person", help="draw the person variants a spec declares, side by side (PNG)")
+    p.add_argument("spec", help="task spec file")
+    p.add_argument("--robot", help="robot to compile the task for (default: the spec's default)")
+    p.add_argument("--out", required=True, help="output .png")
+    p.add_argument("--out-dir", dest="out_dir", help="artifact directory")
+    p.set_defaults(func=cmd_render_person)
 
     p = sub.add_parser("compare", help="compile a task for several robots and compare placement and scripted results")
     p.add_argument("spec", help="task spec file")
