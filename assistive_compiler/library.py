@@ -94,9 +94,7 @@ class Library:
     def _urdf_of(self, kind: str, loaded: LoadedPart) -> UrdfInfo:
         part = loaded.part
         if kind == "people":
-            from .person.body import body_measurements
-
-            m = body_measurements(part.sex, part.mass_kg, part.height_scale, part.radius_scale)
+            m = part.measurements()
             return urdf_info(render_template(PERSON_TEMPLATE_RELPATH, m.xacro_args()))
         if getattr(part, "urdf", None):
             return urdf_info(self.urdf_path(loaded).read_text())

@@ -48,7 +48,7 @@ from ..artifact import (
 from ..errors import Problem, SpecError
 from ..library import PERSON_TEMPLATE_RELPATH, Library
 from ..paths import display, templates_dir
-from ..person.body import body_measurements, format_fixed_joints
+from ..person.body import format_fixed_joints
 from ..resolve import ResolvedTask, resolve
 from ..spec.load import LoadedSpec, load_spec
 from ..spec.models import Uniform, scalar_bounds
@@ -229,7 +229,7 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
     measurements = {}
     for i, variant in enumerate(person.variants):
         part = rt.people[variant].part
-        m = body_measurements(part.sex, part.mass_kg, part.height_scale, part.radius_scale)
+        m = part.measurements()
         measurements[variant] = m
         args = m.xacro_args() | {"fixed_joints": format_fixed_joints(baked), "skin_rgba": " ".join(repr(float(c)) for c in part.skin_rgba)}
         emit(f"person_{variant}", templates_dir() / PERSON_TEMPLATE_RELPATH, args, rt.loaded.smap.value(("person", "variants", i)))

@@ -494,3 +494,19 @@ def format_fixed_joints(angles: Mapping[str, float]) -> str:
                 raise ValueError(f"angle of {name} must be finite, got {angles[name]!r}")
             parts.append(f"{name}={a!r}")
     return " ".join(parts)
+
+
+def body_for_height(sex: Sex, height_m: float, mass_kg: float | None = None, radius_scale: float = 1.0) -> BodyMeasurements:
+    """The body of ``sex`` whose standing height is ``height_m`` (metres, within 0.1 mm): the
+    height scale is solved for, since radii and some offsets do not scale with it."""
+    low, high = 0.5, 1.5
+    if not (body_measurements(sex, mass_kg, low, radius_scale).standing_height_m <= height_m
+            <= body_measurements(sex, mass_kg, high, radius_scale).standing_height_m):
+        raise ValueError(f"a {sex} body cannot be {height_m} m tall with height scales 0.5-1.5")
+    for _ in range(60):
+        mid = 0.5 * (low + high)
+        if body_measurements(sex, mass_kg, mid, radius_scale).standing_height_m < height_m:
+            low = mid
+        else:
+            high = mid
+    return body_measurements(sex, mass_kg, 0.5 * (low + high), radius_scale)

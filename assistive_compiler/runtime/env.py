@@ -81,7 +81,6 @@ class AssistiveEnv(gym.Env):
         self.obs_fns = [bind_term(t, self.snap) for t in m.observations["robot"]]
         self.reward_fns = [(t.name, t.weight, bind_term(t, self.snap)) for t in m.reward]
         self.tool_point = self.snap.point({"body": "robot", "link": m.robot.links["tool_mount"]})
-        person_names = [b.name for b in m.bodies if b.kind == "person"]
         self._force_on_person = ([b.name for b in m.bodies if b.kind in ("robot", "tool")], ["person"])
         obs_size = sum(t.size for t in m.observations["robot"])
         bounds = np.cumsum([0] + [t.size for t in m.observations["robot"]])
@@ -91,7 +90,6 @@ class AssistiveEnv(gym.Env):
         self.steps = 0
         self.success_metric: float | None = None
         self._stepped = False
-        self._person_names = person_names
 
     @classmethod
     def from_spec(cls, spec: str | Path, robot: str | None = None, out_dir: str | Path | None = None, **kwargs) -> "AssistiveEnv":

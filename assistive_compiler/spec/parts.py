@@ -126,6 +126,23 @@ class PersonPart(Strict):
     name: Name = Field(description="Person part name, e.g. male_50th.")
     sex: Literal["male", "female"] = Field(description="Body model (the reference's male or female segment tables).")
     mass_kg: float = Field(gt=20, le=250, description="Total body mass, kg (paper: 78.4 male, 62.5 female).")
+    height_m: float | None = Field(
+        None, gt=1.0, le=2.3, description="Standing height, metres (the segment-length scale is solved for); or give height_scale."
+    )
     height_scale: float = Field(1.0, gt=0.5, le=1.5, description="Multiplier of segment lengths (1.0: 50th pct).")
     radius_scale: float = Field(1.0, gt=0.5, le=2.0, description="Multiplier of segment radii.")
     skin_rgba: tuple[float, float, float, float] = Field((0.8, 0.6, 0.4, 1.0), description="Skin colour.")
+
+    @model_validator(mode="after")
+    def _one_height(self) -> "PersonPart":
+        if self.height_m is not None and self.height_scale != 1.0:
+            raise ValueError("@height_m: give height_m or height_scale, not both")
+        return self
+
+    def measurements(self):
+        """The body model of this person (segment lengths, radii and masses)."""
+        from ..person.body import body_for_height, body_measurements
+
+        if self.height_m is not None:
+            return body_for_height(self.sex, self.height_m, self.mass_kg, self.radius_scale)
+        return body_measurements(self.sex, self.mass_kg, self.height_scale, self.radius_scale)
