@@ -223,6 +223,8 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
     if person.control.compliant:
         for ref in person.control.compliant.joints:
             movable |= set(rt.joint_groups[ref]["joints"])
+    for choice in person.impairments.choices:  # impaired joints move (tremor) or keep their limits
+        movable |= set(_impairment_joints(rt, choice))
     person_joints = [j for j in rt.person_urdf.movable_joints]
     baked = {j: math.radians(person.joints_deg.get(j, 0.0)) for j in person_joints if j not in movable}
     movable_ordered = [j for j in person_joints if j in movable]
@@ -697,7 +699,7 @@ def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lowe
         person=Person(variants=variants, policy_joints=_policy_joints(rt), position_gain=gains.position_gain, max_force=gains.max_force_nm,
                       hold_gain=0.1, hold_force=1000.0, compliant_joints=compliant_joints,
                       compliant_gain=compliant.position_gain if compliant else 0.0, compliant_force=compliant.max_force_nm if compliant else 0.0,
-                      impairments=[_impairment_json(ch) for ch in spec.person.impairments.choices]),
+                      impairments=[_impairment_json(rt, ch) for ch in spec.person.impairments.choices]),
         robot=Robot(name=rt.robot_name, title=robot_part.title, arm_joints=arm_joints, joint_lower=_round(lower), joint_upper=_round(upper),
                     links=rt.robot_links, action_scale=control.action_scale_rad, position_gain=chosen["position_gain"],
                     max_force=chosen["max_force_nm"], gripper_joints=list(gripper.joints) if gripper else [], gripper_position=grip_pos,
@@ -710,16 +712,31 @@ def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lowe
     )
 
 
-def _impairment_json(choice) -> dict[str, Any]:
-    out = choice.model_dump(mode="json")
-    for key, value in list(out.items()):
-        if key.endswith("_deg"):
+def _impairment_joints(rt: ResolvedTask, choice) -> list[str]:
+    """The person joints an impairment choice names (joint-group references resolved)."""
+    joints: list[str] = []
+    for ref in getattr(choice, "joints", []):
+        group = _policy_joints(rt) if ref == "person.policy" else rt.joint_groups[ref]["joints"]
+        joints += [j for j in group if j not in joints]
+    return joints
+
+
+def _impairment_json(rt: ResolvedTask, choice) -> dict[str, Any]:
+    """An impairment choice for the runtime: ranges as [low, high] (angles in radians), joints by
+    URDF name, and each joint's pose-independent limits (for limited range of motion)."""
+    out: dict[str, Any] = {"kind": choice.kind}
+    for key in ("amplitude_deg", "strength", "scale"):
+        if hasattr(choice, key):
             lo, hi = scalar_bounds(getattr(choice, key))
-            out[key.replace("_deg", "_rad")] = [math.radians(lo), math.radians(hi)]
-            del out[key]
-        elif isinstance(getattr(choice, key, None), (Uniform, float, int)) and key != "kind":
-            lo, hi = scalar_bounds(getattr(choice, key))
-            out[key] = [lo, hi]
+            if key.endswith("_deg"):
+                out[key.replace("_deg", "_rad")] = [math.radians(lo), math.radians(hi)]
+            else:
+                out[key] = [lo, hi]
+    joints = _impairment_joints(rt, choice)
+    if joints:
+        movable = rt.person_urdf.movable_joints
+        out["joints"] = joints
+        out["limits"] = {j: [movable[j].lower, movable[j].upper] for j in joints}
     return out
 
 

@@ -54,6 +54,24 @@ def bind_term(use: TermUse, snap: Snapshot) -> Callable[[Snapshot], Any]:
     return lambda s: fn(s, params)
 
 
+def draw_impairment(choices: list[dict], rng: np.random.Generator) -> dict:
+    """One impairment for an episode, drawn uniformly from the spec's choices, with its values:
+    ``amplitude`` (tremor ε per joint, rad), ``strength`` (weakness β) or ``limits`` (limited range:
+    each joint's limits × γ, as the paper scales them), plus the ``joints`` it affects."""
+    choice = choices[int(rng.integers(len(choices)))]
+    drawn: dict = {"kind": choice["kind"], "joints": list(choice.get("joints", []))}
+    if choice["kind"] == "tremor":
+        lo, hi = choice["amplitude_rad"]
+        drawn["amplitude"] = {j: float(rng.uniform(lo, hi)) for j in drawn["joints"]}
+    elif choice["kind"] == "weakness":
+        drawn["strength"] = float(rng.uniform(*choice["strength"]))
+    elif choice["kind"] == "limited_range":
+        gamma = float(rng.uniform(*choice["scale"]))
+        drawn["scale"] = gamma
+        drawn["limits"] = {j: (lo * gamma, hi * gamma) for j, (lo, hi) in choice["limits"].items()}
+    return drawn
+
+
 class AssistiveEnv(gym.Env):
     """A compiled assistive task as a Gymnasium environment (robot acting, person static)."""
 
@@ -90,6 +108,7 @@ class AssistiveEnv(gym.Env):
         self.steps = 0
         self.success_metric: float | None = None
         self._stepped = False
+        self._tremor: list[tuple[int, float]] = []
 
     @classmethod
     def from_spec(cls, spec: str | Path, robot: str | None = None, out_dir: str | Path | None = None, **kwargs) -> "AssistiveEnv":
@@ -120,12 +139,19 @@ class AssistiveEnv(gym.Env):
         angles = {j: variant.initial_angles[j] for j in variant.movable_joints}
         for j, (lo, hi) in variant.randomize.items():
             angles[j] = float(rng.uniform(lo, hi))
+        impairment = self.impairment = draw_impairment(m.person.impairments, rng)
+        for j, (lo, hi) in impairment.get("limits", {}).items():  # limited range: stay inside γ·limits
+            angles[j] = min(max(angles[j], lo), hi)
         idx = [person.joints[j] for j in variant.movable_joints]
         for i, j in zip(idx, variant.movable_joints):
             pb.resetJointState(person.id, i, angles[j], physicsClientId=c)
+        self._person_hold = (person.id, idx, [angles[j] for j in variant.movable_joints])
+        strength = impairment.get("strength", 1.0)
+        self._person_forces = [m.person.hold_force * (strength if j in impairment.get("joints", ()) else 1.0) for j in variant.movable_joints]
+        self._tremor = [(k, impairment["amplitude"][j]) for k, j in enumerate(variant.movable_joints) if j in impairment.get("amplitude", {})]
         if idx:
-            pb.setJointMotorControlArray(person.id, idx, pb.POSITION_CONTROL, targetPositions=[angles[j] for j in variant.movable_joints],
-                                         positionGains=[m.person.hold_gain] * len(idx), forces=[m.person.hold_force] * len(idx), physicsClientId=c)
+            pb.setJointMotorControlArray(person.id, idx, pb.POSITION_CONTROL, targetPositions=self._person_hold[2],
+                                         positionGains=[m.person.hold_gain] * len(idx), forces=self._person_forces, physicsClientId=c)
         for name, offset in variant.target_offsets.items():
             if name in self.snap.target_offsets:
                 self.snap.target_offsets[name] = np.asarray(offset, dtype=float)
@@ -164,7 +190,7 @@ class AssistiveEnv(gym.Env):
         self.snap.set_frame("robot_base", *w.base_frame(w.robot))
         self.snap.set_frame("person_base", *w.base_frame(person))
         self.snap.refresh()
-        return self._observe(), {"person_variant": variant.name, "start": k}
+        return self._observe(), {"person_variant": variant.name, "start": k, "impairment": impairment}
 
     def step(self, action):
         m, w, c = self.manifest, self.world, self.world.client
@@ -175,6 +201,14 @@ class AssistiveEnv(gym.Env):
         target = np.clip(q + self.delta_scale * np.clip(raw, -1.0, 1.0), self.lower, self.upper)
         pb.setJointMotorControlArray(w.robot.id, self.arm_idx, pb.POSITION_CONTROL, targetPositions=target.tolist(),
                                      positionGains=self._gains, forces=self._forces, physicsClientId=c)
+        if self._tremor:  # the paper's tremor: q̄ + ε·(−1)^t, the sign flipping every env step
+            person_id, idx, hold = self._person_hold
+            sign = 1.0 if self.steps % 2 == 0 else -1.0
+            targets = list(hold)
+            for k, eps in self._tremor:
+                targets[k] = hold[k] + sign * eps
+            pb.setJointMotorControlArray(person_id, idx, pb.POSITION_CONTROL, targetPositions=targets,
+                                         positionGains=[m.person.hold_gain] * len(idx), forces=self._person_forces, physicsClientId=c)
         w.step_physics()
         self._stepped = True
         self.steps += 1
