@@ -146,12 +146,17 @@ class AssistiveEnv(gym.Env):
         for i, j in zip(idx, variant.movable_joints):
             pb.resetJointState(person.id, i, angles[j], physicsClientId=c)
         self._person_hold = (person.id, idx, [angles[j] for j in variant.movable_joints])
+        # Held stiffly, or compliantly (a weak hold that yields to contact) where the spec says so;
+        # weakness scales the force of the joints it names.
         strength = impairment.get("strength", 1.0)
-        self._person_forces = [m.person.hold_force * (strength if j in impairment.get("joints", ()) else 1.0) for j in variant.movable_joints]
+        compliant = set(m.person.compliant_joints)
+        self._person_gains = [m.person.compliant_gain if j in compliant else m.person.hold_gain for j in variant.movable_joints]
+        self._person_forces = [(m.person.compliant_force if j in compliant else m.person.hold_force)
+                               * (strength if j in impairment.get("joints", ()) else 1.0) for j in variant.movable_joints]
         self._tremor = [(k, impairment["amplitude"][j]) for k, j in enumerate(variant.movable_joints) if j in impairment.get("amplitude", {})]
         if idx:
             pb.setJointMotorControlArray(person.id, idx, pb.POSITION_CONTROL, targetPositions=self._person_hold[2],
-                                         positionGains=[m.person.hold_gain] * len(idx), forces=self._person_forces, physicsClientId=c)
+                                         positionGains=self._person_gains, forces=self._person_forces, physicsClientId=c)
         for name, offset in variant.target_offsets.items():
             if name in self.snap.target_offsets:
                 self.snap.target_offsets[name] = np.asarray(offset, dtype=float)
@@ -208,7 +213,7 @@ class AssistiveEnv(gym.Env):
             for k, eps in self._tremor:
                 targets[k] = hold[k] + sign * eps
             pb.setJointMotorControlArray(person_id, idx, pb.POSITION_CONTROL, targetPositions=targets,
-                                         positionGains=[m.person.hold_gain] * len(idx), forces=self._person_forces, physicsClientId=c)
+                                         positionGains=self._person_gains, forces=self._person_forces, physicsClientId=c)
         w.step_physics()
         self._stepped = True
         self.steps += 1
