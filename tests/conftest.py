@@ -5,6 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+import xacro
+import yourdfpy
 
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.runtime.env import AssistiveEnv
@@ -25,3 +27,26 @@ def env(artifact):
     e = AssistiveEnv(artifact)
     yield e
     e.close()
+
+
+# Template modules (test_<robot>_kinematics.py) define TEMPLATE; these render and load it once per module.
+
+
+@pytest.fixture(scope="module")
+def urdf_text(request) -> str:
+    """The module's TEMPLATE rendered with its defaults (a fresh mappings dict: xacro mutates it)."""
+    return xacro.process_file(str(request.module.TEMPLATE), mappings={}).toprettyxml(indent="  ")
+
+
+@pytest.fixture(scope="module")
+def urdf_path(urdf_text, request, tmp_path_factory) -> Path:
+    name = Path(request.module.TEMPLATE).name.removesuffix(".urdf.xacro")
+    path = tmp_path_factory.mktemp(name) / f"{name}.urdf"
+    path.write_text(urdf_text)
+    return path
+
+
+@pytest.fixture(scope="module")
+def model(urdf_path):
+    """The rendered template loaded by yourdfpy (an independent URDF reader)."""
+    return yourdfpy.URDF.load(str(urdf_path), build_scene_graph=True, load_meshes=False)

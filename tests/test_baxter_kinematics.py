@@ -185,23 +185,6 @@ def dh_fk(side: str, q) -> np.ndarray:
 
 
 @pytest.fixture(scope="module")
-def urdf_text() -> str:
-    return xacro.process_file(str(TEMPLATE), mappings={}).toprettyxml(indent="  ")
-
-
-@pytest.fixture(scope="module")
-def urdf_path(urdf_text, tmp_path_factory) -> Path:
-    path = tmp_path_factory.mktemp("baxter") / "baxter.urdf"
-    path.write_text(urdf_text)
-    return path
-
-
-@pytest.fixture(scope="module")
-def model(urdf_path):
-    return yourdfpy.URDF.load(str(urdf_path), build_scene_graph=True, load_meshes=False)
-
-
-@pytest.fixture(scope="module")
 def bullet(urdf_path):
     """(client, body, joint index by name, link index by name, text printed while loading).
     Loaded at the origin, identity orientation: world frame == `base`."""

@@ -24,8 +24,6 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 import pytest
-import xacro
-import yourdfpy
 
 TEMPLATE = Path(__file__).resolve().parents[1] / "templates" / "robots" / "jaco.urdf.xacro"
 PI = math.pi
@@ -117,19 +115,6 @@ def dh_ee_in_base(q, d) -> np.ndarray:
     ee_fix = np.eye(4)
     ee_fix[:3, :3] = rot_z(PI)
     return base_to_dh0 @ dh_fk(theta, d) @ ee_fix
-
-
-@pytest.fixture(scope="module")
-def urdf_path(tmp_path_factory) -> Path:
-    text = xacro.process_file(str(TEMPLATE), mappings={}).toprettyxml(indent="  ")
-    path = tmp_path_factory.mktemp("jaco") / "jaco.urdf"
-    path.write_text(text)
-    return path
-
-
-@pytest.fixture(scope="module")
-def model(urdf_path):
-    return yourdfpy.URDF.load(str(urdf_path), build_scene_graph=True, load_meshes=False)
 
 
 @pytest.fixture(scope="module")

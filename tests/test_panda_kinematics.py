@@ -207,23 +207,6 @@ def random_configs(n=30, seed=0):
 # fixtures
 
 @pytest.fixture(scope="module")
-def urdf_text() -> str:
-    return render(TEMPLATE)
-
-
-@pytest.fixture(scope="module")
-def urdf_path(urdf_text, tmp_path_factory) -> Path:
-    path = tmp_path_factory.mktemp("panda") / "panda.urdf"
-    path.write_text(urdf_text)
-    return path
-
-
-@pytest.fixture(scope="module")
-def model(urdf_path):
-    return yourdfpy.URDF.load(str(urdf_path), build_scene_graph=True, load_meshes=False)
-
-
-@pytest.fixture(scope="module")
 def bullet(urdf_path):
     """(client, body, joint index by name, link index by name); base at the world origin."""
     cid = pb.connect(pb.DIRECT)

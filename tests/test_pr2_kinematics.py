@@ -23,7 +23,6 @@ import pytest
 
 from assistive_compiler.compile.external_checks import captured_c_output
 import xacro
-import yourdfpy
 
 from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.library import Library
@@ -173,23 +172,6 @@ def facts_tool(s: str, q) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------- fixtures
-
-
-@pytest.fixture(scope="module")
-def urdf_text() -> str:
-    return xacro.process_file(str(TEMPLATE), mappings={}).toprettyxml(indent="  ")
-
-
-@pytest.fixture(scope="module")
-def urdf_path(urdf_text, tmp_path_factory) -> Path:
-    path = tmp_path_factory.mktemp("pr2") / "pr2.urdf"
-    path.write_text(urdf_text)
-    return path
-
-
-@pytest.fixture(scope="module")
-def model(urdf_path):
-    return yourdfpy.URDF.load(str(urdf_path), build_scene_graph=True, load_meshes=False)
 
 
 @pytest.fixture(scope="module")

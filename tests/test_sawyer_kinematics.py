@@ -161,23 +161,6 @@ def random_configs(n=30, seed=0):
 # fixtures
 
 @pytest.fixture(scope="module")
-def urdf_text() -> str:
-    return xacro.process_file(str(TEMPLATE), mappings={}).toprettyxml(indent="  ")
-
-
-@pytest.fixture(scope="module")
-def urdf_path(urdf_text, tmp_path_factory) -> Path:
-    path = tmp_path_factory.mktemp("sawyer") / "sawyer.urdf"
-    path.write_text(urdf_text)
-    return path
-
-
-@pytest.fixture(scope="module")
-def model(urdf_path):
-    return yourdfpy.URDF.load(str(urdf_path), build_scene_graph=True, load_meshes=False)
-
-
-@pytest.fixture(scope="module")
 def bullet(urdf_path):
     """(client, body, joint index by joint name, link index by link name, load output)."""
     cid = pb.connect(pb.DIRECT)
