@@ -333,3 +333,15 @@ def test_bad_template_refusal_is_located(bad_table):
     in_part = f"{display(bad_table['part'])}:{at(bad_table['part_text'], str(bad_table['template']))}"
     in_task = f"{display(bad_table['task'])}:{at(bad_table['task_text'], 'bad_table}')}"
     assert where in (in_part, in_task)
+
+
+def test_a_closed_pipe_ends_the_cli_quietly():
+    """`assistive-compiler schema | head` must not print a traceback when head stops reading."""
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-m", "assistive_compiler.cli", "schema"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # the reader goes away before the CLI writes: its write fails with EPIPE
+    stderr = proc.stderr.read().decode()
+    assert proc.wait(timeout=60) == 0
+    assert "Traceback" not in stderr
