@@ -25,6 +25,8 @@ import numpy as np
 import pybullet as pb
 import pytest
 
+from frames import body_indices, origin_matrix, rot_x, rot_z
+
 TEMPLATE = Path(__file__).resolve().parents[1] / "templates" / "robots" / "jaco.urdf.xacro"
 PI = math.pi
 
@@ -72,28 +74,6 @@ DH_D_TABLE = [-0.2755, 0.0, -0.41, -0.0098, -0.31105, 0.0, -0.26375]
 DH_D_SPLIT = [-0.2755, -0.0016, -0.41, -0.0114, -0.31105, 0.0, -0.26375]
 
 
-def rot_x(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
-
-
-def rot_y(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
-
-
-def rot_z(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
-
-
-def origin_matrix(xyz, rpy) -> np.ndarray:
-    t = np.eye(4)
-    t[:3, :3] = rot_z(rpy[2]) @ rot_y(rpy[1]) @ rot_x(rpy[0])
-    t[:3, 3] = xyz
-    return t
-
-
 def dh_fk(theta, d) -> np.ndarray:
     """Classic DH: T = prod Rz(theta) Tz(d) Tx(a) Rx(alpha), with a = 0 for this arm."""
     t = np.eye(4)
@@ -124,11 +104,7 @@ def bullet(urdf_path):
     # Loaded at the origin with identity orientation: world frame == URDF base frame.
     body = pb.loadURDF(str(urdf_path), [0, 0, 0], [0, 0, 0, 1], useFixedBase=True,
                        flags=pb.URDF_USE_SELF_COLLISION, physicsClientId=cid)
-    joints, links = {}, {}
-    for j in range(pb.getNumJoints(body, physicsClientId=cid)):
-        info = pb.getJointInfo(body, j, physicsClientId=cid)
-        joints[info[1].decode()] = j
-        links[info[12].decode()] = j
+    joints, links = body_indices(cid, body)
     yield cid, body, joints, links
     pb.disconnect(cid)
 

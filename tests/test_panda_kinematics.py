@@ -31,12 +31,14 @@ import numpy as np
 import pybullet as pb
 import pytest
 
-from assistive_compiler.compile.external_checks import captured_c_output
 import xacro
 import yourdfpy
 
 from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.library import Library
+from assistive_compiler.compile.external_checks import captured_c_output
+
+from frames import body_indices, homogeneous, origin_matrix, rot_x, rot_z
 
 REPO = Path(__file__).resolve().parents[1]
 TEMPLATE = REPO / "templates" / "robots" / "panda.urdf.xacro"
@@ -123,31 +125,6 @@ READY = [0.0, -PI / 4, 0.0, -3 * PI / 4, 0.0, PI / 2, PI / 4]
 # --------------------------------------------------------------------------------------------
 # helpers
 
-def rot_x(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
-
-
-def rot_y(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
-
-
-def rot_z(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
-
-
-def homogeneous(rot=np.eye(3), xyz=(0, 0, 0)) -> np.ndarray:
-    t = np.eye(4)
-    t[:3, :3] = rot
-    t[:3, 3] = xyz
-    return t
-
-
-def origin_matrix(xyz, rpy) -> np.ndarray:
-    return homogeneous(rot_z(rpy[2]) @ rot_y(rpy[1]) @ rot_x(rpy[0]), xyz)
-
 
 def chain_fk(q) -> dict[str, np.ndarray]:
     """Link frames in panda_link0 from the published joint transforms (facts §4.1)."""
@@ -180,17 +157,6 @@ def render(path: Path, **args) -> str:
     return xacro.process_file(str(path), mappings={k: str(v) for k, v in args.items()}).toprettyxml(indent="  ")
 
 
-
-
-def indices(cid: int, body: int) -> tuple[dict[str, int], dict[str, int]]:
-    joints, links = {}, {}
-    for j in range(pb.getNumJoints(body, physicsClientId=cid)):
-        info = pb.getJointInfo(body, j, physicsClientId=cid)
-        joints[info[1].decode()] = j
-        links[info[12].decode()] = j
-    return joints, links
-
-
 def link_pose(cid: int, body: int, link: int) -> np.ndarray:
     ls = pb.getLinkState(body, link, computeForwardKinematics=True, physicsClientId=cid)
     return homogeneous(np.array(pb.getMatrixFromQuaternion(ls[5])).reshape(3, 3), ls[4])
@@ -212,7 +178,7 @@ def bullet(urdf_path):
     cid = pb.connect(pb.DIRECT)
     body = pb.loadURDF(str(urdf_path), [0, 0, 0], [0, 0, 0, 1], useFixedBase=True,
                        flags=pb.URDF_USE_SELF_COLLISION, physicsClientId=cid)
-    joints, links = indices(cid, body)
+    joints, links = body_indices(cid, body)
     yield cid, body, joints, links
     pb.disconnect(cid)
 
@@ -334,7 +300,7 @@ def test_fk_matches_pb_panda_file(bullet):
     cid, body, _, links = bullet
     with captured_c_output():
         ref = pb.loadURDF(str(path), [0, 0, 0], [0, 0, 0, 1], useFixedBase=True, physicsClientId=cid)
-    ref_joints, ref_links = indices(cid, ref)
+    ref_joints, ref_links = body_indices(cid, ref)
     try:
         worst = 0.0
         for q in random_configs(30, seed=2):
@@ -530,7 +496,7 @@ def test_base_fits_the_wheelchair_mount(side, urdf_path, tmp_path):
     cid = pb.connect(pb.DIRECT)
     try:
         chair = pb.loadURDF(str(chair_path), [0, 0, 0.06], useFixedBase=True, physicsClientId=cid)
-        _, chair_links = indices(cid, chair)
+        _, chair_links = body_indices(cid, chair)
         mount = link_pose(cid, chair, chair_links["robot_mount"])
         orn = pb.getQuaternionFromEuler([0, 0, -PI / 2 if side == "right" else PI / 2])
         np.testing.assert_allclose(mount[:3, 3], [-0.35 if side == "right" else 0.35, -0.3, 0.36], atol=1e-6)
@@ -541,7 +507,7 @@ def test_base_fits_the_wheelchair_mount(side, urdf_path, tmp_path):
         # The base's bottom face rests on the post's plane: 1 cm above the post's collision top.
         post_top = 0.06 + 0.12 + 0.34 / 2
         assert mount[2, 3] - post_top == pytest.approx(0.01, abs=1e-6)
-        joints, _ = indices(cid, robot)
+        joints, _ = body_indices(cid, robot)
         for q in ([0.0] * 7, READY):
             for name, v in zip(ARM_JOINTS, q):
                 pb.resetJointState(robot, joints[name], v, physicsClientId=cid)
@@ -564,7 +530,7 @@ def test_position_control_holds_a_random_pose_without_gravity(urdf_path):
         pb.setTimeStep(0.02, physicsClientId=cid)
         body = pb.loadURDF(str(urdf_path), [0, 0, 0.5], [0, 0, 0, 1], useFixedBase=True,
                            flags=pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=cid)
-        joints, links = indices(cid, body)
+        joints, links = body_indices(cid, body)
         rng = np.random.default_rng(7)
         q = rng.uniform([LIMITS[j][4] for j in ARM_JOINTS], [LIMITS[j][5] for j in ARM_JOINTS])
         names = ARM_JOINTS + FINGER_JOINTS

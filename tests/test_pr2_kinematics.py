@@ -21,11 +21,13 @@ import numpy as np
 import pybullet as pb
 import pytest
 
-from assistive_compiler.compile.external_checks import captured_c_output
 import xacro
 
 from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.library import Library
+from assistive_compiler.compile.external_checks import captured_c_output
+
+from frames import body_indices
 
 ROOT = Path(__file__).resolve().parents[1]
 TEMPLATE = ROOT / "templates" / "robots" / "pr2.urdf.xacro"
@@ -181,11 +183,7 @@ def bullet(urdf_path):
     with captured_c_output() as out:
         body = pb.loadURDF(str(urdf_path), [0, 0, 0], [0, 0, 0, 1], useFixedBase=True,
                            flags=pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=cid)
-    joints, links = {}, {}
-    for j in range(pb.getNumJoints(body, physicsClientId=cid)):
-        info = pb.getJointInfo(body, j, physicsClientId=cid)
-        joints[info[1].decode()] = j
-        links[info[12].decode()] = j
+    joints, links = body_indices(cid, body)
     yield cid, body, joints, links, out[0]
     pb.disconnect(cid)
 

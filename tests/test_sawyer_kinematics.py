@@ -29,12 +29,14 @@ import numpy as np
 import pybullet as pb
 import pytest
 
-from assistive_compiler.compile.external_checks import captured_c_output
 import xacro
 import yourdfpy
 
 from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.library import Library
+from assistive_compiler.compile.external_checks import captured_c_output
+
+from frames import body_indices, origin_matrix, rot_z
 
 ROOT = Path(__file__).resolve().parents[1]
 TEMPLATE = ROOT / "templates" / "robots" / "sawyer.urdf.xacro"
@@ -109,27 +111,6 @@ SPOON_HANDLE_END = "spoon_handle_end"
 # --------------------------------------------------------------------------------------------
 # helpers
 
-def rot_x(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
-
-
-def rot_y(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
-
-
-def rot_z(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
-
-
-def origin_matrix(xyz, rpy) -> np.ndarray:
-    t = np.eye(4)
-    t[:3, :3] = rot_z(rpy[2]) @ rot_y(rpy[1]) @ rot_x(rpy[0])
-    t[:3, 3] = xyz
-    return t
-
 
 def dh_fk(q, d) -> np.ndarray:
     """Flange pose in the base frame according to the standard DH table."""
@@ -145,8 +126,6 @@ def dh_fk(q, d) -> np.ndarray:
     fix = np.eye(4)
     fix[:3, :3] = rot_z(J6_PITCH)
     return t @ fix
-
-
 
 
 def random_configs(n=30, seed=0):
@@ -168,11 +147,7 @@ def bullet(urdf_path):
     with captured_c_output() as out:
         body = pb.loadURDF(str(urdf_path), [0, 0, 0], [0, 0, 0, 1], useFixedBase=True,
                            physicsClientId=cid)
-    joints, links = {}, {}
-    for j in range(pb.getNumJoints(body, physicsClientId=cid)):
-        info = pb.getJointInfo(body, j, physicsClientId=cid)
-        joints[info[1].decode()] = j
-        links[info[12].decode()] = j
+    joints, links = body_indices(cid, body)
     yield cid, body, joints, links, out[0]
     pb.disconnect(cid)
 

@@ -15,9 +15,9 @@ import numpy as np
 import pybullet as pb
 import pytest
 
-from assistive_compiler.compile.external_checks import captured_c_output
 import xacro
 import yourdfpy
+from assistive_compiler.compile.external_checks import captured_c_output
 
 TEMPLATES = Path(__file__).resolve().parents[1] / "templates"
 CHECK_URDF = Path(sys.executable).parent / "check_urdf"
