@@ -364,7 +364,7 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, baked, movable, measureme
     for name, use in spec.tools.items():
         tpart = rt.tools[name].part
         grip = robot_part.grips[tpart.name]
-        hand_side, hand = robot_part.arm_for(use.hand)
+        _, hand = robot_part.arm_for(use.hand)
         tool_ids[name] = pc.load(written[name], (0, 0, -10), (0, 0, 0, 1), True)
         attachments.append(ToolAttachment(body=name, parent_link=hand.tool_mount, position=_round(grip.position_m),
                                           orientation=_round(_quat_from_rpy(grip.rpy_rad)),
@@ -385,7 +385,7 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, baked, movable, measureme
     variants_out: list[PersonVariant] = []
     particle_sets: list[ParticleSet] = []
     placements: dict[str, Any] = {}
-    for vi, variant in enumerate(person_spec.variants):
+    for variant in person_spec.variants:
         for other, pid in person_ids.items():  # only this variant in the scene
             pc.place(pid, person_pos[other] if other == variant else (0, 0, -20), person_orn)
         rng = np.random.default_rng(_seed(rt, variant))
