@@ -93,6 +93,14 @@ class RobotPart(Strict):
         return only_side, only_arm
 
 
+class Container(Strict):
+    """A tool's inside: a vertical cylinder in the tool frame from z = 0 (the inside floor) up to
+    ``height_m``, opening towards +z. Particles within it count as still held."""
+
+    radius_m: float = Field(gt=0, le=1, description="Inner radius, metres.")
+    height_m: float = Field(gt=0, le=2, description="Height of the rim above the inside floor, metres.")
+
+
 class ToolPart(Strict):
     """A hand-held tool."""
 
@@ -102,6 +110,7 @@ class ToolPart(Strict):
     links: dict[Name, str] = Field(default_factory=dict, description="Semantic link names → URDF link names.")
     reference_link: Name = Field(description="Semantic link meant when a spec names the tool alone (e.g. tip).")
     mass_kg: float = Field(gt=0, description="Total mass, kg.")
+    container: Container | None = Field(None, description="The open volume the tool holds things in (a cup), if any.")
 
 
 class FurniturePart(Strict):
@@ -125,7 +134,15 @@ class PersonPart(Strict):
 
     name: Name = Field(description="Person part name, e.g. male_50th.")
     sex: Literal["male", "female"] = Field(description="Body model (the reference's male or female segment tables).")
-    mass_kg: float = Field(gt=20, le=250, description="Total body mass, kg (paper: 78.4 male, 62.5 female).")
+    mass_kg: float | None = Field(
+        None, gt=20, le=250, description="Total body mass, kg (paper: 78.4 male, 62.5 female); required unless percentile is given."
+    )
+    percentile: float | None = Field(
+        None,
+        description="Body percentile, 5-95 (e.g. 5, 50, 95): standing height and mass follow from the CDC/NCHS adult "
+        "stature and weight percentiles (2021-2023), scaled so that 50 is the paper's body; instead of mass_kg, height_m "
+        "and height_scale.",
+    )
     height_m: float | None = Field(
         None, gt=1.0, le=2.3, description="Standing height, metres (the segment-length scale is solved for); or give height_scale."
     )
@@ -139,10 +156,45 @@ class PersonPart(Strict):
             raise ValueError("@height_m: give height_m or height_scale, not both")
         return self
 
+    @model_validator(mode="after")
+    def _size(self) -> "PersonPart":
+        if self.percentile is None:
+            if self.mass_kg is None:
+                raise ValueError("@mass_kg: give mass_kg (kg) or percentile")
+            return self
+        from ..person.anthropometry import check_percentile
+
+        if self.mass_kg is not None:
+            raise ValueError("@percentile: give percentile or mass_kg, not both (the percentile sets the mass)")
+        if self.height_m is not None or "height_scale" in self.model_fields_set:
+            which = "height_m" if self.height_m is not None else "height_scale"
+            raise ValueError(f"@percentile: give percentile or {which}, not both (the percentile sets the height)")
+        try:
+            check_percentile(self.percentile)
+        except ValueError as exc:
+            raise ValueError(f"@percentile: {str(exc).removeprefix('percentile ')}") from None
+        return self
+
+    def size(self) -> tuple[float | None, float]:
+        """``(standing height m or None, mass kg)`` as given or as the percentile sets them (None:
+        the height follows from height_scale)."""
+        if self.percentile is not None:
+            from ..person.anthropometry import percentile_body
+
+            return percentile_body(self.sex, self.percentile)
+        return self.height_m, self.mass_kg
+
     def measurements(self):
-        """The body model of this person (segment lengths, radii and masses)."""
+        """The body model of this person (segment lengths, radii and masses). A percentile body is
+        solved for its standing height like height_m; the 50th percentile is the paper's body
+        itself (height scale 1)."""
         from ..person.body import body_for_height, body_measurements
 
+        if self.percentile is not None:
+            height, mass = self.size()
+            if self.percentile == 50:
+                return body_measurements(self.sex, mass, 1.0, self.radius_scale)
+            return body_for_height(self.sex, height, mass, self.radius_scale)
         if self.height_m is not None:
             return body_for_height(self.sex, self.height_m, self.mass_kg, self.radius_scale)
         return body_measurements(self.sex, self.mass_kg, self.height_scale, self.radius_scale)
