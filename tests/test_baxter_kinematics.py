@@ -422,7 +422,7 @@ def test_library_part(part):
         assert arm.rest_rad == TUCKED[side]
         p = FINGER_PREFIX[side]
         assert part.gripper[side].joints == [f"{p}_gripper_l_finger_joint", f"{p}_gripper_r_finger_joint"]
-        assert part.gripper[side].positions == {"spoon": 0.0, "none": 0.0}  # reference: feeding (0, 0)
+        assert {k: part.gripper[side].positions[k] for k in ("spoon", "none")} == {"spoon": 0.0, "none": 0.0}  # reference: feeding (0, 0)
 
 
 def test_base_height_puts_the_pedestal_on_the_floor(part, urdf_path):

@@ -245,7 +245,7 @@ def test_library_part():
         assert part.arms[side].end_effector == part.arms[side].tool_mount == f"{s}_gripper_tool_frame"
         assert part.arms[side].rest_rad == list(TUCKED[s])
         assert part.gripper[side].joints == finger_joints(s)
-        assert part.gripper[side].positions == {"spoon": FEEDING_GRIP, "none": 0.0}
+        assert {k: part.gripper[side].positions[k] for k in ("spoon", "none")} == {"spoon": FEEDING_GRIP, "none": 0.0}
 
 
 # ---------------------------------------------------------------------------- structure

@@ -330,7 +330,7 @@ def test_library_part():
     assert arm.joints == ARM_JOINTS
     assert (arm.end_effector, arm.tool_mount) == ("right_gripper", "right_gripper_base")
     assert part.gripper["right"].joints == FINGER_JOINTS
-    assert part.gripper["right"].positions == {"spoon": 0.0, "none": 0.0}  # facts: feeding 0
+    assert {k: part.gripper["right"].positions[k] for k in ("spoon", "none")} == {"spoon": 0.0, "none": 0.0}  # facts: feeding 0
     assert not part.mountable
     assert part.base_height_m == BASE_HEIGHT
 
