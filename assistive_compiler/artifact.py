@@ -57,6 +57,22 @@ class StartState(_Model):
     tool_position: Vec3 = Field(description="Where the tool frame (or end effector) starts, world, m.")
 
 
+class Capsule(_Model):
+    """A limb's capsule axis in its link frame: ``start`` at the joint end, ``end``, and the radius."""
+
+    link: str = Field(description="URDF link name.")
+    start: Vec3 = Field(description="Axis end at the joint, link frame, m.")
+    end: Vec3 = Field(description="Other axis end, link frame, m.")
+    radius: float = Field(description="Radius, m.")
+
+
+class MarkerPoint(_Model):
+    """One marker: a point on a limb's surface."""
+
+    link: str = Field(description="URDF link it rides on.")
+    offset: Vec3 = Field(description="Position in the link frame, m.")
+
+
 class PersonVariant(_Model):
     """One person body the task may draw at reset."""
 
@@ -69,6 +85,10 @@ class PersonVariant(_Model):
     initial_angles: dict[str, float] = Field(description="Initial angle of each movable joint, rad.")
     randomize: dict[str, tuple[float, float]] = Field(description="Per-reset uniform angle ranges, rad.")
     target_offsets: dict[str, Vec3] = Field(description="Offset of each person-attached target in its link, m.")
+    surfaces: dict[str, list[Capsule]] = Field(
+        default_factory=dict, description="Per surface-drawn target: the limbs (capsules, link frame) a reset draws its point on."
+    )
+    markers: dict[str, list[MarkerPoint]] = Field(default_factory=dict, description="Per marker set: every marker of this body.")
     starts: list[StartState] = Field(description="Robot starts for this variant; reset() draws one.")
 
 
@@ -85,6 +105,17 @@ class Person(_Model):
     compliant_gain: float = Field(0.0, description="Gain of the compliant hold.")
     compliant_force: float = Field(0.0, description="Force of the compliant hold, N·m.")
     impairments: list[dict[str, Any]] = Field(description="Impairment choices (spec form, angles in rad).")
+    action_scale: float = Field(0.05, description="Policy-joint target change per unit human action per physics step, rad.")
+    arm_limits: str = Field(
+        "analytic",
+        description="Pose-dependent arm-limit model of the policy-controlled arm: 'none', 'analytic' (built in) or the path "
+        "of an MLP .npz inside the artifact.",
+    )
+    arm_limits_sha256: str | None = Field(None, description="sha256 of that .npz (so the content hash covers it).")
+    self_collision: list[tuple[str, str]] = Field(
+        default_factory=list,
+        description="Person link pairs (URDF names) that collide with each other; every other pair of the body does not.",
+    )
 
 
 class Robot(_Model):
@@ -122,6 +153,7 @@ class Target(_Model):
     link: str = Field(description="URDF link name.")
     offset: Vec3 = Field(description="Offset in the link frame, m (for the person: the first variant's).")
     show_rgba: tuple[float, float, float, float] | None = Field(None, description="Marker colour for renders.")
+    surface: bool = Field(False, description="Drawn on a limb surface at every reset (offsets per variant in PersonVariant.surfaces).")
 
 
 class ParticleSet(_Model):
@@ -142,6 +174,27 @@ class ParticleSet(_Model):
     lost_distance: float = Field(0.0, description="Distance beyond which it is lost, m.")
     lost_anchor: Vec3 = Field((0.0, 0.0, 0.0), description="A point inside the lost body's collision geometry (lost link frame), m: a particle nearer than lost_distance to it is certainly not lost.")
     hit_body: str | None = Field(description="Body whose first contact with an active particle is a hit.")
+    outside_of: Container | None = Field(None, description="Particles inside this container are neither consumed nor lost.")
+
+
+class MarkerSet(_Model):
+    """Markers on the person (positions per variant in PersonVariant.markers), each cleared once per
+    episode when a contact of the clearing tool link with the person lies within ``radius`` of it."""
+
+    name: str = Field(description="Set name.")
+    tool: str = Field(description="Tool body that clears markers.")
+    tool_link: str = Field(description="URDF link of that tool whose contacts count.")
+    radius: float = Field(description="Clearing radius, m.")
+    show_rgba: tuple[float, float, float, float] | None = Field(None, description="Marker colour for renders.")
+
+
+class Container(_Model):
+    """An open vertical cylinder in a tool link's frame from z = 0 to ``height`` (e.g. a cup's inside)."""
+
+    body: str = Field(description="Tool body.")
+    link: str = Field(description="URDF link whose frame the cylinder is in.")
+    radius: float = Field(description="Radius, m.")
+    height: float = Field(description="Height, m.")
 
 
 class TermUse(_Model):
@@ -160,7 +213,8 @@ class Success(_Model):
 
     term: str = Field(description="Reward term name.")
     aggregate: Literal["sum", "max", "min", "last"] = Field(description="Aggregation over the episode.")
-    threshold: float = Field(description="Absolute threshold.")
+    threshold: float = Field(description="Absolute threshold (a fraction when fraction_of is set).")
+    fraction_of: str | None = Field(None, description="A marker set: the threshold is this fraction of the active variant's markers.")
 
 
 class Sim(_Model):
@@ -193,6 +247,7 @@ class Manifest(_Model):
     tools: list[ToolAttachment]
     targets: dict[str, Target]
     particles: list[ParticleSet]
+    markers: list[MarkerSet] = Field(default_factory=list, description="Marker sets on the person.")
     joint_groups: dict[str, dict[str, Any]] = Field(description="Joint groups by reference name.")
     observations: dict[str, list[TermUse]] = Field(description="Observation features per agent, in order.")
     reward: list[TermUse] = Field(description="Reward terms including preference costs.")

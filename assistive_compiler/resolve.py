@@ -62,6 +62,7 @@ class ResolvedTask:
     points: dict[str, dict[str, Any]] = field(default_factory=dict)
     scripted: dict[str, Any] | None = None
     base_goals: list[dict[str, Any]] = field(default_factory=list)
+    markers: dict[str, dict[str, Any]] = field(default_factory=dict)
 
     @property
     def spec(self) -> TaskSpec:
@@ -131,6 +132,7 @@ class _Resolver:
         self._person(spec)
         self._robot_role(spec)
         points = self._targets(spec)
+        markers = self._markers(spec)
         self._particles(spec)
         observations = {
             agent: [self._term(use, "observation", ("observations", agent, i), f"{agent}_{i}", 1.0) for i, use in enumerate(getattr(spec.observations, agent))]
@@ -155,7 +157,7 @@ class _Resolver:
         return ResolvedTask(
             self.loaded, self.robot_name, robot, self.robot_urdf, tools, furniture, people, self.person_urdf,
             self.robot_links, self.joint_groups, {a: [t for t in ts if t] for a, ts in observations.items()},
-            [t for t in reward if t], threshold, points, scripted, base_goals,
+            [t for t in reward if t], threshold, points, scripted, base_goals, markers,
         )
 
     def _bodies(self, spec: TaskSpec) -> None:
@@ -315,9 +317,28 @@ class _Resolver:
             if use.part not in self.robot.part.grips:
                 self.problem(("tools", name, "part"), f"robot '{self.robot_name}' has no grip for tool '{use.part}' (add it under grips: in {self.robot.shown})")
 
+    def limbs(self, refs: list[str], path: tuple) -> list[str]:
+        """URDF names of person limbs with a capsule (a cylinder collision shape)."""
+        out = []
+        for i, ref in enumerate(refs):
+            p = self.point(ref, path + (i,), allow_target=False)
+            if p is None:
+                continue
+            if p["body"] != "person" or p["link"] not in self.person_urdf.capsules:
+                pool = sorted(self.person_urdf.capsules)
+                self.problem(path + (i,), f"'{ref}' is not a person limb with a capsule; expected one of {one_of(['person.' + l for l in pool])}")
+                continue
+            out.append(p["link"])
+        return out
+
     def _targets(self, spec: TaskSpec) -> dict[str, dict[str, Any]]:
         out: dict[str, dict[str, Any]] = {}
         for name, target in spec.targets.items():
+            if target.surface_of:
+                links = self.limbs(target.surface_of, ("targets", name, "surface_of"))
+                if links:
+                    out[name] = {"body": "person", "link": links[0], "surface_links": links}
+                continue
             p = self.point(target.link, ("targets", name, "link"), allow_target=False)
             for variant in target.offset_by_variant:
                 if variant not in spec.person.variants:
@@ -326,12 +347,33 @@ class _Resolver:
                 out[name] = p
         return out
 
+    def _markers(self, spec: TaskSpec) -> dict[str, dict[str, Any]]:
+        out: dict[str, dict[str, Any]] = {}
+        for name, ms in spec.markers.items():
+            base = ("markers", name)
+            if name in self.body_names or name in spec.targets:
+                self.problem(base, f"marker set name '{name}' is already used by a body or target", key=True)
+            links = self.limbs(ms.surface_of, base + ("surface_of",))
+            tool = self.point(ms.cleared_by.tool, base + ("cleared_by", "tool"), allow_target=False)
+            if tool is not None and tool["body"] not in spec.tools:
+                self.problem(base + ("cleared_by", "tool"), f"markers are cleared by a tool link; '{ms.cleared_by.tool}' is not on a tool (tools: {one_of(spec.tools)})")
+                tool = None
+            if links and tool:
+                out[name] = {"links": links, "tool": tool, "radius_m": ms.cleared_by.radius_m, "spacing_m": ms.spacing_m,
+                             "show_rgba": ms.show_rgba}
+        return out
+
     def _particles(self, spec: TaskSpec) -> None:
         for name, ps in spec.particles.items():
             base = ("particles", name)
             self.body(ps.attach, base + ("attach",), allow_particles=False)
             if ps.consumed_at:
                 self.point(ps.consumed_at.target, base + ("consumed_at", "target"))
+                holder = ps.consumed_at.outside_of
+                if holder is not None and self.body(holder, base + ("consumed_at", "outside_of"), allow_particles=False):
+                    if holder not in self.tools or self.tools[holder].part.container is None:
+                        with_container = [t for t, part in self.tools.items() if part.part.container is not None]
+                        self.problem(base + ("consumed_at", "outside_of"), f"'{holder}' is not a tool with a container; tools with one: {one_of(with_container) or 'none'}")
             if ps.lost_beyond:
                 self.body(ps.lost_beyond.body, base + ("lost_beyond", "body"), allow_particles=False)
             if ps.hit_body:
@@ -375,6 +417,12 @@ class _Resolver:
             return self.joints(value, path)
         if kind == "particles":
             return self.particles(value, path)
+        if kind == "markers":
+            if value not in self.spec.markers:
+                pool = list(self.spec.markers)
+                self.problem(path, f"unknown marker set '{value}'; expected one of {one_of(pool) or 'none (declare one under markers:)'}{did_you_mean(value, pool)}")
+                return None
+            return value
         return value  # frame: a literal pydantic already checked
 
     def _preferences(self, spec: TaskSpec) -> list[ResolvedTerm | None]:
@@ -397,15 +445,24 @@ class _Resolver:
         waypoints = []
         for i, w in enumerate(spec.scripted.waypoints):
             to = self.point(w.to, ("scripted", "waypoints", i, "to"))
-            waypoints.append({"to": to, "offset_m": list(w.offset_m), "tolerance_m": w.tolerance_m})
-        return {"move": move, "waypoints": waypoints}
+            for key in ("normal_offset_m", "axis_offset_m"):
+                if getattr(w, key) and not (w.to in spec.targets and spec.targets[w.to].surface_of):
+                    self.problem(("scripted", "waypoints", i, key), f"{key} needs a target drawn on a surface (surface_of); '{w.to}' is not one")
+            waypoints.append({"to": to, "offset_m": list(w.offset_m), "tolerance_m": w.tolerance_m,
+                              "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
+                              "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None})
+        return {"move": move, "waypoints": waypoints, "repeat_from": spec.scripted.repeat_from}
 
     def _success(self, spec: TaskSpec, reward_names: set[str]) -> float:
         success = spec.success
         if success.term not in reward_names:
             self.problem(("success", "term"), f"unknown reward term '{success.term}'; expected one of {one_of(reward_names)}{did_you_mean(success.term, reward_names)}")
         if success.relative_to is not None:
-            if self.particles(success.relative_to, ("success", "relative_to")) is None:
+            if success.relative_to in spec.markers:
+                return success.threshold  # a fraction: the runtime multiplies by the variant's marker count
+            if success.relative_to not in spec.particles:
+                pool = list(spec.particles) + list(spec.markers)
+                self.problem(("success", "relative_to"), f"unknown particle or marker set '{success.relative_to}'; expected one of {one_of(pool) or 'none'}{did_you_mean(success.relative_to, pool)}")
                 return success.threshold
             return success.threshold * spec.particles[success.relative_to].count
         return success.threshold

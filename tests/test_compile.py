@@ -204,7 +204,7 @@ def test_manifest_reward_has_paper_preference_weights(manifest):
 
 
 def test_manifest_success_threshold(manifest):
-    assert manifest["success"] == {"term": "food_eaten", "aggregate": "sum", "threshold": 6.0}  # 0.75 × 8 particles
+    assert manifest["success"] == {"term": "food_eaten", "aggregate": "sum", "threshold": 6.0, "fraction_of": None}  # 0.75 × 8 particles
 
 
 # --------------------------------------------------------------------------------------------

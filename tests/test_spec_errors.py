@@ -336,7 +336,7 @@ def test_default_robot_not_supported_message(tmp_path, capsys):
 def test_unknown_tool_part(tmp_path, capsys):
     text = EXTENDS + "tools:\n  spoon: {part: spon}\n"
     path = write(tmp_path, text)
-    check(capsys, path, f"{at(text, 'spon}')}: unknown tool 'spon'; expected one of 'spoon' (did you mean 'spoon'?)")
+    check(capsys, path, f"{at(text, 'spon}')}: unknown tool 'spon'; expected one of 'cup', 'scooper', 'scratcher', 'spoon', 'wiper' (did you mean 'spoon'?)")
 
 
 def test_unknown_furniture_part(tmp_path, capsys):
@@ -355,8 +355,9 @@ def test_unknown_reward_term_kind(tmp_path, capsys):
     check(
         capsys,
         path,
-        f"{at(text, 'action_nrom')}: unknown reward term 'action_nrom'; expected one of 'action_norm', 'contact_force', "
-        "'distance', 'particles_consumed', 'particles_lost' (did you mean 'action_norm'?)",
+        f"{at(text, 'action_nrom')}: unknown reward term 'action_nrom'; expected one of 'action_norm', 'closest_distance', "
+        "'contact_events', 'contact_force', 'distance', 'markers_cleared', 'particles_consumed', 'particles_lost', 'tilt' "
+        "(did you mean 'action_norm'?)",
     )
 
 
@@ -523,7 +524,7 @@ def test_several_part_problems_all_reported(tmp_path, capsys):
     check(
         capsys,
         path,
-        f"{at(text, 'spon}')}: unknown tool 'spon'; expected one of 'spoon' (did you mean 'spoon'?)",
+        f"{at(text, 'spon}')}: unknown tool 'spon'; expected one of 'cup', 'scooper', 'scratcher', 'spoon', 'wiper' (did you mean 'spoon'?)",
         f"{at(text, 'table_tal')}: unknown furniture part 'table_tal'; expected one of {FURNITURE_PARTS} (did you mean 'table_tall'?)",
     )
 

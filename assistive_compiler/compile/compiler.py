@@ -33,6 +33,10 @@ import numpy as np
 from .. import __version__
 from ..artifact import (
     Body,
+    Capsule,
+    Container,
+    MarkerPoint,
+    MarkerSet,
     Manifest,
     ParticleSet,
     Person,
@@ -55,7 +59,7 @@ from ..spec.models import Uniform, scalar_bounds
 from ..terms.registry import SizeContext, terms
 from .lint import lint_urdf
 from .merge import merge_fixed_links
-from .render import render_template
+from .render import render_template, urdf_info
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 
@@ -90,6 +94,8 @@ def input_hash(loaded: LoadedSpec, robot: str, library: Library) -> str:
     artifact — so a cache hit never needs resolution."""
     h = hashlib.sha256(f"assistive-compiler {__version__} robot={robot}\n".encode())
     files = list(loaded.files)
+    if loaded.spec.person.control.arm_limits not in ("none", "analytic") and _arm_limits_path(loaded).is_file():
+        files.append(_arm_limits_path(loaded))  # a user's arm-limit network
     for root in library.roots:
         files += sorted(root.rglob("*.yaml")) + sorted((root.parent / "templates").rglob("*.xacro"))
     files += sorted(templates_dir().rglob("*.xacro")) + sorted(PACKAGE_DIR.rglob("*.py"))
@@ -226,26 +232,33 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
     for choice in person.impairments.choices:  # impaired joints move (tremor) or keep their limits
         movable |= set(_impairment_joints(rt, choice))
     person_joints = [j for j in rt.person_urdf.movable_joints]
-    baked = {j: math.radians(person.joints_deg.get(j, 0.0)) for j in person_joints if j not in movable}
     movable_ordered = [j for j in person_joints if j in movable]
-    measurements = {}
+    measurements = {variant: rt.people[variant].part.measurements() for variant in person.variants}
+    # Supine people settle at compile time (limp, free base, onto the furniture); their settled
+    # angles are the posture, overridden by any joints_deg the spec gives.
+    settled = {variant: _settle_person(rt, written, variant, measurements[variant]) for variant in person.variants} if person.placement.settle else {}
+    postures: dict[str, dict[str, float]] = {}
     for i, variant in enumerate(person.variants):
         part = rt.people[variant].part
-        m = part.measurements()
-        measurements[variant] = m
-        args = m.xacro_args() | {"fixed_joints": format_fixed_joints(baked), "skin_rgba": " ".join(repr(float(c)) for c in part.skin_rgba)}
+        posture = dict(settled[variant][2]) if variant in settled else {j: 0.0 for j in person_joints}
+        posture |= {j: math.radians(a) for j, a in person.joints_deg.items()}
+        postures[variant] = posture
+        baked = {j: posture[j] for j in person_joints if j not in movable}
+        args = measurements[variant].xacro_args() | {"fixed_joints": format_fixed_joints(baked), "skin_rgba": " ".join(repr(float(c)) for c in part.skin_rgba)}
         emit(f"person_{variant}", templates_dir() / PERSON_TEMPLATE_RELPATH, args, rt.loaded.smap.value(("person", "variants", i)))
 
     # 3. Precompute (on the unmerged bodies) -------------------------------------------------
     pc = _Precompute()
     try:
-        manifest = _precompute(rt, pc, written, out_tmp, baked, movable_ordered, measurements, mounted_on)
+        manifest = _precompute(rt, pc, written, out_tmp, postures, movable_ordered, measurements, mounted_on, settled)
     finally:
         pc.close()
 
     # 4. Merge each person's static links into as few rigid links as possible: a seated person
     #    with a movable head goes from 43 links to 5, which is most of a step's physics cost.
     keep = _referenced_person_links(rt)
+    collision_keep, collision_pairs = person_self_collision(written[f"person_{person.variants[0]}"].read_text(), keep)
+    keep |= collision_keep  # links kept so that self-collision stays exact (see person_self_collision)
     for variant in person.variants:
         path = written[f"person_{variant}"]
         merged, _frames = merge_fixed_links(path.read_text(), keep=keep)
@@ -253,7 +266,135 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
         if problems:  # pragma: no cover - the merge preserves validity; lint guards it
             raise SpecError([Problem(rt.loaded.smap.value(("person", "variants")), f"merged person URDF refused: {pr}") for pr in problems])
         path.write_text(merged)
-    return manifest
+    return _finish_person(rt, manifest, out_tmp, collision_pairs)
+
+
+def person_self_collision(urdf_xml: str, keep: set[str]) -> tuple[set[str], list[tuple[str, str]]]:
+    """Which person links collide with each other, and which links the merge must keep for that.
+
+    ``urdf_xml`` is the unmerged person (static joints already fixed), ``keep`` the links the
+    merge keeps anyway. The reference's groups (facts §3.3, ``SELF_COLLISION_GROUPS``: each arm
+    and leg against the rest, never torso, head and girdles among themselves) are applied to the
+    groups whose links move in the task (below a movable joint); a person whose arms and legs are
+    all static (Feeding: only the head moves) gets no self-collision at all.
+
+    Merging puts several original links into one rigid link, named after the link that survives
+    (``merge_fixed_links``). A pair of surviving links collides when their names form an enabled
+    pair; that is exact only if every pair of geometry-carrying links they contain agrees. Where
+    one does not — a static shoulder girdle, which overlaps the upper arm and must not collide
+    with it, merged into the chest that a moving arm must collide with; the stomach and hips
+    merged into the chest against a moving thigh; a static upper arm merged into the chest
+    while its forearm moves — the link is kept out of the merge (a link of its own on its fixed
+    joint) until all agree. Returns (extra links to keep, enabled pairs of surviving link names),
+    the pairs sorted and limited to links that move relative to each other and are not parent
+    and child (pybullet never collides those).
+    """
+    import xml.etree.ElementTree as ET
+
+    from ..person.body import SELF_COLLISION_GROUPS
+
+    root = ET.fromstring(urdf_xml)
+    parent: dict[str, tuple[str, bool]] = {}  # child link -> (parent link, joint is fixed)
+    for joint in root.findall("joint"):
+        parent[joint.find("child").get("link")] = (joint.find("parent").get("link"), joint.get("type") == "fixed")
+    geometry = sorted(link.get("name") for link in root.findall("link") if link.find("collision") is not None)
+
+    def chain(link: str) -> list[tuple[str, bool]]:
+        """(link, its joint is fixed) from ``link`` up to (not including) the root."""
+        out = []
+        while link in parent:
+            out.append((link, parent[link][1]))
+            link = parent[link][0]
+        return out
+
+    geometry.sort(key=lambda link: (len(chain(link)), link))  # root side first: keeping a link keeps what hangs on it
+    moving = {link for link in geometry if any(not fixed for _, fixed in chain(link))}
+    enabled: set[tuple[str, str]] = set()
+    for group in SELF_COLLISION_GROUPS.values():
+        if moving & set(group.links):
+            enabled |= {tuple(sorted((a, b))) for a in group.links for b in group.against if a != b}  # type: ignore[misc]
+    extra: set[str] = set()
+    if not enabled:
+        return extra, []
+
+    def survivor(link: str) -> str:
+        while link in parent and parent[link][1] and link not in keep and link not in extra:
+            link = parent[link][0]
+        return link
+
+    def rigid(a: str, b: str) -> bool:
+        """No movable joint on the tree path between surviving links a and b."""
+        up_a, up_b = chain(a), chain(b)
+        common = {name for name, _ in up_a} & {name for name, _ in up_b}
+        return all(fixed for name, fixed in up_a + up_b if name not in common)
+
+    changed = True
+    while changed:
+        changed = False
+        for i, a in enumerate(geometry):
+            for b in geometry[i + 1:]:
+                sa, sb = survivor(a), survivor(b)
+                if sa == sb or rigid(sa, sb):
+                    continue
+                if (tuple(sorted((a, b))) in enabled) != (tuple(sorted((sa, sb))) in enabled):
+                    pick = a if a != sa else b  # one of them is merged (two survivors agree by definition)
+                    assert pick not in extra
+                    extra.add(pick)
+                    changed = True
+    survivors = sorted({survivor(link) for link in geometry})
+    pairs = [(a, b) for i, a in enumerate(survivors) for b in survivors[i + 1:]
+             if (a, b) in enabled and not rigid(a, b) and parent.get(a, ("",))[0] != b and parent.get(b, ("",))[0] != a]
+    return extra, pairs
+
+
+def _finish_person(rt: ResolvedTask, manifest: Manifest, out_tmp: Path, pairs: list[tuple[str, str]]) -> Manifest:
+    """The person's runtime settings that need the merged bodies or extra files: the self-collision
+    pairs minus those already touching (within 1 mm) at a variant's initial pose — shapes that
+    overlap at rest, such as the upper arm and the chest capsule, would otherwise push each other
+    apart at every reset — and the arm-limit model (a user's .npz is copied into the artifact)."""
+    update: dict[str, Any] = {}
+    if pairs:
+        import pybullet
+
+        pc = _Precompute()
+        try:
+            p, c = pc.p, pc.client
+            touching: set[tuple[str, str]] = set()
+            for variant in manifest.person.variants:
+                body = manifest.body(variant.body)
+                bid = p.loadURDF(str(out_tmp / body.urdf), useFixedBase=True, flags=pybullet.URDF_USE_SELF_COLLISION, physicsClientId=c)
+                joints = pc.joint_index(bid)
+                for name, q in variant.initial_angles.items():
+                    p.resetJointState(bid, joints[name], q, physicsClientId=c)
+                for a, b in pairs:
+                    if p.getClosestPoints(bid, bid, 0.001, pc.link_index(bid, a), pc.link_index(bid, b), physicsClientId=c):
+                        touching.add((a, b))
+        finally:
+            pc.close()
+        update["self_collision"] = [pair for pair in pairs if pair not in touching]
+    setting = rt.spec.person.control.arm_limits
+    if setting not in ("none", "analytic"):
+        from ..person.arm_limits import MLPArmLimits
+
+        where = rt.loaded.smap.value(("person", "control", "arm_limits"))
+        source = _arm_limits_path(rt.loaded)
+        try:
+            MLPArmLimits.from_npz(source)
+        except ValueError as exc:
+            raise SpecError([Problem(where, f"person.control.arm_limits: {exc}")]) from None
+        shutil.copyfile(source, out_tmp / "arm_limits.npz")
+        update |= {"arm_limits": "arm_limits.npz", "arm_limits_sha256": _sha(source.read_bytes())}
+    if not update:
+        return manifest
+    return manifest.model_copy(update={"person": manifest.person.model_copy(update=update)})
+
+
+def _arm_limits_path(loaded: LoadedSpec) -> Path:
+    """The .npz that ``person.control.arm_limits`` names, relative to the spec file that says it."""
+    value = loaded.spec.person.control.arm_limits
+    where = loaded.smap.value(("person", "control", "arm_limits")).path
+    spec_file = next((f for f in loaded.files if display(f) == where), loaded.path)
+    return (Path(spec_file).parent / value).resolve()
 
 
 def _referenced_person_links(rt: ResolvedTask) -> set[str]:
@@ -274,6 +415,10 @@ def _referenced_person_links(rt: ResolvedTask) -> set[str]:
         visit(term.params)
     visit(rt.points)
     visit(rt.scripted)
+    for ref in rt.points.values():
+        found.update(ref.get("surface_links", ()))
+    for ms in rt.markers.values():
+        found.update(ms["links"])
     return found
 
 
@@ -297,7 +442,56 @@ def _policy_joints(rt: ResolvedTask) -> list[str]:
     return out
 
 
-def _precompute(rt, pc: _Precompute, written, out_tmp, baked, movable, measurements, mounted_on) -> Manifest:
+def _settle_person(rt: ResolvedTask, written: dict[str, Path], variant: str, measurements) -> tuple[tuple, tuple, dict[str, float]]:
+    """Drop the limp person onto the furniture (facts §2.2): every joint free and perturbed by
+    U(±joint_noise_rad) around the spec's posture, a free base at the placement pose, the settle
+    gravity and furniture friction, ``steps`` physics steps. Returns the settled base pose (URDF
+    frame) and joint angles (rad). Deterministic per (task, robot, variant)."""
+    spec = rt.spec
+    settle = spec.person.placement.settle
+    pc = _Precompute()
+    p, c = pc.p, pc.client
+    try:
+        p.setTimeStep(spec.sim.time_step_s, physicsClientId=c)
+        p.setGravity(0, 0, settle.gravity_mps2, physicsClientId=c)
+        p.setPhysicsEngineParameter(numSolverIterations=spec.sim.solver.iterations, numSubSteps=spec.sim.solver.sub_steps,
+                                    deterministicOverlappingPairs=1, physicsClientId=c)
+        p.createMultiBody(0, p.createCollisionShape(p.GEOM_PLANE, physicsClientId=c), physicsClientId=c)
+        for name, use in spec.scene.furniture.items():
+            fid = pc.load(written[name], use.position_m, _quat_from_rpy(tuple(math.radians(a) for a in use.rpy_deg)), True)
+            if settle.friction is not None:
+                for link in range(-1, p.getNumJoints(fid, physicsClientId=c)):
+                    p.changeDynamics(fid, link, lateralFriction=settle.friction, physicsClientId=c)
+        part = rt.people[variant].part
+        args = measurements.xacro_args() | {"fixed_joints": "", "skin_rgba": " ".join(repr(float(v)) for v in part.skin_rgba)}
+        limp = written["robot"].with_name(f".settle_{variant}.urdf")
+        limp.write_text(render_template(templates_dir() / PERSON_TEMPLATE_RELPATH, args))
+        placement = spec.person.placement
+        orn = _quat_from_rpy(tuple(math.radians(a) for a in placement.rpy_deg))
+        body = pc.load(limp, (0, 0, 0), orn, False)
+        limp.unlink()
+        pc.place(body, tuple(placement.position_m), orn)
+        rng = np.random.default_rng(_seed(rt, variant) ^ 0x5E771E)
+        joints = pc.joint_index(body)
+        names = [j for j in rt.person_urdf.movable_joints]
+        for name in names:
+            info = rt.person_urdf.movable_joints[name]
+            q = math.radians(spec.person.joints_deg.get(name, 0.0)) + rng.uniform(-settle.joint_noise_rad, settle.joint_noise_rad)
+            p.resetJointState(body, joints[name], min(max(q, info.lower), info.upper), physicsClientId=c)
+        idx = [joints[n] for n in names]
+        p.setJointMotorControlArray(body, idx, p.VELOCITY_CONTROL, forces=[0.0] * len(idx), physicsClientId=c)
+        for _ in range(settle.steps):
+            p.stepSimulation(physicsClientId=c)
+        pos, orn = pc.link_pose(body, -1)
+        angles = {n: s[0] for n, s in zip(names, p.getJointStates(body, idx, physicsClientId=c))}
+        if not all(math.isfinite(v) for v in [*pos, *orn, *angles.values()]) or abs(pos[2]) > 10:
+            raise _fail(rt, ("person", "placement", "settle"), f"person '{variant}' did not settle (the body left the scene); check placement.position_m")
+        return _round(tuple(pos)), _round(tuple(orn)), {n: _round(a) for n, a in angles.items()}
+    finally:
+        pc.close()
+
+
+def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measurements, mounted_on, settled) -> Manifest:
     spec = rt.spec
     p, c = pc.p, pc.client
     p.setGravity(0, 0, spec.sim.gravity_mps2, physicsClientId=c)
@@ -318,13 +512,17 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, baked, movable, measureme
 
     # Person: seated on the furniture's seat surface, or at an explicit position.
     person_spec = spec.person
-    person_orn = _quat_from_rpy(tuple(math.radians(a) for a in person_spec.placement.rpy_deg))
+    person_orns = {v: settled[v][1] if v in settled else _quat_from_rpy(tuple(math.radians(a) for a in person_spec.placement.rpy_deg))
+                   for v in person_spec.variants}
     person_ids: dict[str, int] = {}
     person_pos: dict[str, tuple] = {}
     for variant in person_spec.variants:
         body_name = f"person_{variant}"
+        person_orn = person_orns[variant]
         probe = pc.load(written[body_name], (0, 0, 0), person_orn, True)
-        if person_spec.placement.seated_on:
+        if variant in settled:
+            pos = settled[variant][0]
+        elif person_spec.placement.seated_on:
             seat_name = person_spec.placement.seated_on
             seat_part = rt.furniture[seat_name].part
             seat_pos, _ = pc.link_pose(furniture_ids[seat_name], pc.link_index(furniture_ids[seat_name], seat_part.seat_link))
@@ -336,7 +534,7 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, baked, movable, measureme
         pc.place(probe, pos, person_orn)
         jidx = pc.joint_index(probe)
         for j in movable:
-            p.resetJointState(probe, jidx[j], math.radians(person_spec.joints_deg.get(j, 0.0)), physicsClientId=c)
+            p.resetJointState(probe, jidx[j], postures[variant][j], physicsClientId=c)
         person_ids[variant], person_pos[variant] = probe, _round(pos)
 
     # Robot: loaded once; its base is placed per candidate pose below.
@@ -387,7 +585,7 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, baked, movable, measureme
     placements: dict[str, Any] = {}
     for variant in person_spec.variants:
         for other, pid in person_ids.items():  # only this variant in the scene
-            pc.place(pid, person_pos[other] if other == variant else (0, 0, -20), person_orn)
+            pc.place(pid, person_pos[other] if other == variant else (0, 0, -20), person_orns[other])
         rng = np.random.default_rng(_seed(rt, variant))
         arm_kin.person = person_ids[variant]
         goals = [(tuple(start.tool_position_m), tool_orn, True, "the start pose")]
@@ -419,13 +617,17 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, baked, movable, measureme
         for tname, target in spec.targets.items():
             if rt.points.get(tname, {}).get("body") == "person":
                 offsets[tname] = _round(tuple(target.offset_by_variant.get(variant, target.offset_m)))
-        initial = {j: _round(math.radians(person_spec.joints_deg.get(j, 0.0))) for j in movable}
+        limbs = urdf_info(written[f"person_{variant}"].read_text()).capsules
+        surfaces = {t: [_capsule(limbs, link) for link in ref["surface_links"]] for t, ref in rt.points.items() if "surface_links" in ref}
+        marker_points = {name: _marker_points(limbs, ms["links"], ms["spacing_m"]) for name, ms in rt.markers.items()}
+        initial = {j: _round(postures[variant][j]) for j in movable}
         randomize = {j: _round(tuple(math.radians(a) for a in person_spec.randomize_deg[j].uniform)) for j in movable if j in person_spec.randomize_deg}
         variants_out.append(PersonVariant(name=variant, body=f"person_{variant}", sex=m.sex, mass_kg=_round(m.mass_kg),
                                           standing_height_m=_round(m.standing_height_m), movable_joints=movable,
-                                          initial_angles=initial, randomize=randomize, target_offsets=offsets, starts=starts))
+                                          initial_angles=initial, randomize=randomize, target_offsets=offsets, starts=starts,
+                                          surfaces=surfaces, markers=marker_points))
         bodies.append(Body(name=f"person_{variant}", kind="person", urdf=rel(written[f"person_{variant}"]), position=person_pos[variant],
-                           orientation=_round(person_orn), fixed_base=True, gravity=person_spec.gravity_mps2))
+                           orientation=_round(person_orns[variant]), fixed_base=True, gravity=person_spec.gravity_mps2))
     first = variants_out[0].starts[0]
     base_pos, base_orn = first.base_position, first.base_orientation
     arm_kin.place(base_pos, base_orn)
@@ -439,6 +641,33 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, baked, movable, measureme
     bodies.insert(0, Body(name="robot", kind="robot", urdf=rel(written["robot"]), position=_round(base_pos), orientation=_round(base_orn),
                           fixed_base=True, gravity=spec.robot.gravity_mps2))
     return _manifest(rt, bodies, variants_out, attachments, particle_sets, arm_joints, lower, upper, movable, placements)
+
+
+def _capsule(limbs: dict, link: str) -> Capsule:
+    cap = limbs[link]
+    return Capsule(link=link, start=_round(cap.start), end=_round(cap.end), radius=_round(cap.radius))
+
+
+def _marker_points(limbs: dict, links: list[str], spacing: float) -> list[MarkerPoint]:
+    """The reference's capsule_points: on each limb, int(L/spacing) rings at L·(i+1)/(n+1) from the
+    joint end, each with int(2πr/spacing) points spacing/r radians apart (male arm: 81 + 48)."""
+    out: list[MarkerPoint] = []
+    for link in links:
+        cap = limbs[link]
+        start, end = np.asarray(cap.start), np.asarray(cap.end)
+        length, r = float(np.linalg.norm(end - start)), cap.radius
+        axis = (end - start) / length
+        helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        u = np.cross(axis, helper)
+        u /= np.linalg.norm(u)
+        v = np.cross(axis, u)
+        rings, per_ring = int(length / spacing), int(2 * math.pi * r / spacing)
+        for i in range(rings):
+            centre = start + axis * length * (i + 1) / (rings + 1)
+            for k in range(per_ring):
+                a = k * spacing / r
+                out.append(MarkerPoint(link=link, offset=_round(tuple(centre + r * (math.cos(a) * u + math.sin(a) * v)))))
+    return out
 
 
 def _seat_links(rt: ResolvedTask) -> list[str]:
@@ -636,7 +865,14 @@ def _settle_particles(rt, pc, name, ps, tool_ids, furniture_ids, start, tool_orn
                        consumed_radius=ps.consumed_at.radius_m if ps.consumed_at else 0.0,
                        lost_body=ps.lost_beyond.body if ps.lost_beyond else None, lost_link=lost_link,
                        lost_distance=ps.lost_beyond.distance_m if ps.lost_beyond else 0.0, lost_anchor=_round(anchor),
-                       hit_body=ps.hit_body)
+                       hit_body=ps.hit_body, outside_of=_container(rt, ps.consumed_at.outside_of if ps.consumed_at else None))
+
+
+def _container(rt: ResolvedTask, tool: str | None) -> Container | None:
+    if tool is None:
+        return None
+    part = rt.tools[tool].part
+    return Container(body=tool, link=part.base_link, radius=part.container.radius_m, height=part.container.height_m)
 
 
 def _inside_point(pc, body: int, link_name: str) -> tuple[float, float, float]:
@@ -652,9 +888,9 @@ def _inside_point(pc, body: int, link_name: str) -> tuple[float, float, float]:
     return tuple(pos)
 
 
-def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lower, upper, movable, placements) -> Manifest:
-    spec = rt.spec
-    robot_part = rt.robot.part
+def _gripper(rt: ResolvedTask) -> tuple[list[str], list[float]]:
+    """The acting hand's finger joints and their positions for the held tool (or 'none')."""
+    spec, robot_part = rt.spec, rt.robot.part
     gripper = robot_part.gripper.get(robot_part.arm_for(spec.robot.arm if spec.robot.arm != "both" else "right")[0])
     tool_part = rt.tools[next(iter(spec.tools))].part.name if spec.tools else "none"
     grip_pos = gripper.positions.get(tool_part, gripper.positions.get("none", 0.0)) if gripper else 0.0
@@ -662,6 +898,13 @@ def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lowe
     grip_pos = [float(v) for v in grip_pos] if isinstance(grip_pos, list) else [float(grip_pos)] * n_fingers
     if len(grip_pos) != n_fingers:
         raise _fail(rt, ("tools",), f"robot '{rt.robot_name}' gives {len(grip_pos)} finger positions for '{tool_part}' but has {n_fingers} finger joints")
+    return (list(gripper.joints) if gripper else []), grip_pos
+
+
+def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lower, upper, movable, placements) -> Manifest:
+    spec = rt.spec
+    robot_part = rt.robot.part
+    finger_joints, grip_pos = _gripper(rt)
     control = spec.robot.control
     chosen = {field: getattr(control, field) for field in ("position_gain", "max_force_nm")}
     for field in chosen:  # the task's explicit value, else the robot's default, else the spec default
@@ -681,7 +924,10 @@ def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lowe
     targets = {}
     for name, t in spec.targets.items():
         ref = rt.points[name]
-        targets[name] = Target(body=ref["body"], link=ref["link"], offset=_round(tuple(t.offset_m)), show_rgba=t.show_rgba)
+        targets[name] = Target(body=ref["body"], link=ref["link"], offset=_round(tuple(t.offset_m)), show_rgba=t.show_rgba,
+                               surface="surface_links" in ref)
+    markers = [MarkerSet(name=name, tool=ms["tool"]["body"], tool_link=ms["tool"]["link"], radius=ms["radius_m"],
+                         show_rgba=ms["show_rgba"]) for name, ms in rt.markers.items()]
     ground = scalar_bounds(spec.sim.ground.friction)
     gains = spec.person.control
     compliant = spec.person.control.compliant
@@ -699,15 +945,17 @@ def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lowe
         person=Person(variants=variants, policy_joints=_policy_joints(rt), position_gain=gains.position_gain, max_force=gains.max_force_nm,
                       hold_gain=0.1, hold_force=1000.0, compliant_joints=compliant_joints,
                       compliant_gain=compliant.position_gain if compliant else 0.0, compliant_force=compliant.max_force_nm if compliant else 0.0,
-                      impairments=[_impairment_json(rt, ch) for ch in spec.person.impairments.choices]),
+                      impairments=[_impairment_json(rt, ch) for ch in spec.person.impairments.choices],
+                      action_scale=gains.action_scale_rad, arm_limits=gains.arm_limits),
         robot=Robot(name=rt.robot_name, title=robot_part.title, arm_joints=arm_joints, joint_lower=_round(lower), joint_upper=_round(upper),
                     links=rt.robot_links, action_scale=control.action_scale_rad, position_gain=chosen["position_gain"],
-                    max_force=chosen["max_force_nm"], gripper_joints=list(gripper.joints) if gripper else [], gripper_position=grip_pos,
+                    max_force=chosen["max_force_nm"], gripper_joints=finger_joints, gripper_position=grip_pos,
                     placement=placements),
-        tools=attachments, targets=targets, particles=particle_sets, joint_groups=rt.joint_groups | {"person.policy": {"body": "person", "group": "policy", "joints": _policy_joints(rt)}},
+        tools=attachments, targets=targets, particles=particle_sets, markers=markers, joint_groups=rt.joint_groups | {"person.policy": {"body": "person", "group": "policy", "joints": _policy_joints(rt)}},
         observations={agent: [obs_use(t) for t in ts] for agent, ts in rt.observations.items()},
         reward=[TermUse(name=t.name, term=t.term, category=t.category, weight=t.weight, params=t.params) for t in rt.reward],
-        success=Success(term=spec.success.term, aggregate=spec.success.aggregate, threshold=rt.success_threshold),
+        success=Success(term=spec.success.term, aggregate=spec.success.aggregate, threshold=rt.success_threshold,
+                        fraction_of=spec.success.relative_to if spec.success.relative_to in rt.markers else None),
         scripted=rt.scripted,
     )
 

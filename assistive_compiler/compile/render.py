@@ -79,12 +79,27 @@ class JointInfo:
 
 
 @dataclass(frozen=True)
+class Capsule:
+    """The cylinder of a link's capsule (cylinder + two spheres), in the link frame: its axis from
+    ``start`` (the end nearer the link origin, i.e. the joint) to ``end``, and its radius (m)."""
+
+    start: tuple[float, float, float]
+    end: tuple[float, float, float]
+    radius: float
+
+    @property
+    def length(self) -> float:
+        return math.dist(self.start, self.end)
+
+
+@dataclass(frozen=True)
 class UrdfInfo:
     """Names declared by a URDF, for cross-reference checks."""
 
     root_link: str
     links: tuple[str, ...]
     joints: dict[str, JointInfo]
+    capsules: dict[str, Capsule]
 
     @property
     def movable_joints(self) -> dict[str, JointInfo]:
@@ -113,4 +128,32 @@ def urdf_info(urdf_xml: str) -> UrdfInfo:
             el.get("name", ""), jtype, el.find("parent").get("link", ""), child, lower, upper, axis  # type: ignore[union-attr]
         )
     roots = [l for l in links if l not in children]
-    return UrdfInfo(roots[0] if roots else "", links, joints)
+    return UrdfInfo(roots[0] if roots else "", links, joints, _capsules(root))
+
+
+def _rpy_matrix(r: float, p: float, y: float) -> list[list[float]]:
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return [[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr]]
+
+
+def _capsules(root: ET.Element) -> dict[str, Capsule]:
+    """Each link's first collision cylinder, as a capsule axis in the link frame."""
+    out: dict[str, Capsule] = {}
+    for link in root.findall("link"):
+        for col in link.findall("collision"):
+            cyl = col.find("geometry/cylinder")
+            if cyl is None:
+                continue
+            origin = col.find("origin")
+            xyz = [float(v) for v in (origin.get("xyz", "0 0 0") if origin is not None else "0 0 0").split()]
+            rpy = [float(v) for v in (origin.get("rpy", "0 0 0") if origin is not None else "0 0 0").split()]
+            half = float(cyl.get("length", "0")) / 2
+            axis = [row[2] for row in _rpy_matrix(*rpy)]
+            a = tuple(c - half * d for c, d in zip(xyz, axis))
+            b = tuple(c + half * d for c, d in zip(xyz, axis))
+            start, end = (a, b) if math.hypot(*a) <= math.hypot(*b) else (b, a)
+            out[link.get("name", "")] = Capsule(start, end, float(cyl.get("radius", "0")))
+            break
+    return out

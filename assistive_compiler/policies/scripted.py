@@ -2,10 +2,11 @@
 
 Each step it reads the world (privileged: true target positions), asks pybullet's IK for the arm
 configuration that puts the moved point at the current waypoint with the tool's start
-orientation, and returns the joint-delta action that heads there (clipped to [−1, 1]). It
+orientation (or the waypoint's own), and returns the joint-delta action that heads there (clipped to [−1, 1]). It
 advances to the next waypoint within the waypoint's tolerance — or when it has stopped getting
 closer (no gain of 2 mm over 10 steps: an approach point the arm cannot quite reach should not
-end the episode) — and holds the last one. Works for any task and robot whose manifest has a
+end the episode) — and holds the last one, or goes on from ``repeat_from`` (to rub back and
+forth). A waypoint may sit off a surface-drawn target along its outward normal and along its limb. Works for any task and robot whose manifest has a
 ``scripted`` section.
 """
 
@@ -29,7 +30,10 @@ class ScriptedPolicy:
         self.env = env
         snap = env.snap
         self.move = snap.point(m.scripted["move"])
-        self.waypoints = [(snap.point(w["to"]), np.asarray(w["offset_m"]), w["tolerance_m"]) for w in m.scripted["waypoints"]]
+        self.waypoints = [(snap.point(w["to"]), np.asarray(w["offset_m"]), w["tolerance_m"], w.get("normal_offset_m", 0.0),
+                           w.get("axis_offset_m", 0.0)) for w in m.scripted["waypoints"]]
+        self.orientations = [pb.getQuaternionFromEuler(w["rpy_rad"]) if w.get("rpy_rad") else None for w in m.scripted["waypoints"]]
+        self.repeat_from = m.scripted.get("repeat_from")
         robot = env.world.robot
         self.ee_link = robot.links[m.robot.links["tool_mount"]]
         self.ee_point = snap.point({"body": "robot", "link": m.robot.links["tool_mount"]})
@@ -53,26 +57,32 @@ class ScriptedPolicy:
         self.index = 0
         self._best, self._since_best = float("inf"), 0
 
+    def _goal(self) -> tuple[np.ndarray, float]:
+        """The current waypoint's position (world, m) and tolerance."""
+        to, offset, tol, along_normal, along_axis = self.waypoints[self.index]
+        snap = self.env.snap
+        return snap.position(to) + offset + along_normal * snap.normal(to) + along_axis * snap.axis(to), tol
+
     def __call__(self, obs) -> np.ndarray:
         env = self.env
         if env.steps == 0:  # first action of an episode
             self._start_episode()
         snap = env.snap
-        to, offset, tol = self.waypoints[self.index]
-        goal = snap.position(to) + offset
+        goal, tol = self._goal()
         error = float(np.linalg.norm(snap.position(self.move) - goal))
         if error < self._best - STALL_GAIN_M:
             self._best, self._since_best = error, 0
         else:
             self._since_best += 1
-        if self.index < len(self.waypoints) - 1 and (error <= tol or self._since_best >= STALL_STEPS):
-            self.index += 1
+        last = self.index == len(self.waypoints) - 1
+        if (not last or self.repeat_from is not None) and (error <= tol or self._since_best >= STALL_STEPS):
+            self.index = self.index + 1 if not last else self.repeat_from
             self._best, self._since_best = float("inf"), 0
-            to, offset, tol = self.waypoints[self.index]
-            goal = snap.position(to) + offset
+            goal, tol = self._goal()
         # End-effector pose that puts the moved point at the goal with the kept orientation.
         inv_pos, inv_orn = pb.invertTransform(*self.point_in_ee)
-        ee_pos, ee_orn = pb.multiplyTransforms(goal.tolist(), self.keep_orn, inv_pos, inv_orn)
+        orn = self.orientations[self.index] or self.keep_orn
+        ee_pos, ee_orn = pb.multiplyTransforms(goal.tolist(), orn, inv_pos, inv_orn)
         c = env.world.client
         robot = env.world.robot.id
         rest = [pb.getJointState(robot, j, physicsClientId=c)[0] for j in self.movable]

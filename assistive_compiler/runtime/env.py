@@ -9,6 +9,11 @@
   contact force of robot and tools on the person (N), ``info["task_success"]`` 1 once the
   success criterion holds (``info["success_metric"]`` its aggregate so far).
 * **Episodes** end by truncation after ``episode_steps`` (no early termination, as the paper).
+* **The person** (:mod:`.human`): ``step()`` leaves it held, compliant or tremoring as the spec
+  says; ``step_agents(robot_action, human_action)`` also drives its policy joints
+  (``human_action_space``, the same delta rule) and returns ``observe_human()`` too — the
+  co-optimisation face. Hard joint limits and pose-dependent arm limits then hold after every
+  physics step.
 
 ``reset()`` restores a saved state and applies the episode's draws — person variant, randomised
 joint angles, one of the precomputed start configurations, furniture noise, floor friction —
@@ -33,6 +38,8 @@ import pybullet as pb
 
 from ..artifact import Manifest, TermUse
 from ..terms.registry import ref_fields, terms
+from .markers import MarkerSystem
+from .human import PersonController, draw_impairment  # noqa: F401  (draw_impairment: re-exported)
 from .particles import ParticleSystem
 from .snapshot import Snapshot
 from .world import PARK, World
@@ -50,26 +57,31 @@ def bind_term(use: TermUse, snap: Snapshot) -> Callable[[Snapshot], Any]:
         if bind is not None:
             values[fname] = [bind(x) for x in v] if shape == "list" else bind(v)
     params = SimpleNamespace(**values)
+    if isinstance(tdef.fn, type):  # a term with memory: one instance per env, reset every episode
+        instance = tdef.fn()
+        bound = lambda s: instance(s, params)  # noqa: E731
+        bound.reset = instance.reset  # type: ignore[attr-defined]
+        return bound
     fn = tdef.fn
     return lambda s: fn(s, params)
 
 
-def draw_impairment(choices: list[dict], rng: np.random.Generator) -> dict:
-    """One impairment for an episode, drawn uniformly from the spec's choices, with its values:
-    ``amplitude`` (tremor ε per joint, rad), ``strength`` (weakness β) or ``limits`` (limited range:
-    each joint's limits × γ, as the paper scales them), plus the ``joints`` it affects."""
-    choice = choices[int(rng.integers(len(choices)))]
-    drawn: dict = {"kind": choice["kind"], "joints": list(choice.get("joints", []))}
-    if choice["kind"] == "tremor":
-        lo, hi = choice["amplitude_rad"]
-        drawn["amplitude"] = {j: float(rng.uniform(lo, hi)) for j in drawn["joints"]}
-    elif choice["kind"] == "weakness":
-        drawn["strength"] = float(rng.uniform(*choice["strength"]))
-    elif choice["kind"] == "limited_range":
-        gamma = float(rng.uniform(*choice["scale"]))
-        drawn["scale"] = gamma
-        drawn["limits"] = {j: (lo * gamma, hi * gamma) for j, (lo, hi) in choice["limits"].items()}
-    return drawn
+def draw_surface_point(capsules, rng: np.random.Generator) -> tuple[str, np.ndarray, np.ndarray]:
+    """A point on one of the limbs' capsules, as the reference draws an itch (facts §2.1): a limb
+    uniformly, the distance from its joint end U(r, L) along the axis, the azimuth U(0, 2π).
+    Returns (link, point, outward normal, axis away from the joint), in the link frame (m)."""
+    cap = capsules[int(rng.integers(len(capsules)))]
+    start, end = np.asarray(cap.start), np.asarray(cap.end)
+    length = float(np.linalg.norm(end - start))
+    axis = (end - start) / length
+    helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    u = np.cross(axis, helper)
+    u /= np.linalg.norm(u)
+    v = np.cross(axis, u)
+    along = rng.uniform(min(cap.radius, length), length)
+    azimuth = rng.uniform(0.0, 2 * np.pi)
+    normal = np.cos(azimuth) * u + np.sin(azimuth) * v
+    return cap.link, start + axis * along + cap.radius * normal, normal, axis
 
 
 class AssistiveEnv(gym.Env):
@@ -98,6 +110,9 @@ class AssistiveEnv(gym.Env):
 
         self.obs_fns = [bind_term(t, self.snap) for t in m.observations["robot"]]
         self.reward_fns = [(t.name, t.weight, bind_term(t, self.snap)) for t in m.reward]
+        self._term_resets = [fn.reset for _, _, fn in self.reward_fns if hasattr(fn, "reset")]
+        self.markers = MarkerSystem(self.world, self.snap)
+        self.success_threshold = m.success.threshold
         self.tool_point = self.snap.point({"body": "robot", "link": m.robot.links["tool_mount"]})
         self._force_on_person = ([b.name for b in m.bodies if b.kind in ("robot", "tool")], ["person"])
         obs_size = sum(t.size for t in m.observations["robot"])
@@ -108,7 +123,15 @@ class AssistiveEnv(gym.Env):
         self.steps = 0
         self.success_metric: float | None = None
         self._stepped = False
-        self._tremor: list[tuple[int, float]] = []
+        # The person: holds, impairments, the human agent's policy joints (see runtime/human.py).
+        self.human = PersonController(self.world, m, self.artifact_dir)
+        n_human = len(m.person.policy_joints)
+        self.human_action_space = gym.spaces.Box(-1.0, 1.0, (n_human,), np.float32) if n_human else None
+        human_terms = m.observations.get("human", [])
+        self.human_obs_fns = [bind_term(t, self.snap) for t in human_terms]
+        bounds = np.cumsum([0] + [t.size for t in human_terms])
+        self._human_obs_slices = [slice(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
+        self.human_observation_space = gym.spaces.Box(-np.inf, np.inf, (int(bounds[-1]),), np.float32)
 
     @classmethod
     def from_spec(cls, spec: str | Path, robot: str | None = None, out_dir: str | Path | None = None, **kwargs) -> "AssistiveEnv":
@@ -136,30 +159,19 @@ class AssistiveEnv(gym.Env):
             parked = (PARK[0] + 10.0 * i, PARK[1], PARK[2])
             w.set_base_frame(w.variant_bodies[v.name], body.position if v.name == variant.name else parked, body.orientation)
         person = w.variant_bodies[variant.name]
-        angles = {j: variant.initial_angles[j] for j in variant.movable_joints}
-        for j, (lo, hi) in variant.randomize.items():
-            angles[j] = float(rng.uniform(lo, hi))
-        impairment = self.impairment = draw_impairment(m.person.impairments, rng)
-        for j, (lo, hi) in impairment.get("limits", {}).items():  # limited range: stay inside γ·limits
-            angles[j] = min(max(angles[j], lo), hi)
-        idx = [person.joints[j] for j in variant.movable_joints]
-        for i, j in zip(idx, variant.movable_joints):
-            pb.resetJointState(person.id, i, angles[j], physicsClientId=c)
-        self._person_hold = (person.id, idx, [angles[j] for j in variant.movable_joints])
-        # Held stiffly, or compliantly (a weak hold that yields to contact) where the spec says so;
-        # weakness scales the force of the joints it names.
-        strength = impairment.get("strength", 1.0)
-        compliant = set(m.person.compliant_joints)
-        self._person_gains = [m.person.compliant_gain if j in compliant else m.person.hold_gain for j in variant.movable_joints]
-        self._person_forces = [(m.person.compliant_force if j in compliant else m.person.hold_force)
-                               * (strength if j in impairment.get("joints", ()) else 1.0) for j in variant.movable_joints]
-        self._tremor = [(k, impairment["amplitude"][j]) for k, j in enumerate(variant.movable_joints) if j in impairment.get("amplitude", {})]
-        if idx:
-            pb.setJointMotorControlArray(person.id, idx, pb.POSITION_CONTROL, targetPositions=self._person_hold[2],
-                                         positionGains=self._person_gains, forces=self._person_forces, physicsClientId=c)
+        # Joint angles (randomised), the impairment, and the hold: all drawn and set by the person controller.
+        impairment = self.impairment = self.human.reset(variant, rng)
         for name, offset in variant.target_offsets.items():
             if name in self.snap.target_offsets:
                 self.snap.target_offsets[name] = np.asarray(offset, dtype=float)
+        for name, capsules in variant.surfaces.items():  # e.g. the itch: a new spot every episode
+            link, point, normal, axis = draw_surface_point(capsules, rng)
+            self.snap.place_target(name, link, point, normal, axis)
+        self.markers.reset(variant)
+        for reset_term in self._term_resets:
+            reset_term()
+        if m.success.fraction_of is not None:
+            self.success_threshold = m.success.threshold * self.markers.count(m.success.fraction_of)
         # Robot: one precomputed start — base pose and arm configuration (no IK), gripper at its task position.
         k = int(rng.integers(len(variant.starts)))
         start = variant.starts[k]
@@ -198,6 +210,24 @@ class AssistiveEnv(gym.Env):
         return self._observe(), {"person_variant": variant.name, "start": k, "impairment": impairment}
 
     def step(self, action):
+        """One env step of the robot; the person holds (or tremors) as the spec says."""
+        return self._step(action, None)
+
+    def step_agents(self, robot_action, human_action):
+        """One env step of both agents (co-optimisation): ``human_action`` in ``human_action_space``
+        drives the person's policy joints (see :mod:`.human`); None makes it a plain :meth:`step`.
+        Returns (robot observation, human observation, reward, terminated, truncated, info)."""
+        obs, reward, terminated, truncated, info = self._step(robot_action, human_action)
+        return obs, self.observe_human(), reward, terminated, truncated, info
+
+    def observe_human(self) -> np.ndarray:
+        """The person's observation: the spec's human features concatenated (float32)."""
+        obs = np.empty(self.human_observation_space.shape, dtype=np.float32)
+        for fn, where in zip(self.human_obs_fns, self._human_obs_slices):
+            obs[where] = fn(self.snap)
+        return obs
+
+    def _step(self, action, human_action):
         m, w, c = self.manifest, self.world, self.world.client
         raw = np.asarray(action, dtype=np.float64).reshape(-1)
         if raw.shape != (len(self.arm_idx),):
@@ -206,20 +236,17 @@ class AssistiveEnv(gym.Env):
         target = np.clip(q + self.delta_scale * np.clip(raw, -1.0, 1.0), self.lower, self.upper)
         pb.setJointMotorControlArray(w.robot.id, self.arm_idx, pb.POSITION_CONTROL, targetPositions=target.tolist(),
                                      positionGains=self._gains, forces=self._forces, physicsClientId=c)
-        if self._tremor:  # the paper's tremor: q̄ + ε·(−1)^t, the sign flipping every env step
-            person_id, idx, hold = self._person_hold
-            sign = 1.0 if self.steps % 2 == 0 else -1.0
-            targets = list(hold)
-            for k, eps in self._tremor:
-                targets[k] = hold[k] + sign * eps
-            pb.setJointMotorControlArray(person_id, idx, pb.POSITION_CONTROL, targetPositions=targets,
-                                         positionGains=self._person_gains, forces=self._person_forces, physicsClientId=c)
+        # The person: held / tremoring without a human action, else its policy joints act (runtime/human.py).
+        human = None if human_action is None else np.asarray(human_action, dtype=np.float64).reshape(-1)
+        self.human.apply(human, self.steps)
+        self.snap.actions["human"] = np.zeros(0) if human is None else human
         w.step_physics()
         self._stepped = True
         self.steps += 1
         self.snap.actions["robot"] = raw
         self.snap.refresh()
         self.particles.update()
+        self.markers.update()
 
         values = {name: float(fn(self.snap)) for name, _, fn in self.reward_fns}
         reward = float(sum(weight * values[name] for name, weight, _ in self.reward_fns))
@@ -227,7 +254,7 @@ class AssistiveEnv(gym.Env):
         info = {
             "terms": values,
             "total_force_on_human": self.snap.contact_force(*self._force_on_person),
-            "task_success": int(metric >= m.success.threshold),
+            "task_success": int(metric >= self.success_threshold),
             "success_metric": metric,
         }
         truncated = self.steps >= m.sim.episode_steps

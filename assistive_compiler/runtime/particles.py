@@ -72,6 +72,11 @@ class ParticleSystem:
                 lost_id = holder.id
                 frame = w.link_frame(holder, holder.links[ps.lost_link])
                 anchor = pb.multiplyTransforms(*frame, ps.lost_anchor, (0, 0, 0, 1))[0]
+            inside = None
+            if ps.outside_of is not None:  # particles still in their container are neither consumed nor lost
+                box = ps.outside_of
+                holder = w.bodies[box.body]
+                inside = (pb.invertTransform(*w.link_frame(holder, holder.links[box.link])), box.radius, box.height)
             for k, pid in enumerate(ids):
                 if not active[k]:
                     continue
@@ -79,6 +84,11 @@ class ParticleSystem:
                 if pid in hit_ids and not hit[k]:
                     hit[k] = True
                     ev.hit += 1
+                if inside is not None:
+                    (inv_pos, inv_orn), radius, height = inside
+                    x, y, z = pb.multiplyTransforms(inv_pos, inv_orn, pos, (0, 0, 0, 1))[0]
+                    if x * x + y * y <= radius * radius and -radius <= z <= height:
+                        continue
                 if centre is not None and math.dist(pos, centre) < ps.consumed_radius:
                     ev.consumed += 1
                     ev.consumed_speed_sum += math.hypot(*base_velocity(pid, physicsClientId=c)[0])

@@ -11,39 +11,13 @@ Units: metres, m/s, newtons; quaternions (x, y, z, w); world frame unless a meth
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pybullet as pb
 
+from ..quat import quat_conj, quat_mul, quat_rotate  # noqa: F401  (re-exported)
 from .world import World
-
-
-def quat_rotate(q, v) -> np.ndarray:
-    """Rotate vector ``v`` by unit quaternion ``q`` (x, y, z, w). Scalar arithmetic: for one
-    3-vector this is ~20× faster than numpy's cross products."""
-    x, y, z, w = q
-    vx, vy, vz = v
-    tx, ty, tz = 2.0 * (y * vz - z * vy), 2.0 * (z * vx - x * vz), 2.0 * (x * vy - y * vx)
-    return np.array([
-        vx + w * tx + (y * tz - z * ty),
-        vy + w * ty + (z * tx - x * tz),
-        vz + w * tz + (x * ty - y * tx),
-    ])
-
-
-def quat_conj(q: np.ndarray) -> np.ndarray:
-    return np.array([-q[0], -q[1], -q[2], q[3]])
-
-
-def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    return np.array([
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-        aw * bw - ax * bx - ay * by - az * bz,
-    ])
 
 
 @dataclass(frozen=True)
@@ -85,8 +59,11 @@ class Snapshot:
         self._slots: dict[tuple[str, int], int] = {}
         self._reads: dict[str, _BodyReads] = {}
         self.target_offsets: dict[str, np.ndarray] = {}
+        self.target_slots: dict[str, int] = {}  # a surface-drawn target moves between limbs per episode
+        self.target_normals: dict[str, np.ndarray] = {}  # outward surface normals (link frame)
+        self.target_axes: dict[str, np.ndarray] = {}  # limb axes away from the joint (link frame)
         self.actions: dict[str, np.ndarray] = {"robot": np.zeros(0), "human": np.zeros(0)}
-        self.events: dict[str, ParticleEvents] = {}
+        self.events: dict[str, Any] = {}  # per particle set: ParticleEvents; per marker set: markers cleared (int)
         self._contacts: dict[tuple[int, int], tuple] = {}
         self._joint_cache: dict[JointsHandle, np.ndarray] = {}
         self.pos, self.orn, self.vel = np.zeros((0, 3)), np.zeros((0, 4)), np.zeros((0, 3))
@@ -110,8 +87,24 @@ class Snapshot:
             t = self.world.m.targets[ref["target"]]
             slot = self._slot(t.body, t.link)
             self.target_offsets.setdefault(ref["target"], np.asarray(t.offset, dtype=float))
+            self.target_slots.setdefault(ref["target"], slot)
             return PointHandle(slot, ref["target"])
         return PointHandle(self._slot(ref["body"], ref["link"]))
+
+    def place_target(self, name: str, link_name: str, offset, normal=None, axis=None) -> None:
+        """Put target ``name`` on person link ``link_name`` at ``offset`` (link frame, m) for this
+        episode, with an outward surface ``normal`` and the limb ``axis`` (link frame, unit) when
+        it lies on a limb's surface."""
+        self.target_slots[name] = self._slot("person", link_name)
+        self.target_offsets[name] = np.asarray(offset, dtype=float)
+        if normal is not None:
+            self.target_normals[name] = np.asarray(normal, dtype=float)
+        if axis is not None:
+            self.target_axes[name] = np.asarray(axis, dtype=float)
+
+    def link_slot(self, body: str, link_name: str) -> int:
+        """The slot of a link (read every step from now on)."""
+        return self._slot(body, link_name)
 
     def _slot(self, body: str, link_name: str) -> int:
         key = self.body_key(body)
@@ -164,16 +157,28 @@ class Snapshot:
 
     # -- what terms read ----------------------------------------------------------------------
     def position(self, h: PointHandle) -> np.ndarray:
-        p = self.pos[h.slot]
         if h.target is None:
-            return p.copy()
-        return p + quat_rotate(self.orn[h.slot], self.target_offsets[h.target])
+            return self.pos[h.slot].copy()
+        slot = self.target_slots[h.target]
+        return self.pos[slot] + quat_rotate(self.orn[slot], self.target_offsets[h.target])
 
     def orientation(self, h: PointHandle) -> np.ndarray:
-        return self.orn[h.slot].copy()
+        return self.orn[h.slot if h.target is None else self.target_slots[h.target]].copy()
 
     def velocity(self, h: PointHandle) -> np.ndarray:
-        return self.vel[h.slot].copy()
+        return self.vel[h.slot if h.target is None else self.target_slots[h.target]].copy()
+
+    def normal(self, h: PointHandle) -> np.ndarray:
+        """Outward surface normal at a surface-drawn target, world frame (zero for other points)."""
+        if h.target is None or h.target not in self.target_normals:
+            return np.zeros(3)
+        return quat_rotate(self.orn[self.target_slots[h.target]], self.target_normals[h.target])
+
+    def axis(self, h: PointHandle) -> np.ndarray:
+        """Limb axis (away from its joint) at a surface-drawn target, world frame (zero for other points)."""
+        if h.target is None or h.target not in self.target_axes:
+            return np.zeros(3)
+        return quat_rotate(self.orn[self.target_slots[h.target]], self.target_axes[h.target])
 
     def joint_angles(self, h: JointsHandle) -> np.ndarray:
         q = self._joint_cache.get(h)
@@ -223,6 +228,23 @@ class Snapshot:
     def begin_episode(self) -> None:
         """Forget what depended on the last episode's person variant."""
         self._ids.clear()
+
+    def contacts(self, a, b) -> list:
+        """pybullet contact points between any body of ``a`` (as bodyA) and any of ``b`` this step."""
+        out: list = []
+        for ia in self.body_ids(a):
+            for ib in self.body_ids(b):
+                out.extend(self._contact_points(ia, ib))
+        return out
+
+    def closest_distance(self, a: str, b, max_distance: float) -> float:
+        """Smallest surface distance between body ``a`` and any body of ``b`` within ``max_distance`` (m)."""
+        ia = self.body_ids([a])[0]
+        best = max_distance
+        for ib in self.body_ids(b):
+            for cp in pb.getClosestPoints(ia, ib, max_distance, physicsClientId=self.world.client):
+                best = min(best, cp[8])
+        return best
 
     def contact_force(self, a, b, near: PointHandle | None = None, radius: float = 0.0) -> float:
         """Σ normal force (N) of contacts between any body of ``a`` and any of ``b``; with ``near``,

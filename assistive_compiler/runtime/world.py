@@ -10,6 +10,11 @@ compensated links, and every movable link of a body with a different gravity get
 force m·(g_body − g_world) at its centre of mass before each physics step (forces are cleared by
 ``stepSimulation``). The effect on those links is exactly the body's own gravity.
 
+Person self-collision: a person body whose manifest lists self-collision pairs is loaded with
+``URDF_USE_SELF_COLLISION`` and only those link pairs collide (:meth:`World._set_self_collision`);
+every other body loads as before. :attr:`World.after_physics_step`, when set, runs after each
+physics step of :meth:`step_physics` (the person's limit enforcement).
+
 Frames: pybullet reports a base's pose at its centre of mass; :meth:`base_frame` and
 :meth:`set_base_frame` convert to and from the URDF frame the manifest uses.
 """
@@ -18,6 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import pybullet as pb
 
@@ -43,6 +49,9 @@ class World:
     def __init__(self, artifact_dir: str | Path, manifest: Manifest | None = None):
         self.dir = Path(artifact_dir)
         self.m = manifest or Manifest.read(self.dir)
+        #: Called after every ``stepSimulation`` of :meth:`step_physics` when set (the person's
+        #: joint-limit and arm-limit enforcement); None costs nothing.
+        self.after_physics_step: Callable[[], None] | None = None
         self._build()
 
     def rebuild(self) -> None:
@@ -68,8 +77,13 @@ class World:
         self.bodies: dict[str, BodyHandle] = {}
         for body in self.m.bodies:
             flags = pb.URDF_USE_INERTIA_FROM_FILE
+            self_collision = body.kind == "person" and bool(self.m.person.self_collision)
+            if self_collision:
+                flags |= pb.URDF_USE_SELF_COLLISION
             bid = pb.loadURDF(str(self.dir / body.urdf), body.position, body.orientation, useFixedBase=body.fixed_base, flags=flags, physicsClientId=c)
             self.bodies[body.name] = self._handle(body.name, bid)
+            if self_collision:
+                self._set_self_collision(self.bodies[body.name])
             if body.friction is not None:
                 for link in [-1, *range(pb.getNumJoints(bid, physicsClientId=c))]:
                     pb.changeDynamics(bid, link, lateralFriction=body.friction, physicsClientId=c)
@@ -86,7 +100,8 @@ class World:
         self._create_markers()
         self._set_gravity()
         self._set_stepping()
-        self._all_bodies = [b for b in range(pb.getNumBodies(physicsClientId=c)) if b != self.ground]
+        visual_only = {b for bodies in self.marker_visuals.values() for b in bodies} | set(self.markers.values())
+        self._all_bodies = [b for b in range(pb.getNumBodies(physicsClientId=c)) if b != self.ground and b not in visual_only]
         # Bodies at rest would otherwise fall asleep after ~2 s; sleep is not part of a saved state,
         # so an episode would depend on how long the previous one left something resting.
         for bid in self._all_bodies:
@@ -104,6 +119,31 @@ class World:
             links[info[12].decode()] = j
         ipos, iorn = pb.getDynamicsInfo(bid, -1, physicsClientId=c)[3:5]
         return BodyHandle(name, bid, links, joints, pb.invertTransform(ipos, iorn))
+
+    def _set_self_collision(self, handle: BodyHandle) -> None:
+        """Self-collision of a person body (facts §3.3): every link pair off, then the pairs the
+        compiler chose (``manifest.person.self_collision``, link names) on.
+
+        The compiler lists only pairs between links that move relative to each other, of the
+        reference's groups (an arm or leg against the rest), for the groups that move in the task,
+        and leaves out pairs already touching at the rest pose; see
+        :func:`assistive_compiler.compile.compiler.person_self_collision`. Pybullet never collides
+        a link with its direct parent (the ``URDF_USE_SELF_COLLISION`` default), nor does the list.
+        """
+        c, bid = self.client, handle.id
+        links = sorted(handle.links.values())
+        for i, a in enumerate(links):
+            for b in links[i + 1:]:
+                pb.setCollisionFilterPair(bid, bid, a, b, 0, physicsClientId=c)
+        for a, b in self.m.person.self_collision:
+            if a in handle.links and b in handle.links:
+                pb.setCollisionFilterPair(bid, bid, handle.links[a], handle.links[b], 1, physicsClientId=c)
+        # Saved at its initial pose (free of self-contact, the compiler checked), not at zero angles
+        # (a straight arm touches the hips): restore() runs a collision pass on the saved state.
+        for v in self.m.person.variants:
+            if v.body == handle.name:
+                for name, q in v.initial_angles.items():
+                    pb.resetJointState(bid, handle.joints[name], q, physicsClientId=c)
 
     def _attach_tools(self) -> None:
         c = self.client
@@ -136,13 +176,20 @@ class World:
             self.particles[ps.name] = ids
 
     def _create_markers(self) -> None:
-        """Visual-only spheres for targets that ask to be shown (created before the state is saved)."""
+        """Visual-only spheres for targets and marker sets that ask to be shown (created before the
+        state is saved; they have no collision shape, so physics never sees them)."""
         c = self.client
         self.markers: dict[str, int] = {}
         for name, t in self.m.targets.items():
             if t.show_rgba is not None:
                 vis = pb.createVisualShape(pb.GEOM_SPHERE, radius=0.012, rgbaColor=list(t.show_rgba), physicsClientId=c)
                 self.markers[name] = pb.createMultiBody(0, -1, vis, list(PARK), physicsClientId=c)
+        self.marker_visuals: dict[str, list[int]] = {}
+        for ms in self.m.markers:
+            if ms.show_rgba is not None:
+                count = max(len(v.markers.get(ms.name, [])) for v in self.m.person.variants)
+                vis = pb.createVisualShape(pb.GEOM_SPHERE, radius=0.008, rgbaColor=list(ms.show_rgba), physicsClientId=c)
+                self.marker_visuals[ms.name] = [pb.createMultiBody(0, -1, vis, list(PARK), physicsClientId=c) for _ in range(count)]
 
     def _set_gravity(self) -> None:
         """Choose the world gravity needing the fewest compensated links; list those links."""
@@ -213,9 +260,12 @@ class World:
     # -- per step ------------------------------------------------------------------------------
     def step_physics(self) -> None:
         """Advance one env step (frame_skip physics steps) with per-body gravity compensation."""
+        after = self.after_physics_step
         for _ in range(self.m.sim.frame_skip):
             self._apply_gravity_compensation()
             pb.stepSimulation(physicsClientId=self.client)
+            if after is not None:
+                after()
 
     def _apply_gravity_compensation(self) -> None:
         c = self.client

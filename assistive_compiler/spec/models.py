@@ -230,6 +230,36 @@ class PersonControl(Strict):
     compliant: CompliantHold | None = Field(None, description="Joints held compliantly in the static-person task.")
     position_gain: float = Field(0.05, gt=0, le=1, description="Position gain of policy-controlled joints.")
     max_force_nm: float = Field(1.0, gt=0, description="Force limit of policy-controlled joints, N·m.")
+    action_scale_rad: float = Field(
+        0.05, gt=0, le=1, description="Policy-joint target change per unit human action per physics step, radians (the reference: 0.05)."
+    )
+    arm_limits: str = Field(
+        "analytic",
+        description="Pose-dependent shoulder-elbow limits enforced after every physics step on the arm whose shoulder (3 axes) "
+        "and elbow are policy joints (the right one if both; facts §3.6): 'analytic' (the built-in model), 'none', or the "
+        "path of a .npz MLP (arrays W0, b0, W1, b1, ...; relative to the spec file that says it).",
+    )
+
+    @field_validator("arm_limits")
+    @classmethod
+    def _arm_limit_model(cls, v: str) -> str:
+        if v in ("none", "analytic") or (v.lower().endswith(".npz") and len(v) > 4):
+            return v
+        from ..errors import did_you_mean
+
+        raise ValueError(f"must be 'analytic', 'none' or the path of a .npz file, got '{v}'{did_you_mean(v, ['analytic', 'none'])}")
+
+
+class Settle(Strict):
+    """Compile-time settling, as the reference does at every reset in the bed tasks: the body with a
+    free base and limp joints (each angle perturbed by U(±joint_noise_rad)) falls for ``steps``
+    physics steps under ``gravity_mps2`` onto the furniture; the settled base pose and joint angles
+    are then stored (static joints baked at them), so reset() does not settle again."""
+
+    steps: int = Field(100, ge=1, le=5000, description="Physics steps to settle (the reference: 100 = 2 s).")
+    gravity_mps2: float = Field(-1.0, ge=-20, lt=0, description="Gravity while settling, m/s² (the reference: −1).")
+    joint_noise_rad: float = Field(0.1, ge=0, le=1, description="Half-width of the uniform noise on every joint angle, rad.")
+    friction: float | None = Field(None, ge=0, description="Friction of the furniture while settling (the reference: 5); None keeps it.")
 
 
 class Placement(Strict):
@@ -241,6 +271,9 @@ class Placement(Strict):
     position_m: Vec3 | None = Field(None, description="Explicit chest position in the world, metres.")
     rpy_deg: Vec3 = Field((0.0, 0.0, 0.0), description="Chest orientation (roll, pitch, yaw) in degrees.")
     offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Added to the seat-derived position, metres.")
+    settle: "Settle | None" = Field(
+        None, description="Let the limp body fall onto the furniture at compile time and keep the settled pose (supine people)."
+    )
 
     @model_validator(mode="after")
     def _one_way(self) -> "Placement":
@@ -368,14 +401,47 @@ class ToolUse(Strict):
 
 
 class Target(Strict):
-    """A named point attached to a link: e.g. the mouth is the head link plus an offset."""
+    """A named point attached to a link: e.g. the mouth is the head link plus an offset; or a point
+    drawn on a limb's surface at every reset (e.g. an itch on the right arm)."""
 
-    link: Ref = Field(description="The link it is attached to, e.g. person.head.")
+    link: Ref | None = Field(None, description="The link it is attached to, e.g. person.head (or give surface_of).")
+    surface_of: list[Ref] = Field(
+        default_factory=list,
+        description="Person limbs (capsule links, e.g. person.right_shoulder = the upper arm) to draw the point on at "
+        "every reset: a limb uniformly, then the distance from its joint U(r, L) along the capsule and the azimuth "
+        "U(0, 2π) (the reference's itch target).",
+    )
     offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Offset in the link frame, metres.")
     offset_by_variant: dict[Name, Vec3] = Field(
         default_factory=dict, description="Per person-variant offsets replacing offset_m (e.g. female mouth)."
     )
     show_rgba: Rgba | None = Field(None, description="Draw a small sphere there in renders (no collision).")
+
+    @model_validator(mode="after")
+    def _one_place(self) -> "Target":
+        if (self.link is None) == (not self.surface_of):
+            raise ValueError("give exactly one of 'link' (a fixed point) or 'surface_of' (a point drawn on limbs at every reset)")
+        if self.surface_of and (self.offset_m != (0.0, 0.0, 0.0) or self.offset_by_variant):
+            raise ValueError("@surface_of: a target drawn on a surface takes no offset_m or offset_by_variant")
+        return self
+
+
+class ClearedBy(Strict):
+    """A marker is cleared when a contact between this tool link and the person lies within radius of it."""
+
+    tool: Ref = Field(description="The tool link that clears markers, e.g. wiper.surface.")
+    radius_m: float = Field(0.025, gt=0, le=0.5, description="Clearing radius around a contact point, metres.")
+
+
+class Markers(Strict):
+    """Points laid out in rings around person limbs (e.g. spots to wipe in bed bathing): rings every
+    ``spacing_m`` along each capsule, points every ``spacing_m`` around each ring (the reference's
+    capsule_points). Each is cleared once per episode."""
+
+    surface_of: list[Ref] = Field(min_length=1, description="Person limbs (capsule links) to cover, e.g. person.right_shoulder.")
+    spacing_m: float = Field(0.03, gt=0.005, le=0.5, description="Distance between rings and between points on a ring, metres.")
+    cleared_by: ClearedBy = Field(description="What clears a marker.")
+    show_rgba: Rgba | None = Field(None, description="Draw the markers not yet cleared as small spheres in renders.")
 
 
 class ConsumedAt(Strict):
@@ -383,6 +449,9 @@ class ConsumedAt(Strict):
 
     target: Ref = Field(description="The target that consumes particles, e.g. mouth.")
     radius_m: float = Field(gt=0, le=1, description="Consumption radius, metres.")
+    outside_of: Ref | None = Field(
+        None, description="A tool with a container (e.g. the cup): particles still inside it are not consumed or lost."
+    )
 
 
 class LostBeyond(Strict):
@@ -486,7 +555,7 @@ class Success(Strict):
     aggregate: Literal["sum", "max", "min", "last"] = Field(description="How the per-step values are combined.")
     threshold: float = Field(description="Success when aggregate ≥ threshold.")
     relative_to: Name | None = Field(
-        None, description="A particle set: the threshold is then a fraction (0, 1] of its count."
+        None, description="A particle or marker set: the threshold is then a fraction (0, 1] of its count."
     )
 
     @model_validator(mode="after")
@@ -506,6 +575,16 @@ class Waypoint(Strict):
     to: Ref = Field(description="Target or link the goal is relative to, e.g. mouth.")
     offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Goal offset from that point, world frame, metres.")
     tolerance_m: float = Field(0.02, ge=0, le=1, description="Distance at which the next waypoint starts, metres.")
+    normal_offset_m: float = Field(
+        0.0, ge=-0.5, le=0.5, description="Offset along the target's outward surface normal (targets drawn on a surface), metres."
+    )
+    axis_offset_m: float = Field(
+        0.0, ge=-0.5, le=0.5, description="Offset along the limb's axis, away from its joint (targets drawn on a surface), metres."
+    )
+    rpy_deg: Vec3 | None = Field(
+        None, description="Orientation of the moved point's link at this waypoint (roll, pitch, yaw; world, degrees), e.g. "
+        "to tilt a cup; None keeps the tool's start orientation."
+    )
 
 
 class Scripted(Strict):
@@ -514,7 +593,16 @@ class Scripted(Strict):
     reward wiring; it is not a learned policy."""
 
     move: Ref = Field(description="The point moved, e.g. spoon (its reference link) or spoon.tip.")
-    waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order; the last is held.")
+    waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order; the last is held unless repeat_from is given.")
+    repeat_from: int | None = Field(
+        None, ge=0, description="After the last waypoint, go on from this index (e.g. to rub back and forth); None holds the last."
+    )
+
+    @model_validator(mode="after")
+    def _repeat_in_range(self) -> "Scripted":
+        if self.repeat_from is not None and self.repeat_from >= len(self.waypoints):
+            raise ValueError(f"@repeat_from: repeat_from {self.repeat_from} is not a waypoint index (0..{len(self.waypoints) - 1})")
+        return self
 
 
 # --------------------------------------------------------------------------------------------
@@ -535,6 +623,7 @@ class TaskSpec(Strict):
     tools: dict[Name, ToolUse] = Field(default_factory=dict, description="Tools by name.")
     targets: dict[Name, Target] = Field(default_factory=dict, description="Named points on bodies.")
     particles: dict[Name, Particles] = Field(default_factory=dict, description="Particle sets by name.")
+    markers: dict[Name, Markers] = Field(default_factory=dict, description="Marker sets on the person by name (e.g. spots to wipe).")
     observations: Observations = Field(description="Observation features per agent.")
     reward: list[RewardTerm] = Field(min_length=1, description="Weighted reward terms.")
     preferences: Preferences = Field(default_factory=Preferences, description="Human-preference costs.")

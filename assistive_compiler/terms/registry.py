@@ -23,7 +23,7 @@ from pydantic import BaseModel, ConfigDict
 class RefKind:
     """Marks a parameter field as a reference of a kind the resolver checks and the runtime binds."""
 
-    kind: Literal["point", "body", "bodies", "joints", "particles", "frame"]
+    kind: Literal["point", "body", "bodies", "joints", "particles", "markers", "frame"]
 
 
 PointRef = Annotated[str, RefKind("point")]
@@ -36,6 +36,8 @@ JointsRef = Annotated[str, RefKind("joints")]
 """A joint group: ``robot.arm`` or ``person.<group>``."""
 ParticlesRef = Annotated[str, RefKind("particles")]
 """A particle set name."""
+MarkersRef = Annotated[str, RefKind("markers")]
+"""A marker set name."""
 FrameRef = Annotated[Literal["world", "robot_base", "person_base"], RefKind("frame")]
 """An observation frame: the world, the robot's base or the person's base (chest)."""
 
@@ -84,7 +86,11 @@ def term(
     params: type[Params] = NoParams,
     size: Callable[[Any, SizeContext], int] | int | None = None,
 ) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
-    """Register ``fn(snapshot, params)`` as the term ``name`` of ``category``."""
+    """Register ``fn(snapshot, params)`` as the term ``name`` of ``category``.
+
+    A term with memory across steps (an event counter with hysteresis) is a class instead: the
+    runtime makes one instance per environment, calls it like a function each step and calls its
+    ``reset()`` at the start of every episode."""
 
     def decorate(fn: Callable[..., Any]) -> Callable[..., Any]:
         if name in REGISTRY[category]:

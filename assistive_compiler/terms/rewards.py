@@ -7,7 +7,11 @@ from __future__ import annotations
 import math
 from typing import Literal
 
-from .registry import BodiesRef, Params, ParticlesRef, PointRef, term
+import numpy as np
+from pydantic import Field
+
+from ..quat import quat_rotate
+from .registry import BodiesRef, BodyRef, MarkersRef, Params, ParticlesRef, PointRef, term
 
 
 class Distance(Params):
@@ -56,3 +60,79 @@ def particles_lost(snap, p) -> float:
 def contact_force(snap, p) -> float:
     """Sum of contact normal forces between bodies ``a`` and ``b`` this step (N)."""
     return float(snap.contact_force(p.a, p.b))
+
+
+class ContactEvents(Params):
+    tool: BodiesRef
+    on: BodiesRef
+    target: PointRef
+    radius_m: float = Field(0.025, gt=0, description="Contacts within this distance of the target count, m.")
+    min_move_m: float = Field(0.01, ge=0, description="An event needs the contact to have moved this far since the last event, m.")
+    max_force_n: float = Field(10.0, gt=0, description="An event needs the force at the target below this, N.")
+
+
+@term("contact_events", "reward", ContactEvents)
+class ContactEventCounter:
+    """1 when the tool touches the person near the target gently and has moved since the last
+    event, else 0 (count; the reference's scratch: within 2.5 cm, moved > 1 cm, force < 10 N).
+
+    The contact point p_c is the last contact of ``tool`` with ``on`` within ``radius_m`` of the
+    target (the point on the tool); the force is the sum of those contacts' normal forces. An event
+    fires when force < ``max_force_n`` and p_c lies farther than ``min_move_m`` from the contact
+    point of the previous event (or there was none this episode) — a hysteresis, so resting on the
+    spot counts once, and rubbing back and forth counts every stroke."""
+
+    def __init__(self) -> None:
+        self.last: tuple[float, float, float] | None = None
+
+    def reset(self) -> None:
+        self.last = None
+
+    def __call__(self, snap, p) -> float:
+        centre = snap.position(p.target)
+        near = [cp for cp in snap.contacts(p.tool, p.on) if math.dist(cp[5], centre) <= p.radius_m]
+        if not near:
+            return 0.0
+        force = sum(cp[9] for cp in near)
+        point = near[-1][5]
+        if force < p.max_force_n and (self.last is None or math.dist(point, self.last) > p.min_move_m):
+            self.last = point
+            return 1.0
+        return 0.0
+
+
+class Tilt(Params):
+    of: PointRef
+    axis: tuple[float, float, float] = Field((0.0, 0.0, 1.0), description="Axis in the point's link frame (unit vector not required).")
+    up: tuple[float, float, float] = Field((0.0, 0.0, 1.0), description="World direction the axis should point along.")
+
+
+@term("tilt", "reward", Tilt)
+def tilt(snap, p) -> float:
+    """Angle between a link axis and a world direction (rad): 0 when a cup stands upright."""
+    a = quat_rotate(snap.orientation(p.of), p.axis)
+    up = np.asarray(p.up, dtype=float)
+    cos = float(np.dot(a, up) / (np.linalg.norm(a) * np.linalg.norm(up)))
+    return math.acos(min(1.0, max(-1.0, cos)))
+
+
+class ClosestDistance(Params):
+    a: BodyRef
+    b: BodiesRef
+    max_m: float = Field(5.0, gt=0, le=100, description="Search radius; farther counts as this distance, m.")
+
+
+@term("closest_distance", "reward", ClosestDistance)
+def closest_distance(snap, p) -> float:
+    """Smallest distance between the surfaces of body ``a`` and any of ``b`` (m; ≤ 0 when touching)."""
+    return snap.closest_distance(p.a, p.b, p.max_m)
+
+
+class MarkerSet(Params):
+    markers: MarkersRef
+
+
+@term("markers_cleared", "reward", MarkerSet)
+def markers_cleared(snap, p) -> float:
+    """Markers of the set cleared this step (count), e.g. spots wiped clean."""
+    return float(snap.events[p.markers])

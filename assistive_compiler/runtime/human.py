@@ -1,0 +1,240 @@
+"""The person as an agent: impairments, holds, policy control and the limits enforced on the body.
+
+:class:`PersonController` is the one place the runtime moves the person's joints. Per episode
+(:meth:`PersonController.reset`) it draws the impairment, sets the variant's joints to their
+(randomised) initial angles and holds them; per env step (:meth:`PersonController.apply`) it
+either keeps holding (no human action: the static, compliant or tremoring person of the
+single-agent task) or drives the policy joints from a human action; after every physics step
+(:meth:`PersonController.after_physics_step`, run by :meth:`World.step_physics` only when
+needed) it enforces the hard joint limits and the pose-dependent arm limits.
+
+Action application (facts §1, the same rule as the robot's): each policy joint's target is
+``q_measured + frame_skip · action_scale · clip(a, −1, 1)`` clamped to the joint's limits — the
+URDF limits, or the γ-scaled ones of a limited-range impairment — and one position-control
+command goes out per env step with gain ``person.position_gain`` and force ``person.max_force``.
+**Weakness** multiplies that force by the strength β for the joints the impairment names: this
+is the paper's / v0.1 behaviour (τ_max × β); v1.0 of the reference applies β only to the
+reactive hold of a static person. **Tremor** adds ε·(+1 on even env steps, −1 on odd ones) on
+top of the target, per affected joint; for a tremoring joint the target accumulates (the previous
+target without the tremor, plus the action) instead of starting from the measured angle — as the
+reference does, since a target built on the measured, oscillating angle would cancel the tremor
+one step later.
+
+Without a human action the person is not an agent for that step: every movable joint is held at
+its episode's initial angle (stiffly, or compliantly where the spec says so; weakness scales the
+hold's force; tremor oscillates the hold's target), exactly the behaviour of the single-agent
+env. Switching from acting back to holding returns the joints to those initial angles.
+
+After every physics step, when the person acts, tremors or has a limited range of motion:
+
+* **hard joint limits** (facts §3.2): a movable joint past its limit (γ-scaled under the
+  limited-range impairment, intersected with the URDF's) is reset to the limit with zero
+  velocity (episodes also start with every movable joint inside these limits);
+* **pose-dependent arm limits** (facts §3.6), only while the person acts and only when the policy
+  joints include a whole arm's shoulder (3 axes) and elbow — the right arm if its shoulder is
+  controlled, else the left: :class:`~assistive_compiler.person.arm_limits.ArmLimitGuard` with
+  the model the spec names (``person.control.arm_limits``: the built-in
+  :class:`~assistive_compiler.person.arm_limits.AnalyticArmLimits`, a user's ``.npz`` MLP, or
+  none). An invalid pose resets the four joints to the last valid pose with zero velocity.
+
+Units: radians, N·m. Joint orders: ``manifest.person.policy_joints`` (action order) and each
+variant's ``movable_joints``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pybullet as pb
+
+from ..artifact import Manifest, PersonVariant
+from ..person.arm_limits import ARM_LIMIT_JOINTS, AnalyticArmLimits, ArmLimitGuard, ArmLimitModel, MLPArmLimits
+from .world import World
+
+__all__ = ["PersonController", "draw_impairment", "arm_limit_model", "guarded_arm"]
+
+
+def draw_impairment(choices: list[dict], rng: np.random.Generator) -> dict:
+    """One impairment for an episode, drawn uniformly from the spec's choices, with its values:
+    ``amplitude`` (tremor ε per joint, rad), ``strength`` (weakness β) or ``limits`` (limited range:
+    each joint's limits × γ, as the paper scales them), plus the ``joints`` it affects."""
+    choice = choices[int(rng.integers(len(choices)))]
+    drawn: dict = {"kind": choice["kind"], "joints": list(choice.get("joints", []))}
+    if choice["kind"] == "tremor":
+        lo, hi = choice["amplitude_rad"]
+        drawn["amplitude"] = {j: float(rng.uniform(lo, hi)) for j in drawn["joints"]}
+    elif choice["kind"] == "weakness":
+        drawn["strength"] = float(rng.uniform(*choice["strength"]))
+    elif choice["kind"] == "limited_range":
+        gamma = float(rng.uniform(*choice["scale"]))
+        drawn["scale"] = gamma
+        drawn["limits"] = {j: (lo * gamma, hi * gamma) for j, (lo, hi) in choice["limits"].items()}
+    return drawn
+
+
+def guarded_arm(policy_joints: list[str]) -> str | None:
+    """The arm whose pose-dependent limits apply: the right one if its shoulder is a policy joint,
+    else the left; None unless that arm's shoulder_x/y/z and elbow are all policy joints."""
+    side = "right" if "right_shoulder_x" in policy_joints else "left"
+    return side if all(j in policy_joints for j in ARM_LIMIT_JOINTS[side]) else None
+
+
+def arm_limit_model(setting: str, artifact_dir: str | Path) -> ArmLimitModel | None:
+    """The model ``person.arm_limits`` names: None for 'none', the built-in analytic model, or the
+    MLP stored in the artifact (a path relative to it)."""
+    if setting == "none":
+        return None
+    if setting == "analytic":
+        return AnalyticArmLimits()
+    return MLPArmLimits.from_npz(Path(artifact_dir) / setting)
+
+
+class PersonController:
+    """Moves the active person variant's joints: holds, policy actions, tremor, limits."""
+
+    def __init__(self, world: World, manifest: Manifest, artifact_dir: str | Path):
+        self.world = world
+        self.m = manifest
+        person = manifest.person
+        self.policy_joints: list[str] = list(person.policy_joints)
+        self.delta_scale = person.action_scale * manifest.sim.frame_skip
+        c = world.client
+        # URDF limits of every variant's movable joints (the ids survive World.rebuild()).
+        self._urdf_limits: dict[str, tuple[list[float], list[float]]] = {}
+        for v in person.variants:
+            h = world.variant_bodies[v.name]
+            infos = [pb.getJointInfo(h.id, h.joints[j], physicsClientId=c) for j in v.movable_joints]
+            self._urdf_limits[v.name] = ([i[8] for i in infos], [i[9] for i in infos])
+        self.arm_side = guarded_arm(self.policy_joints)
+        model = arm_limit_model(person.arm_limits, artifact_dir) if self.arm_side else None
+        self.guard: ArmLimitGuard | None = ArmLimitGuard(model, self.arm_side) if model is not None else None
+        #: Arm-limit reverts so far this episode.
+        self.reverts = 0
+        self.impairment: dict[str, Any] = {"kind": "none", "joints": []}
+        self._acting = False
+        self._tremor: list[tuple[int, float]] = []
+
+    # -- per episode ---------------------------------------------------------------------------
+    def reset(self, variant: PersonVariant, rng: np.random.Generator) -> dict:
+        """Draw the episode's joint angles and impairment (in this order, from ``rng``), put the
+        variant's movable joints there and hold them. Returns the drawn impairment."""
+        m, w, c = self.m, self.world, self.world.client
+        person = w.variant_bodies[variant.name]
+        movable = variant.movable_joints
+        angles = {j: variant.initial_angles[j] for j in movable}
+        for j, (lo, hi) in variant.randomize.items():
+            angles[j] = float(rng.uniform(lo, hi))
+        impairment = self.impairment = draw_impairment(m.person.impairments, rng)
+        # Limits in movable order: the URDF's, narrowed to γ·limits under a limited range of motion
+        # (γ·limits of a range without 0, e.g. the right shoulder_x's 5°…198°, can reach past the
+        # URDF's own, which pybullet keeps enforcing: the effective range is the intersection).
+        lower, upper = (list(x) for x in self._urdf_limits[variant.name])
+        scaled = impairment.get("limits", {})
+        for k, j in enumerate(movable):
+            if j in scaled:
+                lower[k], upper[k] = max(lower[k], scaled[j][0]), min(upper[k], scaled[j][1])
+        self.lower, self.upper = lower, upper
+        for k, j in enumerate(movable):  # start inside the limits
+            angles[j] = min(max(angles[j], lower[k]), upper[k])
+        idx = [person.joints[j] for j in movable]
+        for i, j in zip(idx, movable):
+            pb.resetJointState(person.id, i, angles[j], physicsClientId=c)
+        self.body_id, self.idx = person.id, idx
+        self.hold = [angles[j] for j in movable]
+        # Held stiffly, or compliantly (a weak hold that yields to contact) where the spec says so;
+        # weakness scales the force of the joints it names.
+        strength = impairment.get("strength", 1.0)
+        weak = set(impairment.get("joints", ()))
+        compliant = set(m.person.compliant_joints)
+        self.hold_gains = [m.person.compliant_gain if j in compliant else m.person.hold_gain for j in movable]
+        self.hold_forces = [(m.person.compliant_force if j in compliant else m.person.hold_force)
+                            * (strength if j in weak else 1.0) for j in movable]
+        amplitude = impairment.get("amplitude", {})
+        self._tremor = [(k, amplitude[j]) for k, j in enumerate(movable) if j in amplitude]
+        if idx:
+            pb.setJointMotorControlArray(person.id, idx, pb.POSITION_CONTROL, targetPositions=self.hold,
+                                         positionGains=self.hold_gains, forces=self.hold_forces, physicsClientId=c)
+        # Policy joints: their places in the movable list, limits, gains and (weakened) forces.
+        pol = [movable.index(j) for j in self.policy_joints]
+        self._pol = pol
+        self.policy_idx = [idx[k] for k in pol]
+        self._pol_lower = np.array([lower[k] for k in pol])
+        self._pol_upper = np.array([upper[k] for k in pol])
+        self._pol_gains = [m.person.position_gain] * len(pol)
+        self.policy_forces = [m.person.max_force * (strength if j in weak else 1.0) for j in self.policy_joints]
+        tremor_at = dict(self._tremor)
+        self._pol_eps = np.array([tremor_at.get(k, 0.0) for k in pol])
+        self._pol_tremor = np.array([k in tremor_at for k in pol], dtype=bool)
+        self._base = np.array([self.hold[k] for k in pol])  # accumulated targets of tremoring policy joints
+        self._rest_tremor = [(k, e) for k, e in self._tremor if k not in set(pol)]
+        self._arm_k = [movable.index(j) for j in ARM_LIMIT_JOINTS[self.arm_side]] if self.guard else []
+        self.reverts = 0
+        self._acting = False
+        self._static_hook = bool(self._tremor) or bool(impairment.get("limits"))
+        if self.guard is not None:
+            self.guard.reset([self.hold[k] for k in self._arm_k])
+        self.world.after_physics_step = self.after_physics_step if self._static_hook else None
+        return impairment
+
+    # -- per env step --------------------------------------------------------------------------
+    def apply(self, action: np.ndarray | None, step_index: int) -> None:
+        """Send this env step's motor commands: hold (``action`` None) or act on the policy joints."""
+        c = self.world.client
+        sign = 1.0 if step_index % 2 == 0 else -1.0  # the paper's tremor: q̄ + ε·(−1)^t
+        if action is None:
+            if self._tremor or self._acting:
+                targets = list(self.hold)
+                for k, eps in self._tremor:
+                    targets[k] = self.hold[k] + sign * eps
+                pb.setJointMotorControlArray(self.body_id, self.idx, pb.POSITION_CONTROL, targetPositions=targets,
+                                             positionGains=self.hold_gains, forces=self.hold_forces, physicsClientId=c)
+            if self._acting:  # back to the hold: tremor targets accumulate from the hold pose again
+                self._base = np.array([self.hold[k] for k in self._pol])
+            self._acting = False
+        else:
+            a = np.clip(np.asarray(action, dtype=np.float64).reshape(-1), -1.0, 1.0)
+            if a.shape != (len(self.policy_idx),):
+                raise ValueError(f"human action must have shape ({len(self.policy_idx)},), got {a.shape}")
+            q = np.array([s[0] for s in pb.getJointStates(self.body_id, self.policy_idx, physicsClientId=c)])
+            base = np.where(self._pol_tremor, self._base, q)
+            target = np.clip(base + self.delta_scale * a, self._pol_lower, self._pol_upper)
+            self._base = target
+            command = target + sign * self._pol_eps
+            pb.setJointMotorControlArray(self.body_id, self.policy_idx, pb.POSITION_CONTROL, targetPositions=command.tolist(),
+                                         positionGains=self._pol_gains, forces=self.policy_forces, physicsClientId=c)
+            if self._rest_tremor:  # tremoring joints outside the policy keep their oscillating hold
+                ks = [k for k, _ in self._rest_tremor]
+                pb.setJointMotorControlArray(self.body_id, [self.idx[k] for k in ks], pb.POSITION_CONTROL,
+                                             targetPositions=[self.hold[k] + sign * e for k, e in self._rest_tremor],
+                                             positionGains=[self.hold_gains[k] for k in ks], forces=[self.hold_forces[k] for k in ks],
+                                             physicsClientId=c)
+            self._acting = True
+        self.world.after_physics_step = self.after_physics_step if (self._acting or self._static_hook) else None
+
+    @property
+    def acting(self) -> bool:
+        """Whether the last env step was driven by a human action."""
+        return self._acting
+
+    # -- per physics step ----------------------------------------------------------------------
+    def after_physics_step(self) -> None:
+        """Hard joint limits (reset to the limit, zero velocity), then, while acting, the arm guard."""
+        c, bid, idx = self.world.client, self.body_id, self.idx
+        q = [s[0] for s in pb.getJointStates(bid, idx, physicsClientId=c)]
+        lower, upper = self.lower, self.upper
+        for k, v in enumerate(q):
+            if v < lower[k]:
+                q[k] = lower[k]
+                pb.resetJointState(bid, idx[k], lower[k], 0.0, physicsClientId=c)
+            elif v > upper[k]:
+                q[k] = upper[k]
+                pb.resetJointState(bid, idx[k], upper[k], 0.0, physicsClientId=c)
+        if self.guard is not None and self._acting:
+            ks = self._arm_k
+            pose, reverted = self.guard.check([q[k] for k in ks])
+            if reverted:
+                self.reverts += 1
+                for k, v in zip(ks, pose.tolist()):
+                    pb.resetJointState(bid, idx[k], v, 0.0, physicsClientId=c)
