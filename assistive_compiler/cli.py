@@ -101,6 +101,23 @@ def cmd_schema(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def cmd_list(args: argparse.Namespace) -> int:
+    from .paths import display
+    from .registration import shipped_tasks
+
+    tasks = shipped_tasks()
+    if args.json:
+        print(json.dumps([{"task": t.name, "title": t.title, "spec": display(t.spec), "robots": t.robots, "ids": t.ids} for t in tasks], indent=2))
+        return EXIT_OK
+    robots = sorted({r for t in tasks for r in t.robots})
+    print(f"{len(tasks)} tasks x {len(robots)} robots ({', '.join(robots)}); Gymnasium ids (gymnasium.make after import assistive_compiler):")
+    for t in tasks:
+        print(f"  {t.title} ({t.name}, {display(t.spec)})")
+        for robot, env_id in zip(t.robots, t.ids):
+            print(f"    {robot:8s} {env_id}")
+    return EXIT_OK
+
+
 # --------------------------------------------------------------------------------------------
 
 
@@ -119,6 +136,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true", help="recompile even when the output is up to date")
     p.add_argument("--strict", action="store_true", help="also check every URDF with urdfdom, yourdfpy and pybullet")
     p.set_defaults(func=cmd_compile)
+
+    p = sub.add_parser("list", help="list the shipped tasks, their robots and Gymnasium ids")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=cmd_list)
 
     p = sub.add_parser("schema", help="print the JSON Schema of a task spec (or --terms: the term library)")
     p.add_argument("--terms", action="store_true", help="list registered terms and their parameters instead")

@@ -9,6 +9,7 @@ first use into the artifact cache (``$ASSISTIVE_COMPILER_CACHE``, default
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import yaml
@@ -23,18 +24,37 @@ def cache_dir() -> Path:
     return Path(root)
 
 
-def shipped_ids() -> dict[str, tuple[Path, str]]:
-    """Gymnasium id → (task spec path, robot name) for every shipped task and supported robot."""
-    out: dict[str, tuple[Path, str]] = {}
+@dataclass(frozen=True)
+class ShippedTask:
+    """A task spec shipped with the package, its supported robots and their Gymnasium ids."""
+
+    name: str
+    title: str
+    spec: Path
+    robots: list[str]
+    ids: list[str]
+
+
+def shipped_tasks() -> list[ShippedTask]:
+    """Every shipped task (``specs/tasks/*.yaml``), read with plain YAML (no validation, no compile)."""
+    out: list[ShippedTask] = []
     robots_dir = specs_dir() / "robots"
     for spec in sorted((specs_dir() / "tasks").glob("*.yaml")):
         data = yaml.safe_load(spec.read_text()) or {}
-        title = str(data.get("title", spec.stem)).replace(" ", "")
-        for robot in (data.get("robot") or {}).get("supported", []):
+        title = str(data.get("title", spec.stem))
+        robots = list((data.get("robot") or {}).get("supported", []))
+        ids = []
+        for robot in robots:
             robot_file = robots_dir / f"{robot}.yaml"
             robot_title = (yaml.safe_load(robot_file.read_text()) or {}).get("title", robot) if robot_file.is_file() else robot
-            out[f"{NAMESPACE}/{title}{robot_title}-v1"] = (spec, robot)
+            ids.append(f"{NAMESPACE}/{title.replace(' ', '')}{robot_title}-v1")
+        out.append(ShippedTask(str(data.get("name", spec.stem)), title, spec, robots, ids))
     return out
+
+
+def shipped_ids() -> dict[str, tuple[Path, str]]:
+    """Gymnasium id → (task spec path, robot name) for every shipped task and supported robot."""
+    return {env_id: (t.spec, robot) for t in shipped_tasks() for robot, env_id in zip(t.robots, t.ids)}
 
 
 def make_env(spec: str, robot: str, **kwargs):

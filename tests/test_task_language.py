@@ -1,0 +1,255 @@
+"""The spec-language features the itch-scratching, bed-bathing and drinking tasks need, checked on
+the shipped specs with real compiles and real pybullet: targets drawn on a limb's surface, marker
+sets cleared by contact, supine settling at compile time, containers for particles, the scratch
+event counter (hysteresis), the tilt and closest-distance terms, scripted repeats, `list`."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pybullet as pb
+import pytest
+
+from assistive_compiler.cli import main
+from assistive_compiler.compile.compiler import compile_task
+from assistive_compiler.paths import specs_dir
+from assistive_compiler.runtime.env import AssistiveEnv
+from assistive_compiler.terms.registry import terms
+
+TASKS = specs_dir() / "tasks"
+
+
+@pytest.fixture(scope="module")
+def scratch(tmp_path_factory):
+    out = tmp_path_factory.mktemp("scratch") / "scratch_itch-jaco"
+    env = AssistiveEnv(compile_task(TASKS / "scratch_itch.yaml", "jaco", out).out_dir)
+    yield env
+    env.close()
+
+
+@pytest.fixture(scope="module")
+def bathing(tmp_path_factory):
+    out = tmp_path_factory.mktemp("bathing") / "bed_bathing-jaco"
+    env = AssistiveEnv(compile_task(TASKS / "bed_bathing.yaml", "jaco", out).out_dir)
+    yield env
+    env.close()
+
+
+@pytest.fixture(scope="module")
+def drinking(tmp_path_factory):
+    out = tmp_path_factory.mktemp("drinking") / "drinking-jaco"
+    env = AssistiveEnv(compile_task(TASKS / "drinking.yaml", "jaco", out).out_dir)
+    yield env
+    env.close()
+
+
+# --------------------------------------------------------------------------------------------
+# Targets drawn on a limb's surface (the itch)
+
+
+def test_itch_is_drawn_on_the_arm_capsules_every_reset(scratch):
+    """Facts §2.1: upper arm or forearm with probability ½, distance from the joint U(r, L), azimuth
+    U(0, 2π); the point lies on the capsule surface and rides with the limb."""
+    snap = scratch.snap
+    itch = snap.point({"target": "itch"})
+    links, normals = [], []
+    for seed in range(300):
+        scratch.reset(seed=seed) if seed == 0 else scratch.reset()
+        variant = scratch.world.active_variant
+        caps = {c.link: c for c in variant.surfaces["itch"]}
+        slot = snap.target_slots["itch"]
+        link = next(l for l, i in scratch.world.variant_bodies[variant.name].links.items() if snap._slots.get(("person", i)) == slot)
+        cap = caps[link]
+        offset = snap.target_offsets["itch"]
+        start, end = np.asarray(cap.start), np.asarray(cap.end)
+        axis = (end - start) / np.linalg.norm(end - start)
+        along = float(np.dot(offset - start, axis))
+        radial = np.linalg.norm(offset - start - along * axis)
+        assert radial == pytest.approx(cap.radius, abs=1e-9)
+        assert cap.radius - 1e-9 <= along <= np.linalg.norm(end - start) + 1e-9
+        # The world position is the link pose applied to the offset, and the normal points outwards.
+        world = snap.position(itch)
+        assert np.linalg.norm(world - snap.pos[slot]) == pytest.approx(np.linalg.norm(offset), abs=1e-6)
+        assert np.dot(snap.normal(itch), snap.axis(itch)) == pytest.approx(0.0, abs=1e-6)
+        links.append(link)
+        normals.append(snap.normal(itch))
+    share_upper = links.count("right_shoulder") / len(links)
+    assert 0.4 < share_upper < 0.6 and set(links) == {"right_shoulder", "right_elbow"}
+    assert np.linalg.norm(np.mean(normals, axis=0)) < 0.15  # azimuths spread all round
+
+
+def test_surface_target_specs_are_checked(tmp_path):
+    spec = (TASKS / "scratch_itch.yaml").read_text().replace(
+        "surface_of: [person.right_shoulder, person.right_elbow]", "surface_of: [person.right_shoulder, person.head]")
+    path = tmp_path / "bad.yaml"
+    path.write_text(spec)
+    with _capture() as err:
+        assert main(["validate", str(path)]) == 2
+    line = next(i for i, l in enumerate(spec.splitlines(), 1) if "person.head]" in l and "surface_of" in l)
+    assert f"{path}:{line}:" in err.text
+    assert "'person.head' is not a person limb with a capsule" in err.text
+
+
+class _capture:
+    """Collect what the CLI prints on stderr."""
+
+    def __enter__(self):
+        import contextlib
+        import io
+
+        self.buf = io.StringIO()
+        self._cm = contextlib.redirect_stderr(self.buf)
+        self._cm.__enter__()
+        return self
+
+    def __exit__(self, *exc):
+        self._cm.__exit__(*exc)
+        self.text = self.buf.getvalue()
+        return False
+
+
+# --------------------------------------------------------------------------------------------
+# The scratch event counter (hysteresis)
+
+
+def _snap_with(contacts, target=(0.0, 0.0, 0.0)):
+    """A stand-in snapshot: the target's position and this step's contacts (pybullet tuples with
+    the point on the tool at index 5 and the normal force at index 9)."""
+    return SimpleNamespace(position=lambda _h: np.asarray(target), contacts=lambda _a, _b: contacts)
+
+
+def _contact(x, force):
+    cp = [0] * 14
+    cp[5], cp[9] = (x, 0.0, 0.0), force
+    return tuple(cp)
+
+
+def test_scratch_events_need_movement_gentle_force_and_nearness():
+    counter = terms("reward")["contact_events"].fn()
+    p = SimpleNamespace(tool=[], on=[], target=None, radius_m=0.025, min_move_m=0.01, max_force_n=10.0)
+    steps = [
+        ([], 0.0),                          # no contact
+        ([_contact(0.030, 1.0)], 0.0),      # 3 cm from the itch: too far
+        ([_contact(0.000, 12.0)], 0.0),     # on the spot but pressing 12 N: too hard
+        ([_contact(0.000, 2.0)], 1.0),      # first gentle touch: a scratch
+        ([_contact(0.005, 2.0)], 0.0),      # moved 5 mm: not yet
+        ([_contact(0.012, 2.0)], 1.0),      # 12 mm from the last scratch: another
+        ([_contact(0.012, 2.0)], 0.0),      # resting there counts once
+        ([_contact(0.001, 4.0), _contact(0.0005, 4.0)], 1.0),  # back again (8 N in all)
+        ([_contact(0.020, 6.0), _contact(0.021, 5.0)], 0.0),   # 11 N summed: too hard
+    ]
+    got = [counter(_snap_with(c), p) for c, _ in steps]
+    assert got == [want for _, want in steps]
+    counter.reset()
+    assert counter(_snap_with([_contact(0.0005, 1.0)]), p) == 1.0  # a new episode forgets the last point
+
+
+def test_scratch_env_resets_the_counter_each_episode(scratch):
+    scratch.reset(seed=3)
+    fn = next(fn for name, _, fn in scratch.reward_fns if name == "scratch")
+    assert fn.reset in scratch._term_resets  # the env calls it at every reset
+
+
+# --------------------------------------------------------------------------------------------
+# Bed bathing: supine settling and markers
+
+
+def test_person_settles_supine_on_the_mattress(bathing):
+    env = bathing
+    for seed in (0, 1):
+        env.reset(seed=seed)
+        handle = env.world.variant_bodies[env.world.active_variant.name]
+        c = env.world.client
+        bed = env.world.bodies["bed"].id
+        gap = min(cp[8] for cp in pb.getClosestPoints(handle.id, bed, 0.1, physicsClientId=c))
+        assert -0.02 < gap < 0.005  # resting on the bed: touching, not floating, not sunk in
+        for link in ("right_shoulder", "right_elbow", "right_wrist"):  # the arm to wipe lies on the 0.73 m mattress
+            assert 0.69 < pb.getAABB(handle.id, handle.links[link], physicsClientId=c)[0][2] < 0.78
+        chest_pos, chest_orn = env.world.base_frame(env.world.variant_bodies[env.world.active_variant.name])
+        up = np.asarray(pb.getMatrixFromQuaternion(chest_orn)).reshape(3, 3)[:, 2]
+        assert abs(up[1]) > 0.9  # the body's long axis (chest z) lies along the bed (±Y): supine
+
+
+def test_marker_counts_match_the_reference(bathing):
+    """Facts §2.2 (verified counts): 81 + 48 = 129 markers for the male arm, 56 + 35 = 91 female."""
+    counts = {v.name: len(v.markers["wipe_spots"]) for v in bathing.manifest.person.variants}
+    assert counts == {"male_50th": 129, "female_50th": 91}
+    per_link = {v.name: [sum(1 for p in v.markers["wipe_spots"] if p.link == l) for l in ("right_shoulder", "right_elbow")]
+                for v in bathing.manifest.person.variants}
+    assert per_link == {"male_50th": [81, 48], "female_50th": [56, 35]}
+
+
+def test_markers_lie_on_the_arm_and_are_cleared_once(bathing):
+    env = bathing
+    from assistive_compiler.policies.scripted import ScriptedPolicy
+
+    policy = ScriptedPolicy(env)
+    obs, _ = env.reset(seed=2)
+    variant = env.world.active_variant
+    count = len(variant.markers["wipe_spots"])
+    assert env.success_threshold == pytest.approx(0.3 * count)
+    # Every marker sits on its limb's capsule surface: radius from the axis, in the world.
+    where = env.markers.positions("wipe_spots")
+    person = env.world.variant_bodies[variant.name]
+    for link in ("right_shoulder", "right_elbow"):
+        pos, orn = env.world.link_frame(person, person.links[link])
+        rot = np.asarray(pb.getMatrixFromQuaternion(orn)).reshape(3, 3)
+        for k, marker in enumerate(variant.markers["wipe_spots"]):
+            if marker.link == link:
+                assert np.allclose(where[k], np.asarray(pos) + rot @ np.asarray(marker.offset), atol=1e-9)
+    cleared_total = 0
+    for _ in range(120):
+        obs, _, _, _, info = env.step(policy(obs))
+        cleared_total += info["terms"]["wiped"]
+        assert int((~env.markers.remaining["wipe_spots"]).sum()) == cleared_total
+    assert cleared_total > 0
+    assert info["success_metric"] == cleared_total
+
+
+# --------------------------------------------------------------------------------------------
+# Drinking: container, tilt
+
+
+def test_water_in_the_upright_cup_is_neither_drunk_nor_spilled(drinking):
+    env = drinking
+    obs, _ = env.reset(seed=0)
+    for _ in range(10):
+        obs, _, _, _, info = env.step(np.zeros(env.action_space.shape))
+        assert info["terms"]["water_drunk"] == 0 and info["terms"]["water_spilled"] == 0
+    assert env.particles.remaining("water") == 64
+    assert info["terms"]["cup_tilt"] < math.radians(10)
+
+
+def test_tilt_is_the_angle_from_upright():
+    tilt = terms("reward")["tilt"].fn
+    p = SimpleNamespace(of=None, axis=(0.0, 0.0, 1.0), up=(0.0, 0.0, 1.0))
+    for angle in (0.0, 0.3, math.pi / 2, 2.0, math.pi):
+        q = pb.getQuaternionFromEuler((angle, 0.0, 0.0))
+        snap = SimpleNamespace(orientation=lambda _h, q=q: np.asarray(q))
+        assert tilt(snap, p) == pytest.approx(angle, abs=1e-6)
+
+
+def test_closest_distance_term(bathing):
+    env = bathing
+    env.reset(seed=0)
+    env.snap.refresh()
+    d = next(fn for name, _, fn in env.reward_fns if name == "distance_to_person")(env.snap)
+    wiper = env.world.bodies["wiper"].id
+    person = env.world.variant_bodies[env.world.active_variant.name].id
+    expected = min(cp[8] for cp in pb.getClosestPoints(wiper, person, 5.0, physicsClientId=env.world.client))
+    assert d == pytest.approx(expected) and d > 0.05  # the start pose is well clear of the person
+
+
+# --------------------------------------------------------------------------------------------
+# list
+
+
+def test_list_shows_every_task_robot_and_id(capsys):
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    for title in ("ScratchItch", "Feeding"):
+        for robot in ("PR2", "Jaco", "Baxter", "Sawyer", "Panda"):
+            assert f"assistive_compiler/{title}{robot}-v1" in out
+    assert "assistive_compiler/BedBathingBaxter-v1" in out and "assistive_compiler/DrinkingSawyer-v1" in out
