@@ -105,6 +105,25 @@ def total_mass(model: yourdfpy.URDF) -> float:
     return sum(link.inertial.mass for link in model.robot.links)
 
 
+def assert_links_physical(root) -> None:
+    """Every link of a URDF tree: positive mass, a physically valid inertia (positive eigenvalues
+    obeying the triangle inequality), primitive collision and visual shapes only."""
+    for link in root.iter("link"):
+        inertial = link.find("inertial")
+        assert inertial is not None, link.get("name")
+        assert float(inertial.find("mass").get("value")) > 0
+        i = {k: float(v) for k, v in inertial.find("inertia").attrib.items()}
+        tensor = np.array([[i["ixx"], i["ixy"], i["ixz"]],
+                           [i["ixy"], i["iyy"], i["iyz"]],
+                           [i["ixz"], i["iyz"], i["izz"]]])
+        ev = np.linalg.eigvalsh(tensor)
+        assert ev.min() > 0, link.get("name")
+        assert ev[0] + ev[1] >= ev[2] * (1 - 1e-9), link.get("name")  # triangle inequality
+        for geom in link.iter("geometry"):
+            kinds = [child.tag for child in geom]
+            assert kinds and set(kinds) <= {"box", "cylinder", "sphere"}, kinds
+
+
 @pytest.fixture
 def cid():
     client = pb.connect(pb.DIRECT)
@@ -159,20 +178,7 @@ def test_conventions(template, args, out_dir):
     """Positive masses, physically valid inertias, ordered limits with effort and velocity on
     movable joints, unit axes, primitives only."""
     root = ET.parse(render(template, out_dir, **args)).getroot()
-    for link in root.iter("link"):
-        inertial = link.find("inertial")
-        assert inertial is not None, link.get("name")
-        assert float(inertial.find("mass").get("value")) > 0
-        i = {k: float(v) for k, v in inertial.find("inertia").attrib.items()}
-        tensor = np.array([[i["ixx"], i["ixy"], i["ixz"]],
-                           [i["ixy"], i["iyy"], i["iyz"]],
-                           [i["ixz"], i["iyz"], i["izz"]]])
-        ev = np.linalg.eigvalsh(tensor)
-        assert ev.min() > 0, link.get("name")
-        assert ev[0] + ev[1] >= ev[2] * (1 - 1e-9), link.get("name")  # triangle inequality
-        for geom in link.iter("geometry"):
-            kinds = [child.tag for child in geom]
-            assert kinds and set(kinds) <= {"box", "cylinder", "sphere"}, kinds
+    assert_links_physical(root)
     for joint in root.iter("joint"):
         if joint.get("type") in ("revolute", "prismatic"):
             lim = joint.find("limit")

@@ -21,28 +21,27 @@ from assistive_compiler.terms.registry import terms
 TASKS = specs_dir() / "tasks"
 
 
-@pytest.fixture(scope="module")
-def scratch(tmp_path_factory):
-    out = tmp_path_factory.mktemp("scratch") / "scratch_itch-jaco"
-    env = AssistiveEnv(compile_task(TASKS / "scratch_itch.yaml", "jaco", out).out_dir)
+def _env(tmp_path_factory, task: str):
+    """An env of the shipped ``task`` for Jaco, compiled into a fresh directory."""
+    out = tmp_path_factory.mktemp(task) / f"{task}-jaco"
+    env = AssistiveEnv(compile_task(TASKS / f"{task}.yaml", "jaco", out).out_dir)
     yield env
     env.close()
+
+
+@pytest.fixture(scope="module")
+def scratch(tmp_path_factory):
+    yield from _env(tmp_path_factory, "scratch_itch")
 
 
 @pytest.fixture(scope="module")
 def bathing(tmp_path_factory):
-    out = tmp_path_factory.mktemp("bathing") / "bed_bathing-jaco"
-    env = AssistiveEnv(compile_task(TASKS / "bed_bathing.yaml", "jaco", out).out_dir)
-    yield env
-    env.close()
+    yield from _env(tmp_path_factory, "bed_bathing")
 
 
 @pytest.fixture(scope="module")
 def drinking(tmp_path_factory):
-    out = tmp_path_factory.mktemp("drinking") / "drinking-jaco"
-    env = AssistiveEnv(compile_task(TASKS / "drinking.yaml", "jaco", out).out_dir)
-    yield env
-    env.close()
+    yield from _env(tmp_path_factory, "drinking")
 
 
 # --------------------------------------------------------------------------------------------

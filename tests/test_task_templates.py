@@ -22,6 +22,7 @@ import yourdfpy
 from assistive_compiler.compile.external_checks import captured_c_output
 from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.library import Library
+from test_scene_templates import assert_links_physical
 
 REPO = Path(__file__).resolve().parents[1]
 TEMPLATES = REPO / "templates"
@@ -199,20 +200,7 @@ def test_conventions(template, args):
     """Positive masses, physically valid inertias, primitives only, every joint fixed (the parts
     are rigid), and the header comment documents frames and args."""
     root = ET.fromstring(render_text(template, **args))
-    for link in root.iter("link"):
-        inertial = link.find("inertial")
-        assert inertial is not None, link.get("name")
-        assert float(inertial.find("mass").get("value")) > 0
-        i = {k: float(v) for k, v in inertial.find("inertia").attrib.items()}
-        tensor = np.array([[i["ixx"], i["ixy"], i["ixz"]],
-                           [i["ixy"], i["iyy"], i["iyz"]],
-                           [i["ixz"], i["iyz"], i["izz"]]])
-        ev = np.linalg.eigvalsh(tensor)
-        assert ev.min() > 0, link.get("name")
-        assert ev[0] + ev[1] >= ev[2] * (1 - 1e-9), link.get("name")  # triangle inequality
-        for geom in link.iter("geometry"):
-            kinds = [child.tag for child in geom]
-            assert kinds and set(kinds) <= {"box", "cylinder", "sphere"}, kinds
+    assert_links_physical(root)
     assert {j.get("type") for j in root.iter("joint")} == {"fixed"}
     header = (TEMPLATES / template).read_text().split("-->", 1)[0]
     for word in ("Frame", "Args"):
