@@ -285,7 +285,7 @@ def render_people(artifact_dir: Path, width: int = 360, height: int = 480) -> np
         proj = pb.computeProjectionMatrixFOV(40, width / height, 0.05, 10, physicsClientId=c)
         rgba = pb.getCameraImage(width, height, view, proj, renderer=pb.ER_TINY_RENDERER, lightDirection=[1, -2, 2], physicsClientId=c)[2]
         image = Image.fromarray(np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3])
-        label = f"{variant.name}\n{variant.sex}, {variant.mass_kg:g} kg, {variant.standing_height_m:.3f} m"
+        label = f"{variant.name}\n{variant.sex}, {variant.mass_kg:.1f} kg, {variant.standing_height_m:.3f} m"
         ImageDraw.Draw(image).multiline_text((8, 8), label, fill=(0, 0, 0))
         panels.append(np.asarray(image))
     world.close()

@@ -148,3 +148,19 @@ def test_render_person_draws_percentile_people(tmp_path, capsys):
     panels = [picture[:, i * 360:(i + 1) * 360].astype(int) for i in range(3)]
     assert all(panel.std() > 20 for panel in panels)
     assert np.abs(panels[0] - panels[1]).mean() > 1 and np.abs(panels[1] - panels[2]).mean() > 1
+
+
+@pytest.mark.parametrize("sex", ["male", "female"])
+def test_percentile_radii_follow_mass_per_height(sex):
+    """A heavier percentile body is wider: its radius scale is √((m/m₅₀)/(h/h₅₀))."""
+    from assistive_compiler.person.anthropometry import percentile_body
+    from assistive_compiler.spec.parts import PersonPart
+
+    h50, m50 = percentile_body(sex, 50)
+    scales = {}
+    for pct in (5, 50, 95):
+        part = PersonPart(name=f"{sex}_{pct}", sex=sex, percentile=pct)
+        h, m = part.size()
+        scales[pct] = part.measurements().radius_scale
+        assert scales[pct] == pytest.approx(((m / m50) / (h / h50)) ** 0.5, rel=1e-9)
+    assert scales[5] < scales[50] == 1.0 < scales[95]

@@ -186,15 +186,19 @@ class PersonPart(Strict):
 
     def measurements(self):
         """The body model of this person (segment lengths, radii and masses). A percentile body is
-        solved for its standing height like height_m; the 50th percentile is the paper's body
-        itself (height scale 1)."""
+        solved for its standing height like height_m, with its radii scaled by the girth factor
+        √((m/m₅₀)/(h/h₅₀)) so its volume follows its mass (a heavier body at the same height is
+        wider, not denser); the 50th percentile is the paper's body itself (both scales 1)."""
+        from ..person.anthropometry import percentile_body
         from ..person.body import body_for_height, body_measurements
 
         if self.percentile is not None:
             height, mass = self.size()
             if self.percentile == 50:
                 return body_measurements(self.sex, mass, 1.0, self.radius_scale)
-            return body_for_height(self.sex, height, mass, self.radius_scale)
+            height_50, mass_50 = percentile_body(self.sex, 50)
+            girth = ((mass / mass_50) / (height / height_50)) ** 0.5
+            return body_for_height(self.sex, height, mass, self.radius_scale * girth)
         if self.height_m is not None:
             return body_for_height(self.sex, self.height_m, self.mass_kg, self.radius_scale)
         return body_measurements(self.sex, self.mass_kg, self.height_scale, self.radius_scale)
