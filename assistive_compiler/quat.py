@@ -1,5 +1,6 @@
-"""Quaternion arithmetic on (x, y, z, w) tuples, as pybullet orders them. Plain numpy, no pybullet,
-so the term library can use it without importing the simulator."""
+"""Quaternion arithmetic on (x, y, z, w) tuples, as pybullet orders them, and the frame of a capsule
+axis. Plain numpy, no pybullet, so the term library and the compiler can use it without importing
+the simulator."""
 
 from __future__ import annotations
 
@@ -32,3 +33,14 @@ def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         aw * bz + ax * by - ay * bx + az * bw,
         aw * bw - ax * bx - ay * by - az * bz,
     ])
+
+
+def capsule_axes(start, end) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+    """``(length, axis, u, v)`` of the segment start → end: its length, the unit axis, and two unit
+    vectors completing a right-handed frame (u = axis × (x or y), v = axis × u), in the segment's frame."""
+    start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    length = float(np.linalg.norm(end - start))
+    axis = (end - start) / length
+    u = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0])
+    u /= np.linalg.norm(u)
+    return length, axis, u, np.cross(axis, u)

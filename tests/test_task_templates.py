@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 import subprocess
-import sys
 import xml.etree.ElementTree as ET
 from functools import cache
 from pathlib import Path
@@ -19,15 +18,9 @@ import pytest
 
 import xacro
 import yourdfpy
-from assistive_compiler.compile.external_checks import captured_c_output
 from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.library import Library
-from test_scene_templates import assert_links_physical
-
-REPO = Path(__file__).resolve().parents[1]
-TEMPLATES = REPO / "templates"
-CHECK_URDF = Path(sys.executable).parent / "check_urdf"
-PI = math.pi
+from test_scene_templates import CHECK_URDF, PI, TEMPLATES, assert_links_physical, load_quiet
 
 SCRATCHER = "tools/scratcher.urdf.xacro"
 WIPER = "tools/wiper.urdf.xacro"
@@ -82,13 +75,6 @@ def render(template: str, out_dir: Path, **args) -> Path:
     if not path.exists():
         path.write_text(render_text(template, **args))
     return path
-
-
-def load_quiet(cid: int, path: Path, pos=(0, 0, 0), orn=(0, 0, 0, 1), fixed=True):
-    """Load a URDF and return (body, printed text)."""
-    with captured_c_output() as out:
-        body = pb.loadURDF(str(path), list(pos), list(orn), useFixedBase=fixed, physicsClientId=cid)
-    return body, out[0]
 
 
 def link_indices(cid: int, body: int) -> dict[str, int]:

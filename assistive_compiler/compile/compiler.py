@@ -53,9 +53,10 @@ from ..errors import Problem, SpecError
 from ..library import PERSON_TEMPLATE_RELPATH, Library
 from ..paths import display, templates_dir
 from ..person.body import format_fixed_joints
+from ..quat import capsule_axes
 from ..resolve import ResolvedTask, resolve
 from ..spec.load import LoadedSpec, load_spec
-from ..spec.models import Uniform, scalar_bounds
+from ..spec.models import scalar_bounds
 from ..terms.registry import SizeContext, terms
 from .lint import lint_urdf
 from .merge import merge_fixed_links
@@ -654,13 +655,8 @@ def _marker_points(limbs: dict, links: list[str], spacing: float) -> list[Marker
     out: list[MarkerPoint] = []
     for link in links:
         cap = limbs[link]
-        start, end = np.asarray(cap.start), np.asarray(cap.end)
-        length, r = float(np.linalg.norm(end - start)), cap.radius
-        axis = (end - start) / length
-        helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-        u = np.cross(axis, helper)
-        u /= np.linalg.norm(u)
-        v = np.cross(axis, u)
+        start, r = np.asarray(cap.start), cap.radius
+        length, axis, u, v = capsule_axes(cap.start, cap.end)
         rings, per_ring = int(length / spacing), int(2 * math.pi * r / spacing)
         for i in range(rings):
             centre = start + axis * length * (i + 1) / (rings + 1)

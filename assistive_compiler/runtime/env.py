@@ -37,6 +37,7 @@ import numpy as np
 import pybullet as pb
 
 from ..artifact import Manifest, TermUse
+from ..quat import capsule_axes
 from ..terms.registry import ref_fields, terms
 from .markers import MarkerSystem
 from .human import PersonController, draw_impairment  # noqa: F401  (draw_impairment: re-exported)
@@ -66,18 +67,29 @@ def bind_term(use: TermUse, snap: Snapshot) -> Callable[[Snapshot], Any]:
     return lambda s: fn(s, params)
 
 
+class Features:
+    """One agent's observation: its bound features concatenated into a float32 vector."""
+
+    def __init__(self, uses: list[TermUse], snap: Snapshot):
+        self.fns = [bind_term(t, snap) for t in uses]
+        bounds = np.cumsum([0] + [t.size for t in uses])
+        self.slices = [slice(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
+        self.space = gym.spaces.Box(-np.inf, np.inf, (int(bounds[-1]),), np.float32)
+
+    def __call__(self, snap: Snapshot) -> np.ndarray:
+        obs = np.empty(self.space.shape, dtype=np.float32)
+        for fn, where in zip(self.fns, self.slices):
+            obs[where] = fn(snap)
+        return obs
+
+
 def draw_surface_point(capsules, rng: np.random.Generator) -> tuple[str, np.ndarray, np.ndarray]:
     """A point on one of the limbs' capsules, as the reference draws an itch (facts §2.1): a limb
     uniformly, the distance from its joint end U(r, L) along the axis, the azimuth U(0, 2π).
     Returns (link, point, outward normal, axis away from the joint), in the link frame (m)."""
     cap = capsules[int(rng.integers(len(capsules)))]
-    start, end = np.asarray(cap.start), np.asarray(cap.end)
-    length = float(np.linalg.norm(end - start))
-    axis = (end - start) / length
-    helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    u = np.cross(axis, helper)
-    u /= np.linalg.norm(u)
-    v = np.cross(axis, u)
+    start = np.asarray(cap.start)
+    length, axis, u, v = capsule_axes(cap.start, cap.end)
     along = rng.uniform(min(cap.radius, length), length)
     azimuth = rng.uniform(0.0, 2 * np.pi)
     normal = np.cos(azimuth) * u + np.sin(azimuth) * v
@@ -108,17 +120,14 @@ class AssistiveEnv(gym.Env):
         self._gains = [m.robot.position_gain] * len(self.arm_idx)
         self._forces = [m.robot.max_force] * len(self.arm_idx)
 
-        self.obs_fns = [bind_term(t, self.snap) for t in m.observations["robot"]]
+        self.robot_features = Features(m.observations["robot"], self.snap)
         self.reward_fns = [(t.name, t.weight, bind_term(t, self.snap)) for t in m.reward]
         self._term_resets = [fn.reset for _, _, fn in self.reward_fns if hasattr(fn, "reset")]
         self.markers = MarkerSystem(self.world, self.snap)
         self.success_threshold = m.success.threshold
         self.tool_point = self.snap.point({"body": "robot", "link": m.robot.links["tool_mount"]})
         self._force_on_person = ([b.name for b in m.bodies if b.kind in ("robot", "tool")], ["person"])
-        obs_size = sum(t.size for t in m.observations["robot"])
-        bounds = np.cumsum([0] + [t.size for t in m.observations["robot"]])
-        self._obs_slices = [slice(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
-        self.observation_space = gym.spaces.Box(-np.inf, np.inf, (obs_size,), np.float32)
+        self.observation_space = self.robot_features.space
         self.action_space = gym.spaces.Box(-1.0, 1.0, (len(self.arm_idx),), np.float32)
         self.steps = 0
         self.success_metric: float | None = None
@@ -127,11 +136,8 @@ class AssistiveEnv(gym.Env):
         self.human = PersonController(self.world, m, self.artifact_dir)
         n_human = len(m.person.policy_joints)
         self.human_action_space = gym.spaces.Box(-1.0, 1.0, (n_human,), np.float32) if n_human else None
-        human_terms = m.observations.get("human", [])
-        self.human_obs_fns = [bind_term(t, self.snap) for t in human_terms]
-        bounds = np.cumsum([0] + [t.size for t in human_terms])
-        self._human_obs_slices = [slice(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
-        self.human_observation_space = gym.spaces.Box(-np.inf, np.inf, (int(bounds[-1]),), np.float32)
+        self.human_features = Features(m.observations.get("human", []), self.snap)
+        self.human_observation_space = self.human_features.space
 
     @classmethod
     def from_spec(cls, spec: str | Path, robot: str | None = None, out_dir: str | Path | None = None, **kwargs) -> "AssistiveEnv":
@@ -222,10 +228,7 @@ class AssistiveEnv(gym.Env):
 
     def observe_human(self) -> np.ndarray:
         """The person's observation: the spec's human features concatenated (float32)."""
-        obs = np.empty(self.human_observation_space.shape, dtype=np.float32)
-        for fn, where in zip(self.human_obs_fns, self._human_obs_slices):
-            obs[where] = fn(self.snap)
-        return obs
+        return self.human_features(self.snap)
 
     def _step(self, action, human_action):
         m, w, c = self.manifest, self.world, self.world.client
@@ -272,10 +275,7 @@ class AssistiveEnv(gym.Env):
 
     # -- helpers -------------------------------------------------------------------------------
     def _observe(self) -> np.ndarray:
-        obs = np.empty(self.observation_space.shape, dtype=np.float32)
-        for fn, where in zip(self.obs_fns, self._obs_slices):
-            obs[where] = fn(self.snap)
-        return obs
+        return self.robot_features(self.snap)
 
     def _aggregate(self, value: float) -> float:
         """Fold this step's value of the success term into the episode's aggregate."""

@@ -25,8 +25,7 @@ class MarkerSystem:
     def __init__(self, world: World, snap: Snapshot):
         self.world, self.snap = world, snap
         self.sets = world.m.markers
-        tool = {ms.name: world.bodies[ms.tool] for ms in self.sets}
-        self._tool = {name: (h.id, h.links[ms.tool_link]) for ms in self.sets for name, h in [(ms.name, tool[ms.name])]}
+        self._tool = {ms.name: (world.bodies[ms.tool].id, world.bodies[ms.tool].links[ms.tool_link]) for ms in self.sets}
         self.remaining: dict[str, np.ndarray] = {}
         self._groups: dict[str, list[tuple[int, np.ndarray, np.ndarray]]] = {}
 

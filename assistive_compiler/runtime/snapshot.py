@@ -251,12 +251,9 @@ class Snapshot:
         only contacts whose point on ``a`` lies within ``radius`` of that point."""
         total = 0.0
         centre = self.position(near) if near is not None else None
-        for ia in self.body_ids(a):
-            for ib in self.body_ids(b):
-                for cp in self._contact_points(ia, ib):
-                    if centre is not None and np.linalg.norm(np.subtract(cp[5], centre)) > radius:
-                        continue
-                    total += cp[9]
+        for cp in self.contacts(a, b):
+            if centre is None or np.linalg.norm(np.subtract(cp[5], centre)) <= radius:
+                total += cp[9]
         return total
 
     def contact_force_and_count(self, a: str, b, distance: float) -> tuple[float, int]:
