@@ -252,3 +252,26 @@ def test_list_shows_every_task_robot_and_id(capsys):
         for robot in ("PR2", "Jaco", "Baxter", "Sawyer", "Panda"):
             assert f"assistive_compiler/{title}{robot}-v1" in out
     assert "assistive_compiler/BedBathingBaxter-v1" in out and "assistive_compiler/DrinkingSawyer-v1" in out
+
+
+# --------------------------------------------------------------------------------------------
+# Observing joints the task holds still
+
+
+def test_observing_a_static_person_group_keeps_its_joints(tmp_path):
+    """``joint_angles`` of ``person.head`` in Scratch Itch, where the head never moves: the compiler
+    keeps those joints (instead of baking them into fixed joints) and the observation reads the
+    posture's angles, unchanged while the robot acts."""
+    spec = tmp_path / "observe_head.yaml"
+    spec.write_text(f"extends: {TASKS / 'scratch_itch.yaml'}\nname: observe_head\ntitle: Observe Head\n"
+                    "observations:\n  robot:\n    - {term: joint_angles, params: {joints: person.head}}\n")
+    env = AssistiveEnv(compile_task(spec, "jaco", tmp_path / "out").out_dir)
+    try:
+        obs, _ = env.reset(seed=3)
+        assert obs.shape == (4,)  # neck, head_x, head_y, head_z
+        rng = np.random.default_rng(0)
+        for _ in range(10):
+            later, *_ = env.step(rng.uniform(-1, 1, env.action_space.shape).astype(np.float32))
+            np.testing.assert_allclose(later, obs, atol=1e-3)
+    finally:
+        env.close()

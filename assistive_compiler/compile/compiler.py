@@ -232,6 +232,7 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
             movable |= set(rt.joint_groups[ref]["joints"])
     for choice in person.impairments.choices:  # impaired joints move (tremor) or keep their limits
         movable |= set(_impairment_joints(rt, choice))
+    movable |= _observed_person_joints(rt)  # a joint a term reads keeps its joint (held at its posture)
     person_joints = [j for j in rt.person_urdf.movable_joints]
     movable_ordered = [j for j in person_joints if j in movable]
     measurements = {variant: rt.people[variant].part.measurements() for variant in person.variants}
@@ -440,6 +441,17 @@ def _policy_joints(rt: ResolvedTask) -> list[str]:
     out: list[str] = []
     for ref in rt.spec.person.control.policy_joints:
         out += [j for j in rt.joint_groups[ref]["joints"] if j not in out]
+    return out
+
+
+def _observed_person_joints(rt: ResolvedTask) -> set[str]:
+    """Person joints named by a joint group in any term's parameters (e.g. ``joint_angles`` of
+    ``person.head``): they are not baked into fixed joints, so the runtime can read them."""
+    out: set[str] = set()
+    for term in [t for ts in rt.observations.values() for t in ts] + list(rt.reward):
+        for value in term.params.values():
+            if isinstance(value, dict) and value.get("body") == "person" and "joints" in value:
+                out |= set(value["joints"])
     return out
 
 
