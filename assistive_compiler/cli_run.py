@@ -197,6 +197,16 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int) -
             env_rates.append(steps / total)
             raw_rates.append(steps / physics[0])
             overhead.append((total - physics[0]) / steps * 1e6)
+        # Both agents acting (co-optimisation, step_agents), where the person has policy joints.
+        coop_rates = []
+        if env.human_action_space is not None:
+            env.human_action_space.seed(0)
+            for r in range(repeats):
+                env.reset(seed=r)
+                t0 = time.perf_counter()
+                for _ in range(steps):
+                    env.step_agents(env.action_space.sample(), env.human_action_space.sample())
+                coop_rates.append(steps / (time.perf_counter() - t0))
         # A raw loop of stepSimulation with nothing else, for reference.
         env.reset(seed=0)
         t0 = time.perf_counter()
@@ -229,6 +239,7 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int) -
         "raw_physics_steps_per_s": round(raw_med, 1),
         "env_over_raw": round(env_med / raw_med, 3),
         "env_overhead_us_per_step": round(statistics.median(overhead), 1),
+        "coop_env_steps_per_s": round(statistics.median(coop_rates), 1) if coop_rates else None,
         "raw_loop_steps_per_s_at_rest": round(raw_loop, 1),
         "reset_ms_median": round(reset_med, 3), "reset_ms_p95": round(reset_p95, 3), "resets": resets,
         "seeded_reset_ms_median": round(statistics.median(seeded_ms), 2),
@@ -236,7 +247,7 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int) -
         "import_s": round(proc["import_s"], 4), "heavy_modules_on_import": proc["heavy_modules_on_import"],
         "peak_rss_mb_one_env": round(proc["peak_rss_mb"], 1),
         "steps_per_repeat": steps, "repeats": repeats,
-        "notes": "env/raw: the same episodes, physics timed inside env.step (stepSimulation + gravity compensation) vs the whole step; random actions; medians over repeats",
+        "notes": "env/raw: the same episodes, physics timed inside env.step (stepSimulation + gravity compensation) vs the whole step; random actions; coop: step_agents with both agents acting (None: the person has no policy joints); medians over repeats",
     }
 
 
