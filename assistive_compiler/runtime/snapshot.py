@@ -65,6 +65,8 @@ class Snapshot:
         self.actions: dict[str, np.ndarray] = {"robot": np.zeros(0), "human": np.zeros(0)}
         self.events: dict[str, Any] = {}  # per particle set: ParticleEvents; per marker set: markers cleared (int)
         self._contacts: dict[tuple[int, int], tuple] = {}
+        self._pooled: dict[tuple, list] = {}  # contacts(a, b) this step, per (a, b)
+        self._target_pos: dict[str, np.ndarray] = {}  # world positions of targets this step
         self._joint_cache: dict[JointsHandle, np.ndarray] = {}
         self.pos, self.orn, self.vel = np.zeros((0, 3)), np.zeros((0, 4)), np.zeros((0, 3))
         self.frames: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
@@ -97,6 +99,7 @@ class Snapshot:
         it lies on a limb's surface."""
         self.target_slots[name] = self._slot("person", link_name)
         self.target_offsets[name] = np.asarray(offset, dtype=float)
+        self._target_pos.pop(name, None)
         if normal is not None:
             self.target_normals[name] = np.asarray(normal, dtype=float)
         if axis is not None:
@@ -131,7 +134,10 @@ class Snapshot:
 
     # -- per step -----------------------------------------------------------------------------
     def refresh(self) -> None:
-        """Read every bound link (positions, orientations, velocities) and clear per-step caches."""
+        """Read every bound link (positions, orientations, velocities) and clear per-step caches.
+
+        Call it again after changing ``target_offsets`` directly: target positions are cached
+        from the first :meth:`position` call until the next refresh."""
         c = self.world.client
         pos, orn, vel = self.pos, self.orn, self.vel
         for key, reads in self._reads.items():
@@ -148,6 +154,8 @@ class Snapshot:
                 for slot in reads.base_slots:
                     pos[slot], orn[slot], vel[slot] = frame_pos, frame_orn, lin
         self._contacts.clear()
+        self._pooled.clear()
+        self._target_pos.clear()
         self._joint_cache.clear()
 
     def set_frame(self, name: str, pos, orn) -> None:
@@ -159,8 +167,11 @@ class Snapshot:
     def position(self, h: PointHandle) -> np.ndarray:
         if h.target is None:
             return self.pos[h.slot].copy()
-        slot = self.target_slots[h.target]
-        return self.pos[slot] + quat_rotate(self.orn[slot], self.target_offsets[h.target])
+        p = self._target_pos.get(h.target)
+        if p is None:
+            slot = self.target_slots[h.target]
+            p = self._target_pos[h.target] = self.pos[slot] + quat_rotate(self.orn[slot], self.target_offsets[h.target])
+        return p.copy()
 
     def orientation(self, h: PointHandle) -> np.ndarray:
         return self.orn[h.slot if h.target is None else self.target_slots[h.target]].copy()
@@ -228,13 +239,19 @@ class Snapshot:
     def begin_episode(self) -> None:
         """Forget what depended on the last episode's person variant."""
         self._ids.clear()
+        self._pooled.clear()
 
     def contacts(self, a, b) -> list:
-        """pybullet contact points between any body of ``a`` (as bodyA) and any of ``b`` this step."""
-        out: list = []
-        for ia in self.body_ids(a):
-            for ib in self.body_ids(b):
-                out.extend(self._contact_points(ia, ib))
+        """pybullet contact points between any body of ``a`` (as bodyA) and any of ``b`` this step
+        (a list shared by the step's callers: do not modify it)."""
+        key = (tuple(a), tuple(b))
+        out = self._pooled.get(key)
+        if out is None:
+            out = []
+            for ia in self.body_ids(a):
+                for ib in self.body_ids(b):
+                    out.extend(self._contact_points(ia, ib))
+            self._pooled[key] = out
         return out
 
     def closest_distance(self, a: str, b, max_distance: float) -> float:
