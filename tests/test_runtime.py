@@ -267,34 +267,23 @@ def test_binding_a_new_point_keeps_what_the_snapshot_read(make_env):
     np.testing.assert_array_equal(where(env, spoon), before)
 
 
-def test_per_step_caches_follow_the_world(make_env):
-    """Target positions and pooled contact lists are cached within a step: a new step, a moved
-    target or a refresh after teleporting a body must never hand out last step's values."""
+def test_pooled_contacts_follow_the_world(make_env):
+    """contacts(a, b) is pooled once per step: after the world changes and the snapshot is
+    refreshed (every env step does), callers must never get last step's contacts."""
     env = make_env()
     env.reset(seed=0)
     snap = env.snap
-    mouth = snap.point({"target": "mouth"})
-    first = where(env, mouth)
-    assert snap.position(mouth) is not snap.position(mouth)  # callers get copies, not the cache
-    link = env.world.m.targets["mouth"].link
-    snap.place_target("mouth", link, np.asarray(env.world.m.targets["mouth"].offset) + [0.0, 0.0, 0.05])
-    assert where(env, mouth)[2] != pytest.approx(first[2], abs=1e-4)  # placed anew: not the cached spot
-    # The bowl rests on the table; lifted off it, a refresh must drop the pooled contacts.
     c, bowl = env.world.client, env.world.bodies["bowl"].id
     env.step(np.zeros(7, dtype=np.float32))
-    assert snap.contacts(["bowl"], ["table"])
+    resting = snap.contacts(["bowl"], ["table"])
+    assert resting and snap.contacts(["bowl"], ["table"]) is resting  # pooled within the step
+    # Lifted off the table, the next refresh drops the pooled contacts.
     pos, orn = pb.getBasePositionAndOrientation(bowl, physicsClientId=c)
     pb.resetBasePositionAndOrientation(bowl, (pos[0], pos[1], pos[2] + 0.3), orn, physicsClientId=c)
     pb.performCollisionDetection(physicsClientId=c)
     snap.refresh()
     assert snap.contacts(["bowl"], ["table"]) == []
-    # Each step's target position is that step's link pose and offset.
-    from assistive_compiler.quat import quat_rotate
-
-    for _ in range(2):
-        env.step(np.ones(7, dtype=np.float32))
-        slot = snap.target_slots["mouth"]
-        np.testing.assert_array_equal(where(env, mouth), snap.pos[slot] + quat_rotate(snap.orn[slot], snap.target_offsets["mouth"]))
+    assert snap.contact_force(["bowl"], ["table"]) == 0.0
 
 
 # ---------------------------------------------------------------------------------------------

@@ -66,7 +66,6 @@ class Snapshot:
         self.events: dict[str, Any] = {}  # per particle set: ParticleEvents; per marker set: markers cleared (int)
         self._contacts: dict[tuple[int, int], tuple] = {}
         self._pooled: dict[tuple, list] = {}  # contacts(a, b) this step, per (a, b)
-        self._target_pos: dict[str, np.ndarray] = {}  # world positions of targets this step
         self._joint_cache: dict[JointsHandle, np.ndarray] = {}
         self.pos, self.orn, self.vel = np.zeros((0, 3)), np.zeros((0, 4)), np.zeros((0, 3))
         self.frames: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
@@ -99,7 +98,6 @@ class Snapshot:
         it lies on a limb's surface."""
         self.target_slots[name] = self._slot("person", link_name)
         self.target_offsets[name] = np.asarray(offset, dtype=float)
-        self._target_pos.pop(name, None)
         if normal is not None:
             self.target_normals[name] = np.asarray(normal, dtype=float)
         if axis is not None:
@@ -134,10 +132,7 @@ class Snapshot:
 
     # -- per step -----------------------------------------------------------------------------
     def refresh(self) -> None:
-        """Read every bound link (positions, orientations, velocities) and clear per-step caches.
-
-        Call it again after changing ``target_offsets`` directly: target positions are cached
-        from the first :meth:`position` call until the next refresh."""
+        """Read every bound link (positions, orientations, velocities) and clear per-step caches."""
         c = self.world.client
         pos, orn, vel = self.pos, self.orn, self.vel
         for key, reads in self._reads.items():
@@ -155,7 +150,6 @@ class Snapshot:
                     pos[slot], orn[slot], vel[slot] = frame_pos, frame_orn, lin
         self._contacts.clear()
         self._pooled.clear()
-        self._target_pos.clear()
         self._joint_cache.clear()
 
     def set_frame(self, name: str, pos, orn) -> None:
@@ -167,11 +161,8 @@ class Snapshot:
     def position(self, h: PointHandle) -> np.ndarray:
         if h.target is None:
             return self.pos[h.slot].copy()
-        p = self._target_pos.get(h.target)
-        if p is None:
-            slot = self.target_slots[h.target]
-            p = self._target_pos[h.target] = self.pos[slot] + quat_rotate(self.orn[slot], self.target_offsets[h.target])
-        return p.copy()
+        slot = self.target_slots[h.target]
+        return self.pos[slot] + quat_rotate(self.orn[slot], self.target_offsets[h.target])
 
     def orientation(self, h: PointHandle) -> np.ndarray:
         return self.orn[h.slot if h.target is None else self.target_slots[h.target]].copy()
