@@ -445,12 +445,15 @@ class _Resolver:
         waypoints = []
         for i, w in enumerate(spec.scripted.waypoints):
             to = self.point(w.to, ("scripted", "waypoints", i, "to"))
-            for key in ("normal_offset_m", "axis_offset_m"):
-                if getattr(w, key) and not (w.to in spec.targets and spec.targets[w.to].surface_of):
+            used = {"normal_offset_m": w.normal_offset_m != 0.0, "axis_offset_m": w.axis_offset_m != 0.0,
+                    "face_normal_within_deg": w.face_normal_within_deg is not None}
+            for key in used:
+                if used[key] and not (w.to in spec.targets and spec.targets[w.to].surface_of):
                     self.problem(("scripted", "waypoints", i, key), f"{key} needs a target drawn on a surface (surface_of); '{w.to}' is not one")
             waypoints.append({"to": to, "offset_m": list(w.offset_m), "tolerance_m": w.tolerance_m,
                               "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
-                              "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None})
+                              "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
+                              "face_normal_within_rad": math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None})
         return {"move": move, "waypoints": waypoints, "repeat_from": spec.scripted.repeat_from}
 
     def _success(self, spec: TaskSpec, reward_names: set[str]) -> float:

@@ -267,6 +267,25 @@ def test_binding_a_new_point_keeps_what_the_snapshot_read(make_env):
     np.testing.assert_array_equal(where(env, spoon), before)
 
 
+def test_pooled_contacts_follow_the_world(make_env):
+    """contacts(a, b) is pooled once per step: after the world changes and the snapshot is
+    refreshed (every env step does), callers must never get last step's contacts."""
+    env = make_env()
+    env.reset(seed=0)
+    snap = env.snap
+    c, bowl = env.world.client, env.world.bodies["bowl"].id
+    env.step(np.zeros(7, dtype=np.float32))
+    resting = snap.contacts(["bowl"], ["table"])
+    assert resting and snap.contacts(["bowl"], ["table"]) is resting  # pooled within the step
+    # Lifted off the table, the next refresh drops the pooled contacts.
+    pos, orn = pb.getBasePositionAndOrientation(bowl, physicsClientId=c)
+    pb.resetBasePositionAndOrientation(bowl, (pos[0], pos[1], pos[2] + 0.3), orn, physicsClientId=c)
+    pb.performCollisionDetection(physicsClientId=c)
+    snap.refresh()
+    assert snap.contacts(["bowl"], ["table"]) == []
+    assert snap.contact_force(["bowl"], ["table"]) == 0.0
+
+
 # ---------------------------------------------------------------------------------------------
 # 6. particles
 

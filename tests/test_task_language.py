@@ -91,6 +91,19 @@ def test_surface_target_specs_are_checked(tmp_path):
     assert "'person.head' is not a person limb with a capsule" in err.text
 
 
+def test_facing_a_normal_needs_a_surface_target(tmp_path):
+    spec = (TASKS / "scratch_itch.yaml").read_text()
+    first = next(l for l in spec.splitlines() if l.strip().startswith("- {to: itch, normal_offset_m: 0.08"))
+    spec = spec.replace(first, "    - {to: person.right_wrist, face_normal_within_deg: 90}")
+    path = tmp_path / "bad.yaml"
+    path.write_text(spec)
+    with _capture() as err:
+        assert main(["validate", str(path)]) == 2
+    line = next(i for i, l in enumerate(spec.splitlines(), 1) if "person.right_wrist, face_normal" in l)
+    assert f"{path}:{line}:" in err.text
+    assert "face_normal_within_deg needs a target drawn on a surface (surface_of); 'person.right_wrist' is not one" in err.text
+
+
 class _capture:
     """Collect what the CLI prints on stderr."""
 
@@ -149,6 +162,51 @@ def test_scratch_env_resets_the_counter_each_episode(scratch):
     scratch.reset(seed=3)
     fn = next(fn for name, _, fn in scratch.reward_fns if name == "scratch")
     assert fn.reset in scratch._term_resets  # the env calls it at every reset
+
+
+def test_scripted_tool_turns_no_further_than_needed_to_face_the_itch(scratch):
+    """face_normal_within_deg: the tool's pointing axis ends within the angle of the inward normal,
+    turned by the smallest rotation — not at all when it already was within it."""
+    from assistive_compiler.policies.scripted import ScriptedPolicy
+    from assistive_compiler.quat import quat_rotate
+
+    policy = ScriptedPolicy(scratch)
+    itch = scratch.snap.point({"target": "itch"})
+    within = math.radians(90)
+    turned = 0
+    for seed in range(12):
+        scratch.reset(seed=seed)
+        policy._start_episode()
+        start = np.asarray(policy.keep_orn)
+        inward = -scratch.snap.normal(itch)
+        d0 = quat_rotate(start, policy.axis_in_point)
+        before = math.acos(np.clip(np.dot(d0, inward), -1, 1))
+        orn = np.asarray(policy._facing(start, inward, within))
+        d = quat_rotate(orn, policy.axis_in_point)
+        after = math.acos(np.clip(np.dot(d, inward), -1, 1))
+        rotation = 2 * math.acos(min(1.0, abs(float(np.dot(orn, start)))))
+        if before <= within:
+            np.testing.assert_array_equal(orn, start)
+        else:
+            turned += 1
+            assert after == pytest.approx(within, abs=1e-6)
+            assert rotation == pytest.approx(before - within, abs=1e-6)  # no more than needed
+    assert turned > 0  # the inner and front-inner spots of these seeds need a turn
+
+
+@pytest.mark.slow
+def test_scripted_policy_scratches_an_itch_under_the_forearm(scratch):
+    """Seed 14 draws the itch under the forearm, facing the lap: the scratcher, held pointing at the
+    person, would lie across the limb; turned to face the skin it scratches the spot ≥ 25 times."""
+    from assistive_compiler.policies.scripted import ScriptedPolicy
+
+    policy = ScriptedPolicy(scratch)
+    obs, _ = scratch.reset(seed=14)
+    itch = scratch.snap.point({"target": "itch"})
+    assert scratch.snap.normal(itch)[2] < -0.3  # underside
+    for _ in range(scratch.manifest.sim.episode_steps):
+        obs, _, _, truncated, info = scratch.step(policy(obs))
+    assert truncated and info["task_success"] == 1
 
 
 # --------------------------------------------------------------------------------------------

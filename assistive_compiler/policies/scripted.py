@@ -6,14 +6,22 @@ orientation (or the waypoint's own), and returns the joint-delta action that hea
 advances to the next waypoint within the waypoint's tolerance — or when it has stopped getting
 closer (no gain of 2 mm over 10 steps: an approach point the arm cannot quite reach should not
 end the episode) — and holds the last one, or goes on from ``repeat_from`` (to rub back and
-forth). A waypoint may sit off a surface-drawn target along its outward normal and along its limb. Works for any task and robot whose manifest has a
-``scripted`` section.
+forth). A waypoint may sit off a surface-drawn target along its outward normal and along its limb,
+and may turn the tool towards that target's surface (``face_normal_within_rad``: the smallest
+rotation of the start orientation that brings the tool's pointing axis — end effector to moved
+point — within that angle of the inward normal, so a spot on the far side of a limb is met tip
+first rather than with the tool lying across the limb). Works for any task and robot whose
+manifest has a ``scripted`` section.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pybullet as pb
+
+from ..quat import quat_conj, quat_mul, quat_rotate
 
 
 STALL_STEPS = 10  # steps without getting STALL_GAIN_M closer before moving on to the next waypoint
@@ -33,6 +41,7 @@ class ScriptedPolicy:
         self.waypoints = [(snap.point(w["to"]), np.asarray(w["offset_m"]), w["tolerance_m"], w.get("normal_offset_m", 0.0),
                            w.get("axis_offset_m", 0.0)) for w in m.scripted["waypoints"]]
         self.orientations = [pb.getQuaternionFromEuler(w["rpy_rad"]) if w.get("rpy_rad") else None for w in m.scripted["waypoints"]]
+        self.face_normal = [w.get("face_normal_within_rad") for w in m.scripted["waypoints"]]
         self.repeat_from = m.scripted.get("repeat_from")
         robot = env.world.robot
         self.ee_link = robot.links[m.robot.links["tool_mount"]]
@@ -54,8 +63,29 @@ class ScriptedPolicy:
         inv = pb.invertTransform(ee_pos.tolist(), ee_orn.tolist())
         self.point_in_ee = pb.multiplyTransforms(inv[0], inv[1], pt_pos.tolist(), pt_orn.tolist())
         self.keep_orn = pt_orn.tolist()
+        # The tool's pointing axis (end effector → moved point), in the moved point's link frame.
+        d = pt_pos - ee_pos
+        d = d / max(float(np.linalg.norm(d)), 1e-9)
+        self.axis_in_point = np.asarray(quat_rotate(quat_conj(pt_orn), d))
         self.index = 0
         self._best, self._since_best = float("inf"), 0
+
+    def _facing(self, orn, inward: np.ndarray, within: float) -> list[float]:
+        """``orn`` turned by the smallest rotation that brings the pointing axis within ``within``
+        (rad) of the unit vector ``inward`` (world); unchanged when it already is."""
+        d = quat_rotate(np.asarray(orn), self.axis_in_point)
+        angle = math.acos(max(-1.0, min(1.0, float(np.dot(d, inward)))))
+        if angle <= within:
+            return list(orn)
+        k = np.cross(d, inward)
+        if np.linalg.norm(k) < 1e-6:  # pointing straight away from the surface: turn through the horizontal z × d
+            k = np.cross(d, np.cross(np.array([0.0, 0.0, 1.0]), d))
+            if np.linalg.norm(k) < 1e-6:
+                k = np.cross(d, np.array([1.0, 0.0, 0.0]))
+        k = k / np.linalg.norm(k)
+        turn = angle - within
+        q = np.concatenate([k * math.sin(turn / 2), [math.cos(turn / 2)]])
+        return quat_mul(q, np.asarray(orn)).tolist()
 
     def _goal(self) -> tuple[np.ndarray, float]:
         """The current waypoint's position (world, m) and tolerance."""
@@ -82,6 +112,8 @@ class ScriptedPolicy:
         # End-effector pose that puts the moved point at the goal with the kept orientation.
         inv_pos, inv_orn = pb.invertTransform(*self.point_in_ee)
         orn = self.orientations[self.index] or self.keep_orn
+        if self.face_normal[self.index] is not None:
+            orn = self._facing(orn, -snap.normal(self.waypoints[self.index][0]), self.face_normal[self.index])
         ee_pos, ee_orn = pb.multiplyTransforms(goal.tolist(), orn, inv_pos, inv_orn)
         c = env.world.client
         robot = env.world.robot.id

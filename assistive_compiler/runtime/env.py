@@ -236,7 +236,8 @@ class AssistiveEnv(gym.Env):
         if raw.shape != (len(self.arm_idx),):
             raise ValueError(f"action must have shape ({len(self.arm_idx)},), got {raw.shape}")
         q = np.array([s[0] for s in pb.getJointStates(w.robot.id, self.arm_idx, physicsClientId=c)])
-        target = np.clip(q + self.delta_scale * np.clip(raw, -1.0, 1.0), self.lower, self.upper)
+        # np.minimum/np.maximum: np.clip's result, without its ~6 µs of call overhead.
+        target = np.minimum(np.maximum(q + self.delta_scale * np.minimum(np.maximum(raw, -1.0), 1.0), self.lower), self.upper)
         pb.setJointMotorControlArray(w.robot.id, self.arm_idx, pb.POSITION_CONTROL, targetPositions=target.tolist(),
                                      positionGains=self._gains, forces=self._forces, physicsClientId=c)
         # The person: held / tremoring without a human action, else its policy joints act (runtime/human.py).

@@ -65,6 +65,7 @@ class Snapshot:
         self.actions: dict[str, np.ndarray] = {"robot": np.zeros(0), "human": np.zeros(0)}
         self.events: dict[str, Any] = {}  # per particle set: ParticleEvents; per marker set: markers cleared (int)
         self._contacts: dict[tuple[int, int], tuple] = {}
+        self._pooled: dict[tuple, list] = {}  # contacts(a, b) this step, per (a, b)
         self._joint_cache: dict[JointsHandle, np.ndarray] = {}
         self.pos, self.orn, self.vel = np.zeros((0, 3)), np.zeros((0, 4)), np.zeros((0, 3))
         self.frames: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
@@ -148,6 +149,7 @@ class Snapshot:
                 for slot in reads.base_slots:
                     pos[slot], orn[slot], vel[slot] = frame_pos, frame_orn, lin
         self._contacts.clear()
+        self._pooled.clear()
         self._joint_cache.clear()
 
     def set_frame(self, name: str, pos, orn) -> None:
@@ -228,13 +230,19 @@ class Snapshot:
     def begin_episode(self) -> None:
         """Forget what depended on the last episode's person variant."""
         self._ids.clear()
+        self._pooled.clear()
 
     def contacts(self, a, b) -> list:
-        """pybullet contact points between any body of ``a`` (as bodyA) and any of ``b`` this step."""
-        out: list = []
-        for ia in self.body_ids(a):
-            for ib in self.body_ids(b):
-                out.extend(self._contact_points(ia, ib))
+        """pybullet contact points between any body of ``a`` (as bodyA) and any of ``b`` this step
+        (a list shared by the step's callers: do not modify it)."""
+        key = (tuple(a), tuple(b))
+        out = self._pooled.get(key)
+        if out is None:
+            out = []
+            for ia in self.body_ids(a):
+                for ib in self.body_ids(b):
+                    out.extend(self._contact_points(ia, ib))
+            self._pooled[key] = out
         return out
 
     def closest_distance(self, a: str, b, max_distance: float) -> float:

@@ -585,6 +585,12 @@ class Waypoint(Strict):
         None, description="Orientation of the moved point's link at this waypoint (roll, pitch, yaw; world, degrees), e.g. "
         "to tilt a cup; None keeps the tool's start orientation."
     )
+    face_normal_within_deg: float | None = Field(
+        None, ge=0, le=180, description="Turn the tool, by the smallest rotation from its start orientation, until its "
+        "pointing axis (from the end effector to the moved point) lies within this angle of the target's inward surface "
+        "normal (targets drawn on a surface), so the tool meets the surface tip first instead of lying across the limb; "
+        "degrees. None keeps the start orientation (or rpy_deg's)."
+    )
 
 
 class Scripted(Strict):

@@ -57,7 +57,7 @@ def _tool_force(snap, tool, on, target, radius) -> float:
 @term("velocity", "preference", Velocity)
 def velocity(snap, p) -> float:
     """C_v = −Σ‖v‖ over the listed points' linear speeds (m/s): move slowly near a person."""
-    return -sum(math.hypot(*snap.velocity(point)) for point in p.of)
+    return -sum(math.hypot(*snap.velocity(point).tolist()) for point in p.of)
 
 
 @term("force_nontarget", "preference", ForceNonTarget)

@@ -41,7 +41,7 @@ def distance(snap, p) -> float:
 @term("action_norm", "reward", ActionNorm)
 def action_norm(snap, p) -> float:
     """‖a‖₂ of the raw (unclipped) action of ``agent`` — the paper's action penalty input."""
-    return math.hypot(*snap.action(p.agent))
+    return math.hypot(*snap.action(p.agent).tolist())
 
 
 @term("particles_consumed", "reward", ParticleSet)
