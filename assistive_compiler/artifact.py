@@ -175,6 +175,16 @@ class ParticleSet(_Model):
     lost_anchor: Vec3 = Field((0.0, 0.0, 0.0), description="A point inside the lost body's collision geometry (lost link frame), m: a particle nearer than lost_distance to it is certainly not lost.")
     hit_body: str | None = Field(description="Body whose first contact with an active particle is a hit.")
     outside_of: Container | None = Field(None, description="Particles inside this container are neither consumed nor lost.")
+    rest: ParticleRest | None = Field(None, description="Carry particles at rest in a container instead of simulating them (None: always simulated).")
+
+
+class ParticleRest(_Model):
+    """Resting particles ride rigidly in their container while its effective tilt is below ``max_tilt``
+    (see the spec's RestInContainer and :mod:`assistive_compiler.runtime.particles`)."""
+
+    container: Container = Field(description="The container that carries them.")
+    max_tilt: float = Field(description="Effective tilt above which they are simulated again, radians.")
+    max_speed: float = Field(description="Relative speed below which simulated particles count as at rest, m/s.")
 
 
 class MarkerSet(_Model):

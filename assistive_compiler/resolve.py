@@ -369,15 +369,21 @@ class _Resolver:
             self.body(ps.attach, base + ("attach",), allow_particles=False)
             if ps.consumed_at:
                 self.point(ps.consumed_at.target, base + ("consumed_at", "target"))
-                holder = ps.consumed_at.outside_of
-                if holder is not None and self.body(holder, base + ("consumed_at", "outside_of"), allow_particles=False):
-                    if holder not in self.tools or self.tools[holder].part.container is None:
-                        with_container = [t for t, part in self.tools.items() if part.part.container is not None]
-                        self.problem(base + ("consumed_at", "outside_of"), f"'{holder}' is not a tool with a container; tools with one: {one_of(with_container) or 'none'}")
+                if ps.consumed_at.outside_of is not None:
+                    self._container(ps.consumed_at.outside_of, base + ("consumed_at", "outside_of"))
+            if ps.rest is not None:
+                self._container(ps.rest.container, base + ("rest", "container"))
             if ps.lost_beyond:
                 self.body(ps.lost_beyond.body, base + ("lost_beyond", "body"), allow_particles=False)
             if ps.hit_body:
                 self.body(ps.hit_body, base + ("hit_body",), allow_particles=False)
+
+    def _container(self, holder: str, path: tuple) -> None:
+        """``holder`` must be a tool whose part declares a container."""
+        if self.body(holder, path, allow_particles=False):
+            if holder not in self.tools or self.tools[holder].part.container is None:
+                with_container = [t for t, part in self.tools.items() if part.part.container is not None]
+                self.problem(path, f"'{holder}' is not a tool with a container; tools with one: {one_of(with_container) or 'none'}")
 
     def _term(self, use: Any, category: Category, path: tuple, name: str, weight: float) -> ResolvedTerm | None:
         registry = terms(category)

@@ -35,6 +35,7 @@ from ..artifact import (
     Body,
     Capsule,
     Container,
+    ParticleRest,
     MarkerPoint,
     MarkerSet,
     Manifest,
@@ -873,7 +874,9 @@ def _settle_particles(rt, pc, name, ps, tool_ids, furniture_ids, start, tool_orn
                        consumed_radius=ps.consumed_at.radius_m if ps.consumed_at else 0.0,
                        lost_body=ps.lost_beyond.body if ps.lost_beyond else None, lost_link=lost_link,
                        lost_distance=ps.lost_beyond.distance_m if ps.lost_beyond else 0.0, lost_anchor=_round(anchor),
-                       hit_body=ps.hit_body, outside_of=_container(rt, ps.consumed_at.outside_of if ps.consumed_at else None))
+                       hit_body=ps.hit_body, outside_of=_container(rt, ps.consumed_at.outside_of if ps.consumed_at else None),
+                       rest=None if ps.rest is None else ParticleRest(container=_container(rt, ps.rest.container),
+                                                                      max_tilt=math.radians(ps.rest.max_tilt_deg), max_speed=ps.rest.max_speed_mps))
 
 
 def _container(rt: ResolvedTask, tool: str | None) -> Container | None:

@@ -18,6 +18,7 @@ def _place_markers(env) -> None:
     for name, body in env.world.markers.items():
         pb.resetBasePositionAndOrientation(body, env.snap.position(env.snap.point({"target": name})).tolist(), (0, 0, 0, 1), physicsClientId=c)
     env.markers.place_visuals()
+    env.particles.place_visuals()
 
 
 def render_rgb(env, width: int = 480, height: int = 360, view: dict | None = None) -> np.ndarray:

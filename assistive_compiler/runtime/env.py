@@ -244,6 +244,7 @@ class AssistiveEnv(gym.Env):
         human = None if human_action is None else np.asarray(human_action, dtype=np.float64).reshape(-1)
         self.human.apply(human, self.steps)
         self.snap.actions["human"] = np.zeros(0) if human is None else human
+        self.particles.before_physics()
         w.step_physics()
         self._stepped = True
         self.steps += 1

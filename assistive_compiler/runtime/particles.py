@@ -6,6 +6,19 @@ compensation, so they touch nothing; they come back at reset. Nothing else about
 mass of 0 would make them static objects for good, and changing collision filters re-inserts
 them in the broadphase, which reorders contact pairs — either would make an episode depend on the
 ones before it. Events are evaluated once per env step, as in the reference.
+
+**Resting in a container** (a set's ``rest``, optional): while the container's effective tilt —
+the angle between its axis (+z) and the apparent "up" −(g − a), a its acceleration over the last
+env step — is at most ``rest.max_tilt``, particles at rest in it are *carried*: their positions in
+the container frame are kept and the bodies themselves are parked like removed ones, so the
+physics solves none of their contacts. At the start of an env step whose effective tilt exceeds
+the limit they are put back at their carried positions with the container's velocity (linear plus
+ω × r) and simulated. After an env step they are carried again when the tilt is within the limit,
+every active particle is inside the container and none moves faster than ``rest.max_speed``
+relative to it. A reset carries them at their settled start positions when the container starts
+within the limit. Carried particles are active and inside their container, so they produce no
+events; renders draw them with visual-only ghosts (:meth:`ParticleSystem.place_visuals`). Every
+decision is a function of the world's state, so seeded episodes stay reproducible.
 """
 
 from __future__ import annotations
@@ -15,9 +28,13 @@ import math
 import numpy as np
 import pybullet as pb
 
-from ..artifact import ParticleSet
+from ..artifact import Container, ParticleSet
 from .snapshot import ParticleEvents, PointHandle, Snapshot
 from .world import PARK, World
+
+
+def _rotation(orn) -> np.ndarray:
+    return np.asarray(pb.getMatrixFromQuaternion(orn), dtype=float).reshape(3, 3)
 
 
 class ParticleSystem:
@@ -32,9 +49,74 @@ class ParticleSystem:
             self.sets.append((ps, world.particles[ps.name], target))
         self.active: dict[str, np.ndarray] = {}
         self.hit: dict[str, np.ndarray] = {}
+        #: Per set with ``rest``: which particles are carried by their container now, and where (container frame, m).
+        self.carried: dict[str, np.ndarray] = {}
+        self.carried_at: dict[str, np.ndarray] = {}
+        self._container_velocity: dict[str, np.ndarray] = {}  # at the end of the last env step, world frame, m/s
+        self._dt = world.m.sim.time_step * world.m.sim.frame_skip
+        self._gravity = np.array([0.0, 0.0, world.m.sim.gravity])
 
+    # -- containers ------------------------------------------------------------------------------
+    def _container_state(self, box: Container):
+        """World pose of a container's frame (position, rotation matrix) and the rigid velocity
+        field of its body: (origin of that field, linear velocity there, angular velocity)."""
+        w, c = self.world, self.world.client
+        holder = w.bodies[box.body]
+        link = holder.links[box.link]
+        pos, orn = w.link_frame(holder, link)
+        if link == -1:
+            com = pb.getBasePositionAndOrientation(holder.id, physicsClientId=c)[0]
+            lin, ang = pb.getBaseVelocity(holder.id, physicsClientId=c)
+        else:
+            s = pb.getLinkState(holder.id, link, computeLinkVelocity=1, computeForwardKinematics=1, physicsClientId=c)
+            com, lin, ang = s[0], s[6], s[7]
+        return np.asarray(pos), _rotation(orn), np.asarray(com), np.asarray(lin), np.asarray(ang)
+
+    def _tilt(self, name: str, rot: np.ndarray, lin: np.ndarray) -> float:
+        """Effective tilt of a container (radians): its +z against −(g − a)."""
+        prev = self._container_velocity.get(name)
+        accel = np.zeros(3) if prev is None else (lin - prev) / self._dt
+        up = accel - self._gravity
+        norm = float(np.linalg.norm(up))
+        if norm < 1e-9:
+            return math.pi
+        return math.acos(max(-1.0, min(1.0, float(rot[:, 2] @ up) / norm)))
+
+    @staticmethod
+    def _inside(box: Container, local: np.ndarray) -> np.ndarray:
+        """Which container-frame points (n, 3) lie in the container's cylinder."""
+        r2 = local[:, 0] ** 2 + local[:, 1] ** 2
+        return (r2 <= box.radius ** 2) & (local[:, 2] >= -box.radius) & (local[:, 2] <= box.height)
+
+    def _positions(self, ids: list[int]) -> np.ndarray:
+        c = self.world.client
+        return np.array([pb.getBasePositionAndOrientation(pid, physicsClientId=c)[0] for pid in ids], dtype=float).reshape(-1, 3)
+
+    def _carry(self, ps: ParticleSet, ids: list[int], which: np.ndarray, local: np.ndarray) -> None:
+        """Park the particles ``which`` (bool mask) and remember their container-frame positions."""
+        carried, at = self.carried[ps.name], self.carried_at[ps.name]
+        for k in np.flatnonzero(which):
+            at[k] = local[k]
+            carried[k] = True
+            self._park(ids[k], int(k))
+
+    def _release(self, ps: ParticleSet, ids: list[int]) -> None:
+        """Put the carried particles back where they were carried, moving with the container."""
+        w, c = self.world, self.world.client
+        pos, rot, com, lin, ang = self._container_state(ps.rest.container)
+        carried, at = self.carried[ps.name], self.carried_at[ps.name]
+        for k in np.flatnonzero(carried):
+            p = pos + rot @ at[k]
+            v = lin + np.cross(ang, p - com)
+            w.parked.discard(ids[k])
+            pb.resetBasePositionAndOrientation(ids[k], p.tolist(), (0, 0, 0, 1), physicsClientId=c)
+            pb.resetBaseVelocity(ids[k], v.tolist(), (0, 0, 0), physicsClientId=c)
+        carried[:] = False
+
+    # -- lifecycle -------------------------------------------------------------------------------
     def reset(self) -> None:
-        """Place every particle at its settled position in its holder's frame; all active."""
+        """Place every particle at its settled position in its holder's frame; all active (and
+        carried, for a set that rests in a container that starts within its tilt limit)."""
         w, c = self.world, self.world.client
         for ps, ids, _ in self.sets:
             holder = w.bodies[ps.attach]
@@ -47,6 +129,43 @@ class ParticleSystem:
             self.active[ps.name] = np.ones(ps.count, dtype=bool)
             self.hit[ps.name] = np.zeros(ps.count, dtype=bool)
             self.snap.events[ps.name] = ParticleEvents()
+            if ps.rest is not None:
+                self.carried[ps.name] = np.zeros(ps.count, dtype=bool)
+                self.carried_at[ps.name] = np.zeros((ps.count, 3))
+                self._container_velocity.pop(ps.name, None)
+                self._maybe_carry(ps, ids)
+
+    def before_physics(self) -> None:
+        """At the start of an env step: simulate carried particles again if their container tilts too far."""
+        for ps, ids, _ in self.sets:
+            if ps.rest is None or not self.carried[ps.name].any():
+                continue
+            _, rot, _, lin, _ = self._container_state(ps.rest.container)
+            if self._tilt(ps.name, rot, lin) > ps.rest.max_tilt:
+                self._release(ps, ids)
+
+    def _maybe_carry(self, ps: ParticleSet, ids: list[int]) -> None:
+        """After an env step: carry the set's particles if they rest in a container within its tilt limit."""
+        box = ps.rest.container
+        pos, rot, com, lin, ang = self._container_state(box)
+        tilt = self._tilt(ps.name, rot, lin)
+        self._container_velocity[ps.name] = lin
+        free = self.active[ps.name] & ~self.carried[ps.name]
+        if tilt > ps.rest.max_tilt or not free.any():
+            return
+        c = self.world.client
+        idx = np.flatnonzero(free)
+        world = self._positions([ids[k] for k in idx])
+        local = (world - pos) @ rot  # rotᵀ (p − pos), row-wise
+        if not self._inside(box, local).all():
+            return
+        vel = np.array([pb.getBaseVelocity(ids[k], physicsClientId=c)[0] for k in idx], dtype=float)
+        relative = vel - (lin + np.cross(ang, world - com))
+        if float(np.max(np.einsum("ij,ij->i", relative, relative))) > ps.rest.max_speed ** 2:
+            return
+        full = np.zeros((ps.count, 3))
+        full[idx] = local
+        self._carry(ps, ids, free, full)
 
     def _park(self, pid: int, k: int) -> None:
         c = self.world.client
@@ -57,11 +176,20 @@ class ParticleSystem:
     def update(self) -> None:
         """Evaluate this step's events (after physics, after the snapshot refresh)."""
         w, c, snap = self.world, self.world.client, self.snap
-        base_pose, base_velocity, closest = pb.getBasePositionAndOrientation, pb.getBaseVelocity, pb.getClosestPoints
+        base_velocity, closest = pb.getBaseVelocity, pb.getClosestPoints
         for ps, ids, target in self.sets:
             ev = ParticleEvents()
             active, hit = self.active[ps.name], self.hit[ps.name]
-            centre = tuple(snap.position(target)) if target is not None else None
+            carried = self.carried.get(ps.name)
+            live = active & ~carried if carried is not None else active.copy()
+            idx = np.flatnonzero(live)
+            if not len(idx):
+                snap.events[ps.name] = ev
+                if ps.rest is not None:
+                    self._maybe_carry(ps, ids)
+                continue
+            positions = self._positions([ids[k] for k in idx])
+            centre = snap.position(target) if target is not None else None
             hit_ids: set[int] = set()
             if ps.hit_body:
                 hb = snap.handle(snap.body_key(ps.hit_body)).id
@@ -71,37 +199,50 @@ class ParticleSystem:
                 holder = snap.handle(snap.body_key(ps.lost_body))
                 lost_id = holder.id
                 frame = w.link_frame(holder, holder.links[ps.lost_link])
-                anchor = pb.multiplyTransforms(*frame, ps.lost_anchor, (0, 0, 0, 1))[0]
-            inside = None
+                anchor = np.asarray(pb.multiplyTransforms(*frame, ps.lost_anchor, (0, 0, 0, 1))[0])
+            inside = np.zeros(len(idx), dtype=bool)
             if ps.outside_of is not None:  # particles still in their container are neither consumed nor lost
                 box = ps.outside_of
                 holder = w.bodies[box.body]
-                inside = (pb.invertTransform(*w.link_frame(holder, holder.links[box.link])), box.radius, box.height)
-            for k, pid in enumerate(ids):
-                if not active[k]:
-                    continue
-                pos = base_pose(pid, physicsClientId=c)[0]
+                fpos, forn = w.link_frame(holder, holder.links[box.link])
+                inside = self._inside(box, (positions - np.asarray(fpos)) @ _rotation(forn))
+            to_centre = np.linalg.norm(positions - centre, axis=1) if centre is not None else None
+            to_anchor = np.linalg.norm(positions - anchor, axis=1) if anchor is not None else None
+            for j, k in enumerate(idx):
+                pid = ids[k]
                 if pid in hit_ids and not hit[k]:
                     hit[k] = True
                     ev.hit += 1
-                if inside is not None:
-                    (inv_pos, inv_orn), radius, height = inside
-                    x, y, z = pb.multiplyTransforms(inv_pos, inv_orn, pos, (0, 0, 0, 1))[0]
-                    if x * x + y * y <= radius * radius and -radius <= z <= height:
-                        continue
-                if centre is not None and math.dist(pos, centre) < ps.consumed_radius:
+                if inside[j]:
+                    continue
+                if to_centre is not None and to_centre[j] < ps.consumed_radius:
                     ev.consumed += 1
                     ev.consumed_speed_sum += math.hypot(*base_velocity(pid, physicsClientId=c)[0])
                     active[k] = False
-                    self._park(pid, k)
-                elif (lost_id is not None and math.dist(pos, anchor) >= ps.lost_distance
+                    self._park(pid, int(k))
+                elif (lost_id is not None and to_anchor[j] >= ps.lost_distance
                       and not closest(pid, lost_id, ps.lost_distance, physicsClientId=c)):
                     # Within lost_distance of a point inside the holder means certainly near it;
                     # only otherwise is the exact closest-points query needed.
                     ev.lost += 1
                     active[k] = False
-                    self._park(pid, k)
+                    self._park(pid, int(k))
             snap.events[ps.name] = ev
+            if ps.rest is not None:
+                self._maybe_carry(ps, ids)
+
+    def place_visuals(self) -> None:
+        """Put the render ghosts of carried particles where they are carried (the others' ghosts far away)."""
+        w, c = self.world, self.world.client
+        for ps, _, _ in self.sets:
+            ghosts = w.particle_ghosts.get(ps.name)
+            if not ghosts:
+                continue
+            carried = self.carried[ps.name] & self.active[ps.name]
+            pos, rot = (self._container_state(ps.rest.container)[:2]) if carried.any() else (None, None)
+            for k, ghost in enumerate(ghosts):
+                p = (pos + rot @ self.carried_at[ps.name][k]).tolist() if carried[k] else [PARK[0] - 5.0 - 0.1 * k, PARK[1] + 2.0, PARK[2]]
+                pb.resetBasePositionAndOrientation(ghost, p, (0, 0, 0, 1), physicsClientId=c)
 
     def remaining(self, name: str) -> int:
         return int(self.active[name].sum())

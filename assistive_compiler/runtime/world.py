@@ -101,6 +101,7 @@ class World:
         self._set_gravity()
         self._set_stepping()
         visual_only = {b for bodies in self.marker_visuals.values() for b in bodies} | set(self.markers.values())
+        visual_only |= {b for bodies in self.particle_ghosts.values() for b in bodies}
         self._all_bodies = [b for b in range(pb.getNumBodies(physicsClientId=c)) if b != self.ground and b not in visual_only]
         # Bodies at rest would otherwise fall asleep after ~2 s; sleep is not part of a saved state,
         # so an episode would depend on how long the previous one left something resting.
@@ -167,13 +168,20 @@ class World:
     def _create_particles(self) -> None:
         c = self.client
         self.particles: dict[str, list[int]] = {}
+        #: Per set that can rest in a container: one visual-only sphere per particle, drawn in
+        #: renders where a carried particle is (see runtime/particles.py); physics never sees them.
+        self.particle_ghosts: dict[str, list[int]] = {}
         for ps in self.m.particles:
             shape = pb.createCollisionShape(pb.GEOM_SPHERE, radius=ps.radius, physicsClientId=c)
-            ids = []
+            ids, ghosts = [], []
             for i in range(ps.count):
                 visual = pb.createVisualShape(pb.GEOM_SPHERE, radius=ps.radius, rgbaColor=list(ps.colors[i]), physicsClientId=c)
                 ids.append(pb.createMultiBody(ps.mass, shape, visual, [PARK[0] - 5.0 - 0.1 * i, PARK[1] + 1.0, PARK[2]], physicsClientId=c))
+                if ps.rest is not None:
+                    ghosts.append(pb.createMultiBody(0, -1, visual, [PARK[0] - 5.0 - 0.1 * i, PARK[1] + 2.0, PARK[2]], physicsClientId=c))
             self.particles[ps.name] = ids
+            if ghosts:
+                self.particle_ghosts[ps.name] = ghosts
 
     def _create_markers(self) -> None:
         """Visual-only spheres for targets and marker sets that ask to be shown (created before the

@@ -461,6 +461,28 @@ class LostBeyond(Strict):
     distance_m: float = Field(gt=0, le=10, description="Distance beyond which it is lost, metres.")
 
 
+class RestInContainer(Strict):
+    """A simulation shortcut: particles resting in their container ride with it instead of being simulated.
+
+    While the container's effective tilt — the angle between its axis (+z, towards the opening)
+    and the apparent "up" −(g − a), with a the container's acceleration — stays below
+    ``max_tilt_deg``, a heap of particles at rest in it does not flow, so the runtime carries them
+    rigidly in the container's frame and takes them out of the physics (no contacts to solve).
+    Once the tilt exceeds it they are put back where they were carried, with the container's
+    velocity, and simulated again; they rest again once the tilt is below the limit, every active
+    particle is inside the container and none moves faster than ``max_speed_mps`` relative to it.
+    What this trades: sloshing under accelerations below the limit is not simulated.
+    """
+
+    container: Ref = Field(description="A tool with a container (e.g. the cup) that carries the resting particles.")
+    max_tilt_deg: float = Field(
+        20.0, gt=0, le=60, description="Effective tilt (degrees) above which resting particles are simulated again; keep it below the heap's angle of repose."
+    )
+    max_speed_mps: float = Field(
+        0.02, gt=0, le=1, description="Speed relative to the container (m/s) below which simulated particles count as at rest."
+    )
+
+
 class Particles(Strict):
     """A grid of small spheres (food, water) with a lifecycle: active → consumed | lost."""
 
@@ -478,6 +500,9 @@ class Particles(Strict):
     lost_beyond: LostBeyond | None = Field(None, description="When a particle is lost (spilled).")
     hit_body: Ref | None = Field(
         None, description="Body whose first contact with an active particle counts as a hit (food on the person)."
+    )
+    rest: RestInContainer | None = Field(
+        None, description="Carry particles at rest in a container with it instead of simulating them (a speed-up; see RestInContainer)."
     )
 
     @field_validator("grid")
