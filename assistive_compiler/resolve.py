@@ -484,7 +484,8 @@ class _Resolver:
                     self.problem(("scripted", "waypoints", i, key), f"{key} needs a target drawn on a surface (surface_of); '{w.to}' is not one")
             waypoints.append({"to": to, "offset_m": list(w.offset_m), "tolerance_m": w.tolerance_m,
                               "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
-                              "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None})
+                              "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None}
+                             | ({"step_m": w.step_m} if w.step_m is not None else {}))  # absent when unset: other artifacts unchanged
         return {"move": move, "waypoints": waypoints, "repeat_from": spec.scripted.repeat_from}
 
     def _success(self, spec: TaskSpec, reward_names: set[str]) -> float:

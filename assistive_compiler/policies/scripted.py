@@ -6,8 +6,9 @@ orientation (or the waypoint's own), and returns the joint-delta action that hea
 advances to the next waypoint within the waypoint's tolerance — or when it has stopped getting
 closer (no gain of 2 mm over 10 steps: an approach point the arm cannot quite reach should not
 end the episode) — and holds the last one, or goes on from ``repeat_from`` (to rub back and
-forth). A waypoint may sit off a surface-drawn target along its outward normal and along its limb. Works for any task and robot whose manifest has a
-``scripted`` section.
+forth). A waypoint may sit off a surface-drawn target along its outward normal and along its limb,
+and may be approached along a straight line (``step_m``: IK aims at most that far ahead of the
+moved point). Works for any task and robot whose manifest has a ``scripted`` section.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ class ScriptedPolicy:
                            w.get("axis_offset_m", 0.0)) for w in m.scripted["waypoints"]]
         self.orientations = [pb.getQuaternionFromEuler(w["rpy_rad"]) if w.get("rpy_rad") else None for w in m.scripted["waypoints"]]
         self.repeat_from = m.scripted.get("repeat_from")
+        self.steps_m = [w.get("step_m") for w in m.scripted["waypoints"]]
         robot = env.world.robot
         self.ee_link = robot.links[m.robot.links["tool_mount"]]
         self.ee_point = snap.point({"body": "robot", "link": m.robot.links["tool_mount"]})
@@ -79,6 +81,13 @@ class ScriptedPolicy:
             self.index = self.index + 1 if not last else self.repeat_from
             self._best, self._since_best = float("inf"), 0
             goal, tol = self._goal()
+        step = self.steps_m[self.index]
+        if step is not None:  # a straight line from where the point is: IK aims at most step_m ahead
+            here = snap.position(self.move)
+            ahead = goal - here
+            distance = float(np.linalg.norm(ahead))
+            if distance > step:
+                goal = here + ahead * (step / distance)
         # End-effector pose that puts the moved point at the goal with the kept orientation.
         inv_pos, inv_orn = pb.invertTransform(*self.point_in_ee)
         orn = self.orientations[self.index] or self.keep_orn

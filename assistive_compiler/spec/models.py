@@ -598,6 +598,11 @@ class Waypoint(Strict):
         None, description="Orientation of the moved point's link at this waypoint (roll, pitch, yaw; world, degrees), e.g. "
         "to tilt a cup; None keeps the tool's start orientation."
     )
+    step_m: float | None = Field(
+        None, gt=0, le=0.5, description="Largest distance, metres, between the moved point and the goal handed to IK while heading "
+        "for this waypoint: the point then follows the straight line from where it is (e.g. wiping along a limb) instead of the "
+        "joint-space path one IK jump takes. None: IK aims at the waypoint itself."
+    )
 
 
 class Scripted(Strict):
