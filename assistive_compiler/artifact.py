@@ -45,6 +45,11 @@ class Body(_Model):
     gravity: float | None = Field(description="Gravity on this body, m/s² along z (None: the world's).")
     friction: float | None = Field(None, description="Lateral friction of every link (None: URDF value).")
     position_noise: Vec3 = Field((0.0, 0.0, 0.0), description="Per-reset uniform position noise half-widths, m.")
+    carried_by_robot: tuple[Vec3, Quat] | None = Field(
+        None,
+        description="Furniture carried under the robot (robot.mount_base: search): its frame (position m, quaternion) in the "
+        "robot base frame; every reset places it under the start's base pose. None: it stays at position/orientation.",
+    )
 
 
 class StartState(_Model):

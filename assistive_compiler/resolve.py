@@ -231,7 +231,18 @@ class _Resolver:
         if value not in pool:
             self.problem(path, f"unknown body '{value}'; expected one of {one_of(pool)}{did_you_mean(value, pool)}")
             return None
+        if self._conditional(value, path):
+            return None
         return value
+
+    def _conditional(self, body: str, path: tuple) -> bool:
+        """True (and a problem) when ``body`` is furniture present only under a mounted robot."""
+        use = self.spec.scene.furniture.get(body)
+        if use is None or not use.only_when_mounted:
+            return False
+        self.problem(path, f"furniture '{body}' is in the scene only when the robot is mounted on it (only_when_mounted: true), "
+                           "so nothing may refer to it; refer to furniture that is always there")
+        return True
 
     def point(self, value: str, path: tuple, *, allow_target: bool = True) -> dict[str, Any] | None:
         if allow_target and value in self.spec.targets:
@@ -241,6 +252,8 @@ class _Resolver:
             pool = [b for b, s in self.body_names.items() if s != "particles"] + (list(self.spec.targets) if allow_target else [])
             what = "target or body" if allow_target else "body"
             self.problem(path, f"unknown {what} '{value}'; expected one of {one_of(pool)}{did_you_mean(body, pool)}")
+            return None
+        if self._conditional(body, path):
             return None
         if not link:
             return {"body": body, "link": self.reference_link(body)}
@@ -302,6 +315,8 @@ class _Resolver:
             if seat not in spec.scene.furniture:
                 pool = list(spec.scene.furniture)
                 self.problem(("person", "placement", "seated_on"), f"unknown furniture '{seat}'; expected one of {one_of(pool)}{did_you_mean(seat, pool)}")
+            elif self._conditional(seat, ("person", "placement", "seated_on")):
+                pass
             elif seat in self.furniture and not self.furniture[seat].part.seat_link:
                 self.problem(("person", "placement", "seated_on"), f"furniture '{seat}' (part '{self.furniture[seat].part.name}') has no seat_link to sit on")
 
@@ -313,6 +328,25 @@ class _Resolver:
                 self.problem(("robot", "mount_on"), f"unknown furniture '{mount}'; expected one of {one_of(pool)}{did_you_mean(mount, pool)}")
             elif mount in self.furniture and self.robot.part.mountable and not self.furniture[mount].part.mount_link:
                 self.problem(("robot", "mount_on"), f"furniture '{mount}' has no mount_link for the robot")
+        for name, use in spec.scene.furniture.items():
+            if use.only_when_mounted and name != mount:
+                self.problem(("scene", "furniture", name, "only_when_mounted"),
+                             f"furniture '{name}' is only_when_mounted but the robot mounts on {repr(mount) if mount else 'nothing'} "
+                             "(robot.mount_on); only the mount furniture can be left out for robots that stand on the floor")
+        if spec.robot.mount_base == "search":
+            use = spec.scene.furniture.get(mount) if mount else None
+            if mount is None:
+                self.problem(("robot", "mount_base"), "mount_base 'search' carries the mount furniture under the searched base, "
+                                                      "but robot.mount_on names no furniture; set robot.mount_on or use mount_base: furniture")
+            elif use is not None and not use.only_when_mounted:
+                self.problem(("robot", "mount_base"), f"mount_base 'search' places furniture '{mount}' under a mounted robot's base, "
+                                                      f"so without one it has no place: set scene.furniture.{mount}.only_when_mounted: true")
+            elif use is not None:
+                for field in ("position_m", "rpy_deg", "position_noise_m"):
+                    if field in use.model_fields_set:
+                        self.problem(("scene", "furniture", mount, field),
+                                     f"furniture '{mount}' is carried under the robot's searched base (robot.mount_base: search), "
+                                     f"so its {field} is not used; remove it (move the base search instead)")
         for name, use in spec.tools.items():
             if use.part not in self.robot.part.grips:
                 self.problem(("tools", name, "part"), f"robot '{self.robot_name}' has no grip for tool '{use.part}' (add it under grips: in {self.robot.shown})")
@@ -459,7 +493,8 @@ class _Resolver:
             waypoints.append({"to": to, "offset_m": list(w.offset_m), "tolerance_m": w.tolerance_m,
                               "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
                               "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
-                              "face_normal_within_rad": math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None})
+                              "face_normal_within_rad": math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None}
+                             | ({"step_m": w.step_m} if w.step_m is not None else {}))  # absent when unset: other artifacts unchanged
         return {"move": move, "waypoints": waypoints, "repeat_from": spec.scripted.repeat_from}
 
     def _success(self, spec: TaskSpec, reward_names: set[str]) -> float:

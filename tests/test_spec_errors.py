@@ -478,6 +478,63 @@ def test_unknown_seat_furniture(tmp_path, capsys):
 
 
 # --------------------------------------------------------------------------------------------
+# furniture only under a mounted robot; mount furniture carried under a searched base
+
+BATHING = REPO / "specs" / "tasks" / "bed_bathing.yaml"
+CONDITIONAL = ("is in the scene only when the robot is mounted on it (only_when_mounted: true), so nothing may refer to it; "
+               "refer to furniture that is always there")
+
+
+def bathing_location(needle: str, offset: int = 0) -> str:
+    """``PATH:LINE:COL`` of ``needle`` (plus ``offset`` columns) in the shipped bed-bathing spec, as the CLI shows it."""
+    line, column = at(BATHING.read_text(encoding="utf-8"), needle).split(":")
+    return f"{display(BATHING)}:{line}:{int(column) + offset}"
+
+
+def test_only_when_mounted_is_for_the_mount_furniture_and_unreferenced(tmp_path, capsys):
+    text = f"extends: {BATHING}\nscene:\n  furniture:\n    bed: {{part: bed, position_m: [-0.1, 0, 0], only_when_mounted: true}}\n"
+    path = write(tmp_path, text)
+    assert sorted(problems(capsys, path)) == sorted([  # one in each file
+        f"{bathing_location('bed]}}')}: furniture 'bed' {CONDITIONAL}",
+        f"{display(path)}:{at(text, 'true')}: furniture 'bed' is only_when_mounted but the robot mounts on 'nightstand' "
+        "(robot.mount_on); only the mount furniture can be left out for robots that stand on the floor",
+    ])
+
+
+def test_referring_to_furniture_present_only_when_mounted(tmp_path, capsys):
+    text = f"extends: {BATHING}\nscripted:\n  move: nightstand\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, 'nightstand')}: furniture 'nightstand' {CONDITIONAL}")
+
+
+def test_searched_mount_needs_furniture_present_only_when_mounted(tmp_path, capsys):
+    text = f"extends: {BATHING}\nscene:\n  furniture:\n    nightstand: {{part: nightstand, only_when_mounted: false}}\n"
+    path = write(tmp_path, text)
+    assert problems(capsys, path) == [
+        f"{bathing_location('mount_base: search', len('mount_base: '))}: mount_base 'search' places furniture 'nightstand' under a "
+        "mounted robot's base, so without one it has no place: set scene.furniture.nightstand.only_when_mounted: true"
+    ]
+
+
+def test_carried_furniture_has_no_scene_position(tmp_path, capsys):
+    text = f"extends: {BATHING}\nscene:\n  furniture:\n    nightstand: {{part: nightstand, only_when_mounted: true, position_m: [-0.9, 0.7, 0]}}\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, '[-0.9')}: furniture 'nightstand' is carried under the robot's searched base "
+                        "(robot.mount_base: search), so its position_m is not used; remove it (move the base search instead)")
+
+
+def test_searched_mount_needs_a_mount(tmp_path, capsys):
+    text = f"extends: {BATHING}\nrobot:\n  mount_on: null\n"
+    path = write(tmp_path, text)
+    assert problems(capsys, path) == [
+        f"{bathing_location('only_when_mounted: true', len('only_when_mounted: '))}: furniture 'nightstand' is only_when_mounted but "
+        "the robot mounts on nothing (robot.mount_on); only the mount furniture can be left out for robots that stand on the floor",
+        f"{bathing_location('mount_base: search', len('mount_base: '))}: mount_base 'search' carries the mount furniture under the "
+        "searched base, but robot.mount_on names no furniture; set robot.mount_on or use mount_base: furniture",
+    ]
+
+
+# --------------------------------------------------------------------------------------------
 # several problems at once
 
 

@@ -265,6 +265,56 @@ def test_markers_lie_on_the_arm_and_are_cleared_once(bathing):
     assert info["success_metric"] == cleared_total
 
 
+def test_nightstand_is_carried_under_the_searched_base(bathing):
+    """robot.mount_base: search (facts §2.2): Jaco's base comes from the base search and the
+    nightstand (only_when_mounted) is put under it: its robot_mount frame on the robot's base frame
+    at every reset, whichever precomputed start is drawn, with the start arm clear of it."""
+    env = bathing
+    w = env.world
+    assert all("base_poses" in p for p in env.manifest.robot.placement.values())  # searched, not mounted where the scene put it
+    stand = w.bodies["nightstand"]
+    bases = set()
+    for seed in range(8):
+        env.reset(seed=seed)
+        base_pos, base_orn = w.base_frame(w.robot)
+        mount_pos, mount_orn = w.link_frame(stand, stand.links["robot_mount"])
+        assert np.allclose(mount_pos, base_pos, atol=1e-6)
+        assert abs(abs(float(np.dot(mount_orn, base_orn))) - 1.0) < 1e-6
+        assert base_pos[2] == pytest.approx(0.674, abs=1e-6)  # on the nightstand's top
+        assert not pb.getClosestPoints(w.robot.id, stand.id, 0.0, physicsClientId=w.client)
+        bases.add(tuple(np.round(base_pos, 4)))
+    assert len(bases) > 1  # the nightstand follows the start's base
+
+
+def test_closest_distance_equals_a_full_query_every_step(bathing):
+    """closest_distance starts from its last answer; the result is the full query's minimum, exactly."""
+    env = bathing
+    wiper = env.world.bodies["wiper"].id
+    rng = np.random.default_rng(3)
+    env.reset(seed=3)
+    for _ in range(60):
+        env.step(rng.uniform(-1, 1, env.action_space.shape))
+        person = env.world.variant_bodies[env.world.active_variant.name].id
+        full = min([cp[8] for cp in pb.getClosestPoints(wiper, person, 5.0, physicsClientId=env.world.client)] + [5.0])
+        assert env.snap.closest_distance("wiper", ["person"], 5.0) == full
+
+
+@pytest.mark.slow
+def test_free_standing_robot_has_no_nightstand(tmp_path):
+    """The nightstand is only_when_mounted: Sawyer stands on the floor, found by the base search,
+    and its scene has no nightstand (which sat in PR2's and Sawyer's way before)."""
+    env = AssistiveEnv(compile_task(TASKS / "bed_bathing.yaml", "sawyer", tmp_path / "bathing-sawyer").out_dir)
+    try:
+        assert "nightstand" not in {b.name for b in env.manifest.bodies}
+        assert "nightstand" not in env.world.bodies
+        assert all("base_poses" in p for p in env.manifest.robot.placement.values())
+        obs, _ = env.reset(seed=0)
+        obs, *_ = env.step(np.zeros(env.action_space.shape))
+        assert np.isfinite(obs).all()
+    finally:
+        env.close()
+
+
 # --------------------------------------------------------------------------------------------
 # Drinking: container, tilt
 

@@ -214,7 +214,7 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
     else:
         emit("robot", lib.template_path(rt.robot), robot_part.template.params, rt.robot.smap.value(("template", "path")))
     mounted_on = spec.robot.mount_on if robot_part.mountable else None
-    for name, use in spec.scene.furniture.items():
+    for name, use in _present_furniture(rt).items():
         part = rt.furniture[name].part
         params = dict(part.template.params) | dict(use.params)
         if name == mounted_on:
@@ -471,7 +471,7 @@ def _settle_person(rt: ResolvedTask, written: dict[str, Path], variant: str, mea
         p.setPhysicsEngineParameter(numSolverIterations=spec.sim.solver.iterations, numSubSteps=spec.sim.solver.sub_steps,
                                     deterministicOverlappingPairs=1, physicsClientId=c)
         p.createMultiBody(0, p.createCollisionShape(p.GEOM_PLANE, physicsClientId=c), physicsClientId=c)
-        for name, use in spec.scene.furniture.items():
+        for name, use in _present_furniture(rt, placed_only=True).items():
             fid = pc.load(written[name], use.position_m, _quat_from_rpy(tuple(math.radians(a) for a in use.rpy_deg)), True)
             if settle.friction is not None:
                 for link in range(-1, p.getNumJoints(fid, physicsClientId=c)):
@@ -515,7 +515,7 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measur
 
     # Furniture at its nominal pose.
     furniture_ids: dict[str, int] = {}
-    for name, use in spec.scene.furniture.items():
+    for name, use in _present_furniture(rt).items():
         part = rt.furniture[name].part
         orn = _quat_from_rpy(tuple(math.radians(a) for a in use.rpy_deg))
         static = part.static if use.static is None else use.static
@@ -564,10 +564,14 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measur
     lower = [infos[j][8] for j in arm_joints]
     upper = [infos[j][9] for j in arm_joints]
     mount_pose = None
+    carry: _Carried | None = None
     if mounted_on:
         fpart = rt.furniture[mounted_on].part
         mpos, morn = pc.link_pose(furniture_ids[mounted_on], pc.link_index(furniture_ids[mounted_on], fpart.mount_link))
-        mount_pose = (tuple(a + b for a, b in zip(mpos, offset)), tuple(morn))
+        if spec.robot.mount_base == "search":  # loaded at the origin: the mount link's pose is its pose in the furniture frame
+            carry = _Carried(pc, furniture_ids[mounted_on], tuple(mpos), tuple(morn))
+        else:
+            mount_pose = (tuple(a + b for a, b in zip(mpos, offset)), tuple(morn))
 
     # Tools and the grip transform.
     tool_ids: dict[str, int] = {}
@@ -610,13 +614,15 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measur
             bases = [(mount_pose, len(goals), 0.0)]
             placements[variant] = {"mounted_on": mounted_on}
         else:
-            bases = _search_base(rt, arm_kin, goals, offset, rng)
+            bases = _search_base(rt, arm_kin, goals, offset, rng, carry)
             placements[variant] = {"base_poses": [{"position": list(_round(b[0][0])), "yaw_rad": _round(_yaw(b[0][1])),
                                                    "goals_reached": b[1], "goals": len(goals), "jlwki": _round(b[2])} for b in bases]}
         starts: list[StartState] = []
         per_base = max(1, math.ceil(start.samples / len(bases)))
         for (base_pos, base_orn), _, _ in bases:
             arm_kin.place(base_pos, base_orn)
+            if carry is not None:
+                carry.place(base_pos, base_orn)
             for s in range(per_base):
                 noise = np.zeros(3) if s == 0 else rng.uniform(-start.noise_m, start.noise_m, 3)
                 goal = tuple(np.asarray(start.tool_position_m) + noise)
@@ -645,6 +651,11 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measur
     first = variants_out[0].starts[0]
     base_pos, base_orn = first.base_position, first.base_orientation
     arm_kin.place(base_pos, base_orn)
+    if carry is not None:  # the manifest's pose: under the first start's base; reset() carries it under each start's
+        pos, orn = carry.place(base_pos, base_orn)
+        k = next(i for i, b in enumerate(bodies) if b.name == mounted_on)
+        bodies[k] = bodies[k].model_copy(update={"position": _round(pos), "orientation": _round(orn),
+                                                 "carried_by_robot": (_round(carry.inv_pos), _round(carry.inv_orn))})
     for i, q in zip(arm_kin.arm_idx, first.joints):
         p.resetJointState(robot_id, i, q, physicsClientId=c)
 
@@ -677,6 +688,16 @@ def _marker_points(limbs: dict, links: list[str], spacing: float) -> list[Marker
                 a = k * spacing / r
                 out.append(MarkerPoint(link=link, offset=_round(tuple(centre + r * (math.cos(a) * u + math.sin(a) * v)))))
     return out
+
+
+def _present_furniture(rt: ResolvedTask, placed_only: bool = False) -> dict[str, Any]:
+    """The scene's furniture for this robot: only_when_mounted pieces only under a mounted robot;
+    with ``placed_only`` also without one carried under a searched base (its pose is not known yet)."""
+    spec = rt.spec
+    mounted_on = spec.robot.mount_on if rt.robot.part.mountable else None
+    carried = mounted_on if spec.robot.mount_base == "search" else None
+    return {name: use for name, use in spec.scene.furniture.items()
+            if (not use.only_when_mounted or name == mounted_on) and not (placed_only and name == carried)}
 
 
 def _seat_links(rt: ResolvedTask) -> list[str]:
@@ -797,13 +818,30 @@ class _ArmKinematics:
         return float(max(np.linalg.det(M), 0.0) ** (1 / 6) / (np.trace(M) / 6))
 
 
-def _search_base(rt: ResolvedTask, arm: _ArmKinematics, goals, offset, rng):
+class _Carried:
+    """Furniture carried under a robot whose base is searched (robot.mount_base: search): its
+    mount link (pose ``mount_pos``/``mount_orn`` in the furniture frame, m) lies on the base frame."""
+
+    def __init__(self, pc, body: int, mount_pos, mount_orn):
+        self.pc, self.body, self.height = pc, body, float(mount_pos[2])
+        self.inv_pos, self.inv_orn = pc.p.invertTransform(mount_pos, mount_orn)  # furniture frame in the base frame
+
+    def place(self, base_pos, base_orn) -> tuple[tuple, tuple]:
+        """Put the furniture under a base pose (world); returns its frame's world pose."""
+        pos, orn = self.pc.p.multiplyTransforms(base_pos, base_orn, self.inv_pos, self.inv_orn)
+        self.pc.place(self.body, pos, orn)
+        return tuple(pos), tuple(orn)
+
+
+def _search_base(rt: ResolvedTask, arm: _ArmKinematics, goals, offset, rng, carry: _Carried | None = None):
     """The paper's base-pose search, bounded: exactly ``attempts`` samples; the ``keep`` best by
     (goals reached, Σ JLWKI), each reaching every required goal. Raises with the goal that no
-    sampled pose reached."""
+    sampled pose reached. With ``carry`` the base sits at the carried furniture's mount height and
+    the furniture moves under every sampled base; a pose where it touches the person or other
+    furniture is rejected."""
     search = rt.spec.robot.base_search
     anchor = np.asarray(search.origin_m[:2]) + np.asarray(offset[:2])
-    z = rt.robot.part.base_height_m + (offset[2] if len(offset) > 2 else 0.0)
+    z = (carry.height if carry is not None else rt.robot.part.base_height_m) + (offset[2] if len(offset) > 2 else 0.0)
     found = []
     required_misses = np.zeros(len(goals), dtype=int)
     for _ in range(search.attempts):
@@ -812,7 +850,13 @@ def _search_base(rt: ResolvedTask, arm: _ArmKinematics, goals, offset, rng):
         pos, orn = (float(xy[0]), float(xy[1]), float(z)), _quat_from_rpy((0.0, 0.0, yaw))
         arm.place(pos, orn)
         arm.set_arm(arm.rest)
-        if any(arm.pc.touching(arm.robot, o) for o in arm.obstacles) or arm.pc.touching(arm.robot, arm.person):
+        if carry is not None:
+            carry.place(pos, orn)
+            if any(arm.pc.touching(carry.body, o) for o in arm.obstacles if o != carry.body) or arm.pc.touching(carry.body, arm.person):
+                continue
+        # The base must clear the scene at the arm's rest pose; its own carried mount is checked per IK solution
+        # only (a folded arm may rest against the mount's top, which says nothing about the base pose).
+        if any(arm.pc.touching(arm.robot, o) for o in arm.obstacles if carry is None or o != carry.body) or arm.pc.touching(arm.robot, arm.person):
             continue
         reached, score, ok = 0, 0.0, True
         for k, (gpos, gorn, required, _name) in enumerate(goals):

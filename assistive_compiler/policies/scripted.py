@@ -10,7 +10,8 @@ forth). A waypoint may sit off a surface-drawn target along its outward normal a
 and may turn the tool towards that target's surface (``face_normal_within_rad``: the smallest
 rotation of the start orientation that brings the tool's pointing axis — end effector to moved
 point — within that angle of the inward normal, so a spot on the far side of a limb is met tip
-first rather than with the tool lying across the limb). Works for any task and robot whose
+first rather than with the tool lying across the limb), and may be approached along a straight line
+(``step_m``: IK aims at most that far ahead of the moved point). Works for any task and robot whose
 manifest has a ``scripted`` section.
 """
 
@@ -43,6 +44,7 @@ class ScriptedPolicy:
         self.orientations = [pb.getQuaternionFromEuler(w["rpy_rad"]) if w.get("rpy_rad") else None for w in m.scripted["waypoints"]]
         self.face_normal = [w.get("face_normal_within_rad") for w in m.scripted["waypoints"]]
         self.repeat_from = m.scripted.get("repeat_from")
+        self.steps_m = [w.get("step_m") for w in m.scripted["waypoints"]]
         robot = env.world.robot
         self.ee_link = robot.links[m.robot.links["tool_mount"]]
         self.ee_point = snap.point({"body": "robot", "link": m.robot.links["tool_mount"]})
@@ -109,6 +111,13 @@ class ScriptedPolicy:
             self.index = self.index + 1 if not last else self.repeat_from
             self._best, self._since_best = float("inf"), 0
             goal, tol = self._goal()
+        step = self.steps_m[self.index]
+        if step is not None:  # a straight line from where the point is: IK aims at most step_m ahead
+            here = snap.position(self.move)
+            ahead = goal - here
+            distance = float(np.linalg.norm(ahead))
+            if distance > step:
+                goal = here + ahead * (step / distance)
         # End-effector pose that puts the moved point at the goal with the kept orientation.
         inv_pos, inv_orn = pb.invertTransform(*self.point_in_ee)
         orn = self.orientations[self.index] or self.keep_orn

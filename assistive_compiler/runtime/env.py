@@ -198,8 +198,11 @@ class AssistiveEnv(gym.Env):
             pos, orn = pb.multiplyTransforms(link_pos, link_orn, att.position, att.orientation)
             w.set_base_frame(w.bodies[att.body], pos, orn)
             pb.resetBaseVelocity(w.bodies[att.body].id, (0, 0, 0), (0, 0, 0), physicsClientId=c)
-        # Furniture noise and floor friction.
+        # Furniture carried under the robot's base (robot.mount_base: search), furniture noise and floor friction.
         for body in m.bodies:
+            if body.carried_by_robot is not None:
+                pos, orn = pb.multiplyTransforms(start.base_position, start.base_orientation, *body.carried_by_robot)
+                w.set_base_frame(w.bodies[body.name], pos, orn)
             if body.kind == "furniture" and any(body.position_noise):
                 noise = rng.uniform(-np.asarray(body.position_noise), np.asarray(body.position_noise))
                 w.set_base_frame(w.bodies[body.name], tuple(np.asarray(body.position) + noise), body.orientation)

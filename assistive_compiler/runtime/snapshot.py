@@ -20,6 +20,9 @@ from ..quat import quat_conj, quat_mul, quat_rotate  # noqa: F401  (re-exported)
 from .world import World
 
 
+CLOSEST_SLACK_M = 0.05  # closest_distance first looks this far beyond its last answer (m); any value gives the same result
+
+
 @dataclass(frozen=True)
 class PointHandle:
     """A point: link slot plus an offset in the link frame (targets; per person variant)."""
@@ -70,6 +73,7 @@ class Snapshot:
         self.pos, self.orn, self.vel = np.zeros((0, 3)), np.zeros((0, 4)), np.zeros((0, 3))
         self.frames: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self._ids: dict[tuple[str, ...], tuple[int, ...]] = {}
+        self._closest_hint: dict[tuple, float] = {}  # last closest_distance per (body, bodies): where the next query starts
 
     # -- binding ------------------------------------------------------------------------------
     def body_key(self, name: str) -> str:
@@ -231,6 +235,7 @@ class Snapshot:
         """Forget what depended on the last episode's person variant."""
         self._ids.clear()
         self._pooled.clear()
+        self._closest_hint.clear()
 
     def contacts(self, a, b) -> list:
         """pybullet contact points between any body of ``a`` (as bodyA) and any of ``b`` this step
@@ -246,12 +251,35 @@ class Snapshot:
         return out
 
     def closest_distance(self, a: str, b, max_distance: float) -> float:
-        """Smallest surface distance between body ``a`` and any body of ``b`` within ``max_distance`` (m)."""
+        """Smallest surface distance between body ``a`` and any body of ``b`` within ``max_distance`` (m).
+
+        Asked first within the last answer for the same bodies plus ``CLOSEST_SLACK_M`` (most link
+        pairs then drop out in the broadphase instead of each returning its closest points), and
+        within ``max_distance`` only when nothing that near is found: the same minimum, since every
+        pair nearer than the first query's reach is reported by it."""
         ia = self.body_ids([a])[0]
-        best = max_distance
-        for ib in self.body_ids(b):
-            for cp in pb.getClosestPoints(ia, ib, max_distance, physicsClientId=self.world.client):
-                best = min(best, cp[8])
+        ids = self.body_ids(b)
+        key = (a, ids)
+        hint = self._closest_hint.get(key)
+        if hint is not None and hint + CLOSEST_SLACK_M < max_distance:
+            reach = hint + CLOSEST_SLACK_M
+            best = self._closest(ia, ids, reach)
+            if best is not None and best <= reach:
+                self._closest_hint[key] = best
+                return best
+        best = self._closest(ia, ids, max_distance)
+        best = max_distance if best is None else min(best, max_distance)
+        self._closest_hint[key] = best
+        return best
+
+    def _closest(self, ia: int, ids, reach: float) -> float | None:
+        """Smallest distance (m) of the closest points of body ``ia`` and bodies ``ids`` within ``reach``; None if none."""
+        client, best = self.world.client, None
+        for ib in ids:
+            points = pb.getClosestPoints(ia, ib, reach, physicsClientId=client)
+            if points:
+                d = min([cp[8] for cp in points])
+                best = d if best is None or d < best else best
         return best
 
     def contact_force(self, a, b, near: PointHandle | None = None, radius: float = 0.0) -> float:

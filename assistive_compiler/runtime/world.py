@@ -225,6 +225,7 @@ class World:
             forces.append(fz)
         #: Per body: (id, links, z-forces) applied before every physics step; ids in ``parked`` are skipped.
         self.gravity_groups = [(bid, links, forces) for bid, (links, forces) in groups.items()]
+        self._gravity_plan = None  # gravity_groups rearranged for the per-step loop (see _apply_gravity_compensation)
         self.parked: set[int] = set()
         pb.setGravity(0, 0, self.world_gravity, physicsClientId=c)
 
@@ -280,21 +281,20 @@ class World:
         apply, world = pb.applyExternalForce, pb.WORLD_FRAME
         base_pose, link_states = pb.getBasePositionAndOrientation, pb.getLinkStates
         parked = self.parked
-        for bid, links, forces in self.gravity_groups:
+        plan = self._gravity_plan
+        if plan is None or plan[0] is not self.gravity_groups:  # per body: base force, child links, their forces (built once)
+            plan = self._gravity_plan = (self.gravity_groups, [
+                (bid, next(((0.0, 0.0, fz) for l, fz in zip(links, forces) if l == -1), None),
+                 [l for l in links if l >= 0], [(0.0, 0.0, fz) for l, fz in zip(links, forces) if l >= 0])
+                for bid, links, forces in self.gravity_groups])
+        for bid, base_force, children, child_forces in plan[1]:
             if bid in parked:
                 continue
-            if links == [-1]:
-                apply(bid, -1, (0.0, 0.0, forces[0]), base_pose(bid, physicsClientId=c)[0], world, physicsClientId=c)
-                continue
-            states = link_states(bid, [l for l in links if l >= 0], physicsClientId=c)
-            k = 0
-            for link, fz in zip(links, forces):
-                if link == -1:
-                    pos = base_pose(bid, physicsClientId=c)[0]
-                else:
-                    pos = states[k][0]
-                    k += 1
-                apply(bid, link, (0.0, 0.0, fz), pos, world, physicsClientId=c)
+            if base_force is not None:
+                apply(bid, -1, base_force, base_pose(bid, physicsClientId=c)[0], world, physicsClientId=c)
+            if children:
+                for link, force, state in zip(children, child_forces, link_states(bid, children, physicsClientId=c)):
+                    apply(bid, link, force, state[0], world, physicsClientId=c)
 
     # -- frames --------------------------------------------------------------------------------
     def base_frame(self, handle: BodyHandle):

@@ -128,6 +128,12 @@ class FurnitureUse(Strict):
     params: dict[str, float | int | str | bool] = Field(
         default_factory=dict, description="Template parameters of the part (e.g. a wheelchair's robot_mount side)."
     )
+    only_when_mounted: bool = Field(
+        False,
+        description="In the scene only when the task's robot is mounted on it (it must be robot.mount_on and the robot "
+        "mountable): a nightstand that carries Jaco is absent for a PR2 standing on the floor. Nothing else in the spec may "
+        "refer to such furniture.",
+    )
 
     @field_validator("position_noise_m")
     @classmethod
@@ -372,6 +378,13 @@ class RobotRole(Strict):
     mount_on: Name | None = Field(
         None, description="Furniture that mounts robots able to be mounted (e.g. Jaco on the wheelchair)."
     )
+    mount_base: Literal["furniture", "search"] = Field(
+        "furniture",
+        description="Where a mounted robot's base goes. 'furniture': on the mount furniture's mount_link where the scene "
+        "places it, plus per_robot.base_offset_m (Jaco on the wheelchair). 'search': base_search chooses the base pose, as "
+        "for a robot standing on the floor but at the mount link's height, and the furniture is carried under the chosen "
+        "base (the mount link on the base frame; its scene pose is then not given) — the reference's nightstand beside a bed.",
+    )
     gravity_mps2: float | None = Field(0.0, ge=-20, le=0, description="Gravity on the robot (0: compensated).")
     control: RobotControl = Field(default_factory=RobotControl, description="Arm control.")
     start: StartGoal = Field(description="Start pose of the end effector.")
@@ -615,6 +628,11 @@ class Waypoint(Strict):
         "pointing axis (from the end effector to the moved point) lies within this angle of the target's inward surface "
         "normal (targets drawn on a surface), so the tool meets the surface tip first instead of lying across the limb; "
         "degrees. None keeps the start orientation (or rpy_deg's)."
+    )
+    step_m: float | None = Field(
+        None, gt=0, le=0.5, description="Largest distance, metres, between the moved point and the goal handed to IK while heading "
+        "for this waypoint: the point then follows the straight line from where it is (e.g. wiping along a limb) instead of the "
+        "joint-space path one IK jump takes. None: IK aims at the waypoint itself."
     )
 
 
