@@ -195,8 +195,12 @@ def sleeve_progress(
     hand_beyond_wrist_m: float,
     beyond_elbow_m: float,
     beyond_shoulder_m: float,
+    upper_arm_counts: bool = True,
 ) -> float:
     """The reference's dressing reward r_dress (facts §2.5), in metres, for one arm.
+
+    ``upper_arm_counts=False`` skips the upper-arm branch (for a caller that requires the forearm
+    to have been in the sleeve first: see the ``sleeve_progress`` reward term).
 
     Arm geometry (world frame, metres): ``hand_end = wrist + hand_beyond_wrist_m·û(wrist − elbow)``,
     ``elbow_end = elbow + beyond_elbow_m·û(elbow − wrist)``,
@@ -218,7 +222,7 @@ def sleeve_progress(
     centre = ring.mean(axis=0)
     forearm_len = float(np.linalg.norm(hand_end - elbow_end))
     upperarm_len = float(np.linalg.norm(elbow - shoulder))
-    if ring_encloses_segment(ring, elbow_end, shoulder_end):
+    if upper_arm_counts and ring_encloses_segment(ring, elbow_end, shoulder_end):
         along = float(np.linalg.norm(centre - elbow))
         return forearm_len + (along if along < upperarm_len else 0.0)
     to_hand = float(np.linalg.norm(centre - hand_end))

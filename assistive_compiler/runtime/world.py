@@ -15,6 +15,13 @@ Person self-collision: a person body whose manifest lists self-collision pairs i
 every other body loads as before. :attr:`World.after_physics_step`, when set, runs after each
 physics step of :meth:`step_physics` (the person's limit enforcement).
 
+Garments (cloth): an artifact with garments gets a deformable world (``RESET_USE_DEFORMABLE_WORLD``
+before anything is loaded; its gravity is the spec's, as a soft body feels only the world's). Each
+garment is a mass-spring soft body whose held nodes are pinned to a massless, collision-free anchor
+body; :meth:`follow_grips` teleports the anchors to the hand's held frame after every physics step
+and :meth:`reset_garments` puts the settled nodes back at reset (``restoreState`` does not cover
+soft-body nodes). The garment's body handle has the soft body's id and the anchor's pose.
+
 Frames: pybullet reports a base's pose at its centre of mass; :meth:`base_frame` and
 :meth:`set_base_frame` convert to and from the URDF frame the manifest uses.
 """
