@@ -61,6 +61,30 @@ def test_opening_off_the_arm_scores_minus_its_distance_to_the_hand_end():
     assert r_dress(ring(beside, [0, 1, 0])) == pytest.approx(-math.dist(beside, HAND_END))
 
 
+def test_upper_arm_counts_only_after_the_forearm_was_in_the_sleeve():
+    """The term (ordered, the default): an opening swept sideways onto the upper arm scores as
+    off the arm until the forearm has been in the sleeve this episode; reset forgets."""
+    from types import SimpleNamespace
+
+    from assistive_compiler.terms.rewards import SleeveProgressTerm
+
+    points = {"s": S, "e": E, "w": W}
+    snap = SimpleNamespace(node_positions=lambda h: snap.nodes, position=lambda h: points[h])
+    p = SimpleNamespace(opening=None, shoulder="s", elbow="e", wrist="w", hand_beyond_wrist_m=HAND, beyond_elbow_m=R,
+                        beyond_shoulder_m=R, ordered=True)
+    upper, fore = ring([0.15, 0.0, 0.0], [1, 0, 0]), ring([0.28, -0.2, 0.0], [0, 1, 0])
+    term = SleeveProgressTerm()
+    snap.nodes = upper
+    assert term(snap, p) == pytest.approx(-math.dist([0.15, 0, 0], HAND_END))
+    snap.nodes = fore
+    assert term(snap, p) == pytest.approx(0.146, abs=1e-3)
+    snap.nodes = upper
+    assert term(snap, p) == pytest.approx(FOREARM_LEN + 0.13)
+    term.reset()
+    assert term(snap, p) < 0
+    assert term(snap, SimpleNamespace(**{**vars(p), "ordered": False})) == pytest.approx(FOREARM_LEN + 0.13)
+
+
 def test_ring_enclosure_needs_the_segment_to_cross_inside_the_polygon():
     hoop = ring([0, 0, 0], [0, 0, 1])
     assert ring_encloses_segment(hoop, [0, 0, -1], [0, 0, 1])
