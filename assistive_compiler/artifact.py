@@ -212,6 +212,33 @@ class Container(_Model):
     height: float = Field(description="Height, m.")
 
 
+class Garment(_Model):
+    """A soft-body garment: its mesh, physics, node sets and how the robot holds it.
+
+    The OBJ's vertices are in the *held frame* (the garment already posed in it); vertex k is
+    soft-body node k. ``nodes_in_held`` are the settled node positions in the held frame, where
+    every reset puts them (the held frame's world pose is the robot's tool-mount link pose times
+    ``grip_position``/``grip_orientation``). The ``anchored`` nodes follow the held frame exactly.
+    """
+
+    name: str = Field(description="Body name used in references.")
+    obj: str = Field(description="Mesh path relative to the artifact directory (vertices in the held frame, m).")
+    parent_link: str = Field(description="Robot link the held frame rides on (URDF name).")
+    grip_position: Vec3 = Field(description="Held frame origin in the parent link frame, m.")
+    grip_orientation: Quat = Field(description="Held frame orientation in the parent link frame.")
+    anchored: list[int] = Field(description="Node indices pinned to the held frame.")
+    node_sets: dict[str, list[int]] = Field(description="Named node sets (e.g. opening) → node indices.")
+    nodes_in_held: list[Vec3] = Field(description="Settled node positions in the held frame, m (reset starts here).")
+    mass: float = Field(description="Total mass, kg.")
+    collision_margin: float = Field(description="Collision margin, m.")
+    elastic_stiffness: float = Field(description="springElasticStiffness, N/m.")
+    damping_stiffness: float = Field(description="springDampingStiffness (all directions), N·s/m.")
+    bending_stiffness: float = Field(description="springBendingStiffness, N/m.")
+    friction: float = Field(description="Friction coefficient.")
+    collides_with: list[str] | None = Field(None, description="Bodies ('person' = every variant) the cloth collides with; None: all and the floor.")
+    rgba: tuple[float, float, float, float] = Field(description="Colour.")
+
+
 class TermUse(_Model):
     """A bound term: registered kind, normalised parameters, weight."""
 
@@ -267,6 +294,7 @@ class Manifest(_Model):
     observations: dict[str, list[TermUse]] = Field(description="Observation features per agent, in order.")
     reward: list[TermUse] = Field(description="Reward terms including preference costs.")
     success: Success
+    garments: list[Garment] = Field(default_factory=list, description="Soft-body garments (their presence makes the world a deformable one).")
     scripted: dict[str, Any] | None = Field(None, description="Scripted baseline: point moved and waypoints (normalised).")
 
     def body(self, name: str) -> Body:

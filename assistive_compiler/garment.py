@@ -36,6 +36,10 @@ __all__ = [
     "gripped_ring_indices",
     "ring_centre",
     "boundary_edges",
+    "sleeve_node_sets",
+    "ring_encloses_segment",
+    "sleeve_progress",
+    "load_garment",
 ]
 
 
@@ -139,3 +143,114 @@ def boundary_edges(faces: np.ndarray) -> set[tuple[int, int]]:
             e = (int(min(u, v)), int(max(u, v)))
             counts[e] = counts.get(e, 0) + 1
     return {e for e, n in counts.items() if n == 1}
+
+
+def sleeve_node_sets(rings: int, segments: int) -> dict[str, np.ndarray]:
+    """The named node sets a generated sleeve exports (specs refer to them as ``<garment>.<set>``).
+
+    * ``opening`` — ring 0, the hole the hand enters (whole ring, in increasing angle);
+    * ``opening_top`` — the nodes of ring 0 within ±45° of the sleeve frame's +y (a pinch of the rim);
+    * ``cuff`` — the last ring, at the far end of the tube.
+    """
+    return {
+        "opening": opening_ring_indices(segments),
+        "opening_top": gripped_ring_indices(segments, 0, arc_deg=90.0),
+        "cuff": ring_indices(rings - 1, segments),
+    }
+
+
+def ring_encloses_segment(ring_xyz: np.ndarray, a: np.ndarray, b: np.ndarray) -> bool:
+    """True when segment a→b passes through the closed polygon of the ring's nodes (in order).
+
+    The ring's best-fit plane (SVD of the nodes about their mean); the segment must cross it, and
+    the crossing point must have winding number ±1 with respect to the ring projected onto the
+    plane. Any frame (all points in the same one), metres.
+    """
+    ring = np.asarray(ring_xyz, dtype=float)
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    c = ring.mean(axis=0)
+    _, _, vt = np.linalg.svd(ring - c)
+    n, e1, e2 = vt[2], vt[0], vt[1]
+    da, db = float(np.dot(a - c, n)), float(np.dot(b - c, n))
+    if da * db > 0 or da == db:
+        return False
+    x = a + (b - a) * (da / (da - db))
+    q = np.stack([(ring - x) @ e1, (ring - x) @ e2], axis=1)
+    ang = np.arctan2(q[:, 1], q[:, 0])
+    dang = np.diff(np.append(ang, ang[0]))
+    dang = (dang + np.pi) % (2 * np.pi) - np.pi
+    return bool(abs(dang.sum()) > np.pi)
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    n = float(np.linalg.norm(v))
+    return v / n if n > 0 else v
+
+
+def sleeve_progress(
+    ring_xyz: np.ndarray,
+    shoulder: np.ndarray,
+    elbow: np.ndarray,
+    wrist: np.ndarray,
+    hand_beyond_wrist_m: float,
+    beyond_elbow_m: float,
+    beyond_shoulder_m: float,
+    upper_arm_counts: bool = True,
+) -> float:
+    """The reference's dressing reward r_dress (facts §2.5), in metres, for one arm.
+
+    ``upper_arm_counts=False`` skips the upper-arm branch (for a caller that requires the forearm
+    to have been in the sleeve first: see the ``sleeve_progress`` reward term).
+
+    Arm geometry (world frame, metres): ``hand_end = wrist + hand_beyond_wrist_m·û(wrist − elbow)``,
+    ``elbow_end = elbow + beyond_elbow_m·û(elbow − wrist)``,
+    ``shoulder_end = shoulder + beyond_shoulder_m·û(shoulder − elbow)`` (the reference: 2·r, r, r
+    with r the upper-arm radius). The opening is ``ring_xyz`` (its nodes in order), its centre
+    their mean. A limb is *in the sleeve* when its axis segment passes through the opening
+    (:func:`ring_encloses_segment`; the reference uses two triangles of the ring instead).
+
+    * upper arm (elbow_end→shoulder_end) in: ``forearm_len`` (= ‖hand_end − elbow_end‖) plus
+      ‖centre − elbow‖ when that is below ``upperarm_len`` (= ‖elbow − shoulder‖);
+    * else forearm (hand_end→elbow_end) in and ‖centre − hand_end‖ < forearm_len: ‖centre − hand_end‖;
+    * else −‖hand_end − centre‖ (approach the hand).
+    """
+    shoulder, elbow, wrist = (np.asarray(v, dtype=float) for v in (shoulder, elbow, wrist))
+    ring = np.asarray(ring_xyz, dtype=float)
+    hand_end = wrist + hand_beyond_wrist_m * _unit(wrist - elbow)
+    elbow_end = elbow + beyond_elbow_m * _unit(elbow - wrist)
+    shoulder_end = shoulder + beyond_shoulder_m * _unit(shoulder - elbow)
+    centre = ring.mean(axis=0)
+    forearm_len = float(np.linalg.norm(hand_end - elbow_end))
+    upperarm_len = float(np.linalg.norm(elbow - shoulder))
+    if upper_arm_counts and ring_encloses_segment(ring, elbow_end, shoulder_end):
+        along = float(np.linalg.norm(centre - elbow))
+        return forearm_len + (along if along < upperarm_len else 0.0)
+    to_hand = float(np.linalg.norm(centre - hand_end))
+    if ring_encloses_segment(ring, hand_end, elbow_end) and to_hand < forearm_len:
+        return to_hand
+    return -to_hand
+
+
+def load_garment(pb, c: int, obj: str | Path, held_pos, held_orn, mass, margin, ks, kd, kb, friction, anchored, rgba=None) -> tuple[int, int]:
+    """Load a garment OBJ (vertices in the held frame) as a mass-spring soft body with its held
+    frame at (held_pos, held_orn), world frame, and pin the ``anchored`` nodes to a massless,
+    collision-free body placed at that frame (teleport that body to move them). The world must
+    be a deformable one (``resetSimulation(RESET_USE_DEFORMABLE_WORLD)`` before anything was
+    loaded). Returns (soft body id, anchor body id). Shared by the compiler (settling) and the runtime."""
+    sb = pb.loadSoftBody(str(obj), basePosition=list(held_pos), baseOrientation=list(held_orn), scale=1.0, mass=mass,
+                         collisionMargin=margin, useMassSpring=1, useBendingSprings=1, useNeoHookean=0,
+                         springElasticStiffness=ks, springDampingStiffness=kd, springDampingAllDirections=1,
+                         springBendingStiffness=kb, useSelfCollision=0, frictionCoeff=friction, useFaceContact=1, physicsClientId=c)
+    if rgba is not None:
+        pb.changeVisualShape(sb, -1, rgbaColor=list(rgba), flags=pb.VISUAL_SHAPE_DOUBLE_SIDED, physicsClientId=c)
+    # Asleep, a soft body reports no contacts: keep it awake.
+    pb.changeDynamics(sb, -1, activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING, physicsClientId=c)
+    anchor = pb.createMultiBody(baseMass=0, basePosition=list(held_pos), baseOrientation=list(held_orn), physicsClientId=c)
+    # The anchor's local point is taken from the node's position at this moment (the node lies at
+    # held pose × its OBJ vertex), so the pinned nodes keep their place in the held frame.
+    nodes = pb.getMeshData(sb, -1, flags=pb.MESH_DATA_SIMULATION_MESH, physicsClientId=c)[1]
+    inv_pos, inv_orn = pb.invertTransform(list(held_pos), list(held_orn))
+    for i in anchored:
+        local, _ = pb.multiplyTransforms(inv_pos, inv_orn, nodes[int(i)], (0, 0, 0, 1))
+        pb.createSoftBodyAnchor(sb, int(i), anchor, -1, list(local), physicsClientId=c)
+    return sb, anchor

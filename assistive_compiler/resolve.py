@@ -28,6 +28,8 @@ from .spec.validation import problems_from_validation
 from .terms.registry import Category, TermDef, ref_fields, terms
 
 RESERVED_BODIES = ("robot", "person")
+GARMENT_HELD_LINK = "held"
+"""The one link of a garment body: its held frame (the pose the robot's hand gives it)."""
 ROBOT_SEMANTIC_LINKS = ("base", "end_effector", "tool_mount")
 
 
@@ -134,6 +136,7 @@ class _Resolver:
         points = self._targets(spec)
         markers = self._markers(spec)
         self._particles(spec)
+        self._garments(spec)
         observations = {
             agent: [self._term(use, "observation", ("observations", agent, i), f"{agent}_{i}", 1.0) for i, use in enumerate(getattr(spec.observations, agent))]
             for agent in ("robot", "human")
@@ -162,7 +165,8 @@ class _Resolver:
 
     def _bodies(self, spec: TaskSpec) -> None:
         self.body_names: dict[str, str] = {"robot": "robot", "person": "person"}
-        for section, names in (("scene.furniture", spec.scene.furniture), ("tools", spec.tools), ("particles", spec.particles)):
+        for section, names in (("scene.furniture", spec.scene.furniture), ("tools", spec.tools), ("particles", spec.particles),
+                               ("garments", spec.garments)):
             for name in names:
                 path = tuple(section.split(".")) + (name,)
                 if name in self.body_names:
@@ -209,6 +213,8 @@ class _Resolver:
             return dict(self.tools[body].part.links) | {"base": self.tools[body].part.base_link}
         if body in self.furniture:
             return dict(self.furniture[body].part.links) | {"base": self.furniture[body].part.base_link}
+        if body in self.spec.garments:
+            return {GARMENT_HELD_LINK: GARMENT_HELD_LINK}
         return {}
 
     def reference_link(self, body: str) -> str | None:
@@ -221,6 +227,8 @@ class _Resolver:
             return tool.links[tool.reference_link]
         if body in self.furniture:
             return self.furniture[body].part.base_link
+        if body in self.spec.garments:
+            return GARMENT_HELD_LINK
         return None
 
     def robot_person_root(self) -> str:
@@ -271,6 +279,39 @@ class _Resolver:
             self.problem(path, f"unknown joint group '{value}'; expected one of {one_of(pool, 20)}{did_you_mean(value, pool)}")
             return None
         return self.joint_groups[value]
+
+    def node_set(self, value: str, path: tuple) -> dict[str, Any] | None:
+        """``<garment>.<set>`` → {"garment", "set", "nodes"} (node indices of the generated mesh)."""
+        from .garment import sleeve_node_sets
+
+        name, _, set_name = value.partition(".")
+        if name not in self.spec.garments:
+            pool = list(self.spec.garments)
+            self.problem(path, f"unknown garment '{name}'; expected one of {one_of(pool) or 'none (declare one under garments:)'}{did_you_mean(name, pool)}")
+            return None
+        shape = self.spec.garments[name].shape
+        sets = sleeve_node_sets(shape.rings, shape.segments)
+        if set_name not in sets:
+            self.problem(path, f"unknown node set '{set_name}' of garment '{name}'; expected one of {one_of(sets)}{did_you_mean(set_name, sets)} (write {name}.<set>)")
+            return None
+        return {"garment": name, "set": set_name, "nodes": [int(i) for i in sets[set_name]]}
+
+    def _garments(self, spec: TaskSpec) -> None:
+        from .garment import sleeve_node_sets
+
+        for name, g in spec.garments.items():
+            base = ("garments", name, "held")
+            if g.held.grip not in self.robot.part.grips:
+                grips = list(self.robot.part.grips)
+                self.problem(base + ("grip",), f"robot '{self.robot_name}' has no grip '{g.held.grip}' to hold garment '{name}' (add it under grips: in {self.robot.shown}); its grips are {one_of(grips)}{did_you_mean(g.held.grip, grips)}")
+            for i, body in enumerate(g.collides_with or []):
+                if self.body(body, ("garments", name, "collides_with", i), allow_particles=False) == name:
+                    self.problem(("garments", name, "collides_with", i), f"garment '{name}' cannot collide with itself (self-collision is off)")
+            sets = sleeve_node_sets(g.shape.rings, g.shape.segments)
+            if g.held.nodes not in sets:
+                self.problem(base + ("nodes",), f"unknown node set '{g.held.nodes}' of garment '{name}'; expected one of {one_of(sets)}{did_you_mean(g.held.nodes, sets)}")
+        if spec.garments and spec.tools:
+            self.problem(("garments",), "a task with a garment holds no tool (the garment is what the hand holds); remove tools: or garments:", key=True)
 
     def particles(self, value: str, path: tuple) -> str | None:
         if value not in self.spec.particles:
@@ -457,6 +498,8 @@ class _Resolver:
             return self.joints(value, path)
         if kind == "particles":
             return self.particles(value, path)
+        if kind == "nodes":
+            return self.node_set(value, path)
         if kind == "markers":
             if value not in self.spec.markers:
                 pool = list(self.spec.markers)

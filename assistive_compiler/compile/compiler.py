@@ -35,6 +35,7 @@ from ..artifact import (
     Body,
     Capsule,
     Container,
+    Garment,
     ParticleRest,
     MarkerPoint,
     MarkerSet,
@@ -216,9 +217,8 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
     mounted_on = spec.robot.mount_on if robot_part.mountable else None
     for name, use in _present_furniture(rt).items():
         part = rt.furniture[name].part
-        params = dict(part.template.params) | dict(use.params)
-        if name == mounted_on:
-            params |= part.mount_params
+        params = dict(part.template.params) | (dict(part.mount_params) if name == mounted_on else {})
+        params |= dict(use.params)  # the task's explicit parameters win (e.g. a mount on the person's left)
         emit(name, lib.template_path(rt.furniture[name]), params, rt.furniture[name].smap.value(("template", "path")))
     for name, use in spec.tools.items():
         part = rt.tools[name].part
@@ -591,9 +591,16 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measur
     # 3b. Base poses and start configurations, per person variant -----------------------------
     start = spec.robot.start
     tool_orn = _quat_from_rpy(tuple(math.radians(a) for a in start.tool_rpy_deg))
+    garment_grips = {}
+    for gname, g in spec.garments.items():
+        grip = robot_part.grips[g.held.grip]
+        garment_grips[gname] = (robot_part.arm_for(g.held.hand)[1].tool_mount, _round(tuple(grip.position_m)), _round(_quat_from_rpy(grip.rpy_rad)))
     if tool_name:
         att = attachments[0]
         inv_pos, inv_orn = p.invertTransform(att.position, att.orientation)
+    elif garment_grips:  # the start pose is the garment's held frame
+        _, gpos, gorn = next(iter(garment_grips.values()))
+        inv_pos, inv_orn = p.invertTransform(gpos, gorn)
     else:
         inv_pos, inv_orn = (0, 0, 0), (0, 0, 0, 1)
     arm_kin = _ArmKinematics(pc, robot_id, pc.link_index(robot_id, arm.tool_mount), [robot_joints[j] for j in arm_joints], lower, upper,
@@ -665,8 +672,55 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measur
 
     bodies.insert(0, Body(name="robot", kind="robot", urdf=rel(written["robot"]), position=_round(base_pos), orientation=_round(base_orn),
                           fixed_base=True, gravity=spec.robot.gravity_mps2))
-    return _manifest(rt, bodies, variants_out, attachments, particle_sets, arm_joints, lower, upper, movable, placements)
+    garments = [_settle_garment(rt, name, g, out_tmp, garment_grips[name], tool_orn) for name, g in spec.garments.items()]
+    return _manifest(rt, bodies, variants_out, attachments, particle_sets, arm_joints, lower, upper, movable, placements, garments)
 
+
+def _settle_garment(rt: ResolvedTask, name: str, g, out_tmp: Path, grip, held_orn) -> Garment:
+    """Generate a garment's mesh into the artifact (vertices in the held frame) and let it hang
+    from the held frame — at the task's start orientation, away from everything — for
+    ``settle.steps`` physics steps under ``settle.gravity_mps2`` in a deformable world with the
+    task's time step and sub-steps. Returns its manifest entry with the settled nodes (held frame).
+    Deterministic: the same inputs give the same bytes."""
+    import pybullet as pb
+
+    from ..garment import load_garment, sleeve_mesh, sleeve_node_sets, write_obj
+
+    spec, shape, phys = rt.spec, g.shape, g.physics
+    verts, faces = sleeve_mesh(shape.length_m, shape.radius_open_m, shape.radius_end_m, shape.rings, shape.segments)
+    pose_q = _quat_from_rpy(tuple(math.radians(a) for a in g.held.rpy_deg))
+    rot = np.asarray(pb.getMatrixFromQuaternion(pose_q)).reshape(3, 3)
+    held_verts = verts @ rot.T + np.asarray(g.held.offset_m)
+    obj = out_tmp / "garments" / f"{name}.obj"
+    obj.parent.mkdir(exist_ok=True)
+    write_obj(obj, np.round(held_verts, 6), faces, name=name)
+    sets = {k: [int(i) for i in v] for k, v in sleeve_node_sets(shape.rings, shape.segments).items()}
+    anchored = sets[g.held.nodes]
+    c = pb.connect(pb.DIRECT)
+    try:
+        pb.resetSimulation(pb.RESET_USE_DEFORMABLE_WORLD, physicsClientId=c)
+        pb.setTimeStep(spec.sim.time_step_s, physicsClientId=c)
+        pb.setPhysicsEngineParameter(numSubSteps=spec.sim.solver.sub_steps, physicsClientId=c)
+        pb.setGravity(0, 0, g.settle.gravity_mps2, physicsClientId=c)
+        held_pos = (0.0, 0.0, 2.0 + shape.length_m)
+        sb, anchor = load_garment(pb, c, obj, held_pos, held_orn, phys.mass_kg, phys.collision_margin_m, phys.elastic_stiffness,
+                                  phys.damping_stiffness, phys.bending_stiffness, phys.friction, anchored)
+        for _ in range(g.settle.steps):
+            pb.stepSimulation(physicsClientId=c)
+        world = np.asarray(pb.getMeshData(sb, -1, flags=pb.MESH_DATA_SIMULATION_MESH, physicsClientId=c)[1], dtype=float)
+    finally:
+        pb.disconnect(c)
+    inv_rot = np.asarray(pb.getMatrixFromQuaternion(held_orn)).reshape(3, 3).T
+    local = (world - np.asarray(held_pos)) @ inv_rot.T
+    if not np.all(np.isfinite(local)) or np.abs(local).max() > 5 * (shape.length_m + shape.radius_open_m):
+        raise _fail(rt, ("garments", name, "physics"), f"garment '{name}' blew up while settling (nodes left the scene): the springs are "
+                    f"integrated explicitly, so raise sim.solver.sub_steps (now {spec.sim.solver.sub_steps}) or lower physics.elastic_stiffness")
+    parent, gpos, gorn = grip
+    return Garment(name=name, obj=str(obj.relative_to(out_tmp)), parent_link=parent, grip_position=gpos, grip_orientation=gorn,
+                   anchored=anchored, node_sets=sets, nodes_in_held=[_round(tuple(v)) for v in local], mass=phys.mass_kg,
+                   collision_margin=phys.collision_margin_m, elastic_stiffness=phys.elastic_stiffness, damping_stiffness=phys.damping_stiffness,
+                   bending_stiffness=phys.bending_stiffness, friction=phys.friction,
+                   collides_with=list(g.collides_with) if g.collides_with is not None else None, rgba=tuple(g.rgba))
 
 def _capsule(limbs: dict, link: str) -> Capsule:
     cap = limbs[link]
@@ -948,6 +1002,8 @@ def _gripper(rt: ResolvedTask) -> tuple[list[str], list[float]]:
     spec, robot_part = rt.spec, rt.robot.part
     gripper = robot_part.gripper.get(robot_part.arm_for(spec.robot.arm if spec.robot.arm != "both" else "right")[0])
     tool_part = rt.tools[next(iter(spec.tools))].part.name if spec.tools else "none"
+    if spec.garments:  # the hand holds a garment: its grip's finger positions, else the empty hand's
+        tool_part = next(iter(spec.garments.values())).held.grip
     grip_pos = gripper.positions.get(tool_part, gripper.positions.get("none", 0.0)) if gripper else 0.0
     n_fingers = len(gripper.joints) if gripper else 0
     grip_pos = [float(v) for v in grip_pos] if isinstance(grip_pos, list) else [float(grip_pos)] * n_fingers
@@ -956,7 +1012,7 @@ def _gripper(rt: ResolvedTask) -> tuple[list[str], list[float]]:
     return (list(gripper.joints) if gripper else []), grip_pos
 
 
-def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lower, upper, movable, placements) -> Manifest:
+def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lower, upper, movable, placements, garments=()) -> Manifest:
     spec = rt.spec
     robot_part = rt.robot.part
     finger_joints, grip_pos = _gripper(rt)
@@ -1011,6 +1067,7 @@ def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lowe
         reward=[TermUse(name=t.name, term=t.term, category=t.category, weight=t.weight, params=t.params) for t in rt.reward],
         success=Success(term=spec.success.term, aggregate=spec.success.aggregate, threshold=rt.success_threshold,
                         fraction_of=spec.success.relative_to if spec.success.relative_to in rt.markers else None),
+        garments=list(garments),
         scripted=rt.scripted,
     )
 

@@ -54,7 +54,7 @@ def bind_term(use: TermUse, snap: Snapshot) -> Callable[[Snapshot], Any]:
         v = values.get(fname)
         if v is None:
             continue
-        bind = {"point": snap.point, "joints": snap.joints}.get(kind.kind)
+        bind = {"point": snap.point, "joints": snap.joints, "nodes": snap.nodes}.get(kind.kind)
         if bind is not None:
             values[fname] = [bind(x) for x in v] if shape == "list" else bind(v)
     params = SimpleNamespace(**values)
@@ -126,7 +126,7 @@ class AssistiveEnv(gym.Env):
         self.markers = MarkerSystem(self.world, self.snap)
         self.success_threshold = m.success.threshold
         self.tool_point = self.snap.point({"body": "robot", "link": m.robot.links["tool_mount"]})
-        self._force_on_person = ([b.name for b in m.bodies if b.kind in ("robot", "tool")], ["person"])
+        self._force_on_person = ([b.name for b in m.bodies if b.kind in ("robot", "tool")] + [g.name for g in m.garments], ["person"])
         self.observation_space = self.robot_features.space
         self.action_space = gym.spaces.Box(-1.0, 1.0, (len(self.arm_idx),), np.float32)
         self.steps = 0
@@ -209,6 +209,7 @@ class AssistiveEnv(gym.Env):
         lo, hi = m.sim.ground_friction
         pb.changeDynamics(w.ground, -1, lateralFriction=float(rng.uniform(lo, hi)), physicsClientId=c)
         self.particles.reset()
+        w.reset_garments()  # settled shape at the hand's held frame (after the robot is placed)
 
         self.steps = 0
         self.success_metric = None

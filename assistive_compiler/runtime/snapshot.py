@@ -37,6 +37,14 @@ class JointsHandle:
     indices: tuple[int, ...]
 
 
+@dataclass(frozen=True)
+class NodesHandle:
+    """A garment's node set: the garment's index in ``world.garments`` and the node indices."""
+
+    garment: int
+    indices: tuple[int, ...]
+
+
 @dataclass
 class ParticleEvents:
     """What happened to a particle set during the last env step."""
@@ -74,6 +82,11 @@ class Snapshot:
         self.frames: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self._ids: dict[tuple[str, ...], tuple[int, ...]] = {}
         self._closest_hint: dict[tuple, float] = {}  # last closest_distance per (body, bodies): where the next query starts
+        self._garment_nodes: dict[int, np.ndarray] = {}
+        # pybullet reports a soft body's contact forces of its last solver sub-step only: scale them
+        # back to the physics step (experiments/dressing_report.md: then Σ|f_n| ≈ the weight it rests on).
+        sub_steps = max(1, world.m.sim.sub_steps)
+        self.force_scale: dict[int, float] = {g.soft_id: float(sub_steps) for g in getattr(world, "garments", [])}
 
     # -- binding ------------------------------------------------------------------------------
     def body_key(self, name: str) -> str:
@@ -129,6 +142,18 @@ class Snapshot:
             self.vel = np.vstack([self.vel, np.zeros((1, 3))])
         return self._slots[(key, link)]
 
+    def nodes(self, ref: dict) -> NodesHandle:
+        """Bind a normalised node-set reference ({garment, set, nodes})."""
+        names = [g.name for g in self.world.garments]
+        return NodesHandle(names.index(ref["garment"]), tuple(int(i) for i in ref["nodes"]))
+
+    def node_positions(self, h: NodesHandle) -> np.ndarray:
+        """(k, 3) positions of a node set this step, world frame, m (one mesh read per garment per step)."""
+        x = self._garment_nodes.get(h.garment)
+        if x is None:
+            x = self._garment_nodes[h.garment] = self.world.garment_nodes(self.world.garments[h.garment])
+        return x[list(h.indices)]
+
     def joints(self, ref: dict) -> JointsHandle:
         body = ref["body"]
         h = self.handle(body)
@@ -149,12 +174,13 @@ class Snapshot:
                     vel[slot] = s[6]
             if reads.base_slots:
                 frame_pos, frame_orn = self.world.base_frame(h)
-                lin = pb.getBaseVelocity(h.id, physicsClientId=c)[0]
+                lin = pb.getBaseVelocity(h.id if h.pose_id is None else h.pose_id, physicsClientId=c)[0]
                 for slot in reads.base_slots:
                     pos[slot], orn[slot], vel[slot] = frame_pos, frame_orn, lin
         self._contacts.clear()
         self._pooled.clear()
         self._joint_cache.clear()
+        self._garment_nodes.clear()
 
     def set_frame(self, name: str, pos, orn) -> None:
         """Fix an observation frame for the episode (the robot's and the person's bases do not move)."""
@@ -287,9 +313,10 @@ class Snapshot:
         only contacts whose point on ``a`` lies within ``radius`` of that point."""
         total = 0.0
         centre = self.position(near) if near is not None else None
+        scale = self.force_scale
         for cp in self.contacts(a, b):
             if centre is None or np.linalg.norm(np.subtract(cp[5], centre)) <= radius:
-                total += cp[9]
+                total += cp[9] * (scale.get(cp[1]) or scale.get(cp[2]) or 1.0 if scale else 1.0)
         return total
 
     def contact_force_and_count(self, a: str, b, distance: float) -> tuple[float, int]:

@@ -15,6 +15,13 @@ Person self-collision: a person body whose manifest lists self-collision pairs i
 every other body loads as before. :attr:`World.after_physics_step`, when set, runs after each
 physics step of :meth:`step_physics` (the person's limit enforcement).
 
+Garments (cloth): an artifact with garments gets a deformable world (``RESET_USE_DEFORMABLE_WORLD``
+before anything is loaded; its gravity is the spec's, as a soft body feels only the world's). Each
+garment is a mass-spring soft body whose held nodes are pinned to a massless, collision-free anchor
+body; :meth:`follow_grips` teleports the anchors to the hand's held frame after every physics step
+and :meth:`reset_garments` puts the settled nodes back at reset (``restoreState`` does not cover
+soft-body nodes). The garment's body handle has the soft body's id and the anchor's pose.
+
 Frames: pybullet reports a base's pose at its centre of mass; :meth:`base_frame` and
 :meth:`set_base_frame` convert to and from the URDF frame the manifest uses.
 """
@@ -25,6 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
+import numpy as np
 import pybullet as pb
 
 from ..artifact import Manifest
@@ -41,6 +49,20 @@ class BodyHandle:
     links: dict[str, int]
     joints: dict[str, int]
     inertial_inv: tuple  # inverse of the base's local inertial frame (COM → URDF frame)
+    pose_id: int | None = None  # body whose base pose is this body's frame (a garment: its anchor; None: id itself)
+
+
+@dataclass
+class GarmentHandle:
+    """A loaded garment: the soft body, the anchor body its held nodes are pinned to, and where
+    the held frame rides (robot link index, pose in that link's URDF frame)."""
+
+    name: str
+    soft_id: int
+    anchor_id: int
+    link: int
+    grip: tuple  # (position, orientation) of the held frame in the link's URDF frame
+    nodes_in_held: np.ndarray  # (n, 3) settled node positions, held frame, m
 
 
 class World:
@@ -68,6 +90,8 @@ class World:
         self.client = pb.connect(pb.DIRECT)
         c = self.client
         sim = self.m.sim
+        if self.m.garments:  # cloth needs Bullet's deformable world, chosen before anything is loaded
+            pb.resetSimulation(pb.RESET_USE_DEFORMABLE_WORLD, physicsClientId=c)
         pb.setPhysicsEngineParameter(numSolverIterations=sim.solver_iterations, deterministicOverlappingPairs=1, physicsClientId=c)
 
         plane = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=c)
@@ -98,10 +122,12 @@ class World:
         self._attach_tools()
         self._create_particles()
         self._create_markers()
+        self._create_garments()
         self._set_gravity()
         self._set_stepping()
         visual_only = {b for bodies in self.marker_visuals.values() for b in bodies} | set(self.markers.values())
         visual_only |= {b for bodies in self.particle_ghosts.values() for b in bodies}
+        visual_only |= {b for g in self.garments for b in (g.soft_id, g.anchor_id)}  # garments are reset by reset_garments()
         self._all_bodies = [b for b in range(pb.getNumBodies(physicsClientId=c)) if b != self.ground and b not in visual_only]
         # Bodies at rest would otherwise fall asleep after ~2 s; sleep is not part of a saved state,
         # so an episode would depend on how long the previous one left something resting.
@@ -199,6 +225,58 @@ class World:
                 vis = pb.createVisualShape(pb.GEOM_SPHERE, radius=0.008, rgbaColor=list(ms.show_rgba), physicsClientId=c)
                 self.marker_visuals[ms.name] = [pb.createMultiBody(0, -1, vis, list(PARK), physicsClientId=c) for _ in range(count)]
 
+    def _create_garments(self) -> None:
+        """Load each garment as a soft body with its held nodes pinned to an anchor body (see
+        :func:`assistive_compiler.garment.load_garment`); it waits parked until :meth:`reset_garments`.
+        The garment's body handle has the soft body's id (contacts) and the anchor's pose (its
+        ``held`` point)."""
+        from ..garment import load_garment
+
+        c = self.client
+        self.garments: list[GarmentHandle] = []
+        for k, g in enumerate(self.m.garments):
+            park = (PARK[0] + 20.0 + 5.0 * k, PARK[1], PARK[2])
+            sb, anchor = load_garment(pb, c, self.dir / g.obj, park, (0, 0, 0, 1), g.mass, g.collision_margin, g.elastic_stiffness,
+                                      g.damping_stiffness, g.bending_stiffness, g.friction, g.anchored, rgba=g.rgba)
+            self.garments.append(GarmentHandle(g.name, sb, anchor, self.robot.links[g.parent_link], (g.grip_position, g.grip_orientation),
+                                               np.asarray(g.nodes_in_held, dtype=float)))
+            self.bodies[g.name] = BodyHandle(g.name, sb, {"held": -1}, {}, ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)), pose_id=anchor)
+            if g.collides_with is not None:  # contact with every other body (and the floor) off
+                keep = {b.name for b in self.m.bodies if (b.kind == "person" and "person" in g.collides_with) or b.name in g.collides_with}
+                others = [self.ground] + [h.id for name, h in self.bodies.items() if name not in keep and name != g.name]
+                for bid in others:
+                    for link in range(-1, pb.getNumJoints(bid, physicsClientId=c)):
+                        pb.setCollisionFilterPair(sb, bid, -1, link, 0, physicsClientId=c)
+
+    def held_pose(self, g: GarmentHandle):
+        """World pose of a garment's held frame: its robot link's URDF frame times the grip."""
+        pos, orn = self.link_frame(self.robot, g.link)
+        return pb.multiplyTransforms(pos, orn, *g.grip)
+
+    def follow_grips(self) -> None:
+        """Teleport every garment's anchor to its held frame (the pinned nodes follow in the next step)."""
+        c = self.client
+        for g in self.garments:
+            pos, orn = self.held_pose(g)
+            pb.resetBasePositionAndOrientation(g.anchor_id, pos, orn, physicsClientId=c)
+
+    def reset_garments(self) -> None:
+        """Every garment back to its settled shape at its held frame, at rest (call after the robot
+        is placed). ``restoreState`` does not cover soft-body nodes: ``resetMeshData`` sets them and
+        ``resetBaseVelocity`` zeroes their velocities (well under a millisecond)."""
+        c = self.client
+        for g in self.garments:
+            pos, orn = self.held_pose(g)
+            pb.resetBasePositionAndOrientation(g.anchor_id, pos, orn, physicsClientId=c)
+            rot = np.asarray(pb.getMatrixFromQuaternion(orn), dtype=float).reshape(3, 3)
+            world = g.nodes_in_held @ rot.T + np.asarray(pos)
+            pb.resetMeshData(g.soft_id, vertices=world.tolist(), physicsClientId=c)
+            pb.resetBaseVelocity(g.soft_id, (0, 0, 0), (0, 0, 0), physicsClientId=c)
+
+    def garment_nodes(self, g: GarmentHandle) -> np.ndarray:
+        """(n, 3) node positions of a garment, world frame, m."""
+        return np.asarray(pb.getMeshData(g.soft_id, -1, flags=pb.MESH_DATA_SIMULATION_MESH, physicsClientId=self.client)[1], dtype=float)
+
     def _set_gravity(self) -> None:
         """Choose the world gravity needing the fewest compensated links; list those links."""
         c = self.client
@@ -207,7 +285,7 @@ class World:
         for ps in self.m.particles:
             for k, pid in enumerate(self.particles[ps.name]):
                 declared[f"{ps.name}#{k}"] = self.m.sim.gravity
-        options = sorted(set(declared.values()))
+        options = sorted(set(declared.values()) | ({self.m.sim.gravity} if self.m.garments else set()))
         for g_world in options:
             comp: list[tuple[int, int, float]] = []
             for name, g in declared.items():
@@ -217,7 +295,8 @@ class World:
                 for link, mass in self._moving_links(bid):
                     comp.append((bid, link, mass * (g - g_world)))
             candidates[g_world] = comp
-        self.world_gravity = min(options, key=lambda g: (len(candidates[g]), -abs(g)))
+        # A soft body feels only the world gravity: with a garment that is the spec's sim gravity.
+        self.world_gravity = self.m.sim.gravity if self.m.garments else min(options, key=lambda g: (len(candidates[g]), -abs(g)))
         groups: dict[int, tuple[list[int], list[float]]] = {}
         for bid, link, fz in candidates[self.world_gravity]:
             links, forces = groups.setdefault(bid, ([], []))
@@ -270,9 +349,12 @@ class World:
     def step_physics(self) -> None:
         """Advance one env step (frame_skip physics steps) with per-body gravity compensation."""
         after = self.after_physics_step
+        garments = bool(self.garments)
         for _ in range(self.m.sim.frame_skip):
             self._apply_gravity_compensation()
             pb.stepSimulation(physicsClientId=self.client)
+            if garments:  # the held frame moved with the hand: the anchor follows before the next step
+                self.follow_grips()
             if after is not None:
                 after()
 
@@ -298,8 +380,8 @@ class World:
 
     # -- frames --------------------------------------------------------------------------------
     def base_frame(self, handle: BodyHandle):
-        """World pose of a body's URDF base frame."""
-        com_pos, com_orn = pb.getBasePositionAndOrientation(handle.id, physicsClientId=self.client)
+        """World pose of a body's URDF base frame (a garment's: its held frame)."""
+        com_pos, com_orn = pb.getBasePositionAndOrientation(handle.id if handle.pose_id is None else handle.pose_id, physicsClientId=self.client)
         return pb.multiplyTransforms(com_pos, com_orn, *handle.inertial_inv)
 
     def set_base_frame(self, handle: BodyHandle, pos, orn) -> None:

@@ -533,6 +533,84 @@ class Particles(Strict):
 
 
 # --------------------------------------------------------------------------------------------
+# Garments (cloth simulated as a stock-pybullet soft body)
+
+
+class SleeveShape(Strict):
+    """A generated sleeve: an open triangulated tube (see :mod:`assistive_compiler.garment`). Its
+    frame: axis +z, the opening ring (where the hand enters) at z = 0 centred on the origin, the
+    cuff at z = length_m. Node sets it exports: ``opening`` (ring 0), ``opening_top`` (ring 0
+    within ±45° of +y) and ``cuff`` (the last ring)."""
+
+    kind: Literal["sleeve"] = Field(description="Generated shape kind.")
+    length_m: float = Field(gt=0.02, le=2.0, description="Tube length, metres.")
+    radius_open_m: float = Field(gt=0.005, le=0.5, description="Radius of the opening ring, metres.")
+    radius_end_m: float | None = Field(None, gt=0.005, le=0.5, description="Radius of the cuff ring, metres (None: the opening's).")
+    rings: int = Field(8, ge=2, le=64, description="Rings of nodes along the tube (including both ends).")
+    segments: int = Field(10, ge=3, le=64, description="Nodes around each ring.")
+
+
+class SoftBodyPhysics(Strict):
+    """Mass-spring settings of pybullet's deformable world (``loadSoftBody``). The defaults are the
+    tested values of experiments/dressing_report.md: stable with 4 solver sub-steps at a 0.02 s
+    step for about 100 nodes (the springs are integrated explicitly: a stiffer, lighter or finer
+    cloth needs more sub-steps)."""
+
+    mass_kg: float = Field(0.1, gt=0, le=10, description="Total mass, kg (spread evenly over the nodes).")
+    collision_margin_m: float = Field(0.01, gt=0, le=0.1, description="Collision margin of the cloth, metres.")
+    elastic_stiffness: float = Field(10.0, gt=0, le=10_000, description="springElasticStiffness, N/m.")
+    damping_stiffness: float = Field(
+        0.002, ge=0, le=10, description="springDampingStiffness, N·s/m, damping all directions (≈ air drag per node; 0.1 freezes the cloth)."
+    )
+    bending_stiffness: float = Field(0.1, ge=0, le=10_000, description="springBendingStiffness, N/m.")
+    friction: float = Field(0.5, ge=0, le=5, description="Friction coefficient of the cloth.")
+
+
+class GarmentHold(Strict):
+    """How the robot holds the garment: a node set pinned to the robot's hand (the pinned nodes
+    follow the hand exactly; the rest of the cloth hangs and slides freely)."""
+
+    hand: Literal["right", "left"] = Field(description="Which robot hand holds it (single-arm robots: their only hand).")
+    grip: Name = Field(
+        "garment",
+        description="The robot part's grip (grips: in specs/robots/<robot>.yaml) giving the held frame in the hand's "
+        "tool-mount frame; the robot's start pose (robot.start.tool_*) is this frame's pose.",
+    )
+    nodes: Name = Field("opening", description="Node set pinned to the held frame (e.g. opening: a hoop grip; opening_top: a pinch).")
+    offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Garment frame origin in the held frame, metres.")
+    rpy_deg: Vec3 = Field((0.0, 0.0, 0.0), description="Garment frame orientation in the held frame (roll, pitch, yaw), degrees.")
+
+
+class GarmentSettle(Strict):
+    """Compile-time settling: the garment hangs from the held frame (at the start orientation, away
+    from everything) for ``steps`` physics steps under ``gravity_mps2``; the settled node positions
+    are stored (held frame) and every reset starts from them (the reference settles 50 steps at g/2)."""
+
+    steps: int = Field(50, ge=0, le=5000, description="Physics steps to settle.")
+    gravity_mps2: float = Field(-4.905, ge=-20, le=0, description="Gravity while settling, m/s².")
+
+
+class Garment(Strict):
+    """A piece of clothing the robot holds, simulated as a pybullet soft body (stock pybullet: a
+    deformable world, ``loadSoftBody``, ``createSoftBodyAnchor``). The compiler generates its mesh
+    (OBJ) into the artifact. The garment's name is a body: ``<name>`` in contact terms (forces are
+    scaled by the solver sub-steps, as pybullet reports a soft body's last sub-step only), the held
+    frame as a point, and ``<name>.<node set>`` in terms that read cloth nodes."""
+
+    shape: SleeveShape = Field(description="The generated shape.")
+    physics: SoftBodyPhysics = Field(default_factory=SoftBodyPhysics, description="Soft-body settings.")
+    held: GarmentHold = Field(description="How the robot holds it.")
+    settle: GarmentSettle = Field(default_factory=GarmentSettle, description="Compile-time settling.")
+    collides_with: list[Ref] | None = Field(
+        None,
+        description="Bodies the cloth collides with (e.g. [person]); None: every body and the floor. Soft-rigid contact "
+        "is most of a cloth's cost, so leaving out bodies it should not touch (the robot that holds it, furniture) "
+        "makes a step several times faster.",
+    )
+    rgba: Rgba = Field((0.543, 0.762, 0.289, 0.8), description="Colour in renders (the reference's gown green).")
+
+
+# --------------------------------------------------------------------------------------------
 # Terms: observations, rewards, preferences, success
 
 
@@ -673,6 +751,9 @@ class TaskSpec(Strict):
     targets: dict[Name, Target] = Field(default_factory=dict, description="Named points on bodies.")
     particles: dict[Name, Particles] = Field(default_factory=dict, description="Particle sets by name.")
     markers: dict[Name, Markers] = Field(default_factory=dict, description="Marker sets on the person by name (e.g. spots to wipe).")
+    garments: dict[Name, Garment] = Field(
+        default_factory=dict, max_length=1, description="Garments by name (soft bodies held by the robot, e.g. a gown sleeve); at most one."
+    )
     observations: Observations = Field(description="Observation features per agent.")
     reward: list[RewardTerm] = Field(min_length=1, description="Weighted reward terms.")
     preferences: Preferences = Field(default_factory=Preferences, description="Human-preference costs.")

@@ -23,7 +23,7 @@ from pydantic import BaseModel, ConfigDict
 class RefKind:
     """Marks a parameter field as a reference of a kind the resolver checks and the runtime binds."""
 
-    kind: Literal["point", "body", "bodies", "joints", "particles", "markers", "frame"]
+    kind: Literal["point", "body", "bodies", "joints", "particles", "markers", "frame", "nodes"]
 
 
 PointRef = Annotated[str, RefKind("point")]
@@ -38,6 +38,8 @@ ParticlesRef = Annotated[str, RefKind("particles")]
 """A particle set name."""
 MarkersRef = Annotated[str, RefKind("markers")]
 """A marker set name."""
+NodesRef = Annotated[str, RefKind("nodes")]
+"""A garment's node set: ``<garment>.<set>`` (e.g. ``sleeve.opening``)."""
 FrameRef = Annotated[Literal["world", "robot_base", "person_base"], RefKind("frame")]
 """An observation frame: the world, the robot's base or the person's base (chest)."""
 

@@ -11,7 +11,7 @@ import numpy as np
 from pydantic import Field
 
 from ..quat import quat_rotate
-from .registry import BodiesRef, BodyRef, MarkersRef, Params, ParticlesRef, PointRef, term
+from .registry import BodiesRef, BodyRef, MarkersRef, NodesRef, Params, ParticlesRef, PointRef, term
 
 
 class Distance(Params):
@@ -136,3 +136,42 @@ class MarkerSet(Params):
 def markers_cleared(snap, p) -> float:
     """Markers of the set cleared this step (count), e.g. spots wiped clean."""
     return float(snap.events[p.markers])
+
+
+class SleeveProgress(Params):
+    opening: NodesRef = Field(description="The garment's opening ring, e.g. sleeve.opening (its nodes in order around the ring).")
+    shoulder: PointRef = Field(description="The dressed arm's shoulder joint centre, e.g. person.left_shoulder.")
+    elbow: PointRef = Field(description="Its elbow joint centre, e.g. person.left_elbow.")
+    wrist: PointRef = Field(description="Its wrist joint centre, e.g. person.left_wrist.")
+    hand_beyond_wrist_m: float = Field(0.086, ge=0, le=0.5, description="The hand's end beyond the wrist along the forearm, m (the reference: 2× the upper-arm radius).")
+    beyond_elbow_m: float = Field(0.043, ge=0, le=0.5, description="The forearm segment's end beyond the elbow, m (the reference: the upper-arm radius).")
+    beyond_shoulder_m: float = Field(0.043, ge=0, le=0.5, description="The upper-arm segment's end beyond the shoulder, m (the reference: the upper-arm radius).")
+    ordered: bool = Field(True, description="The upper arm counts only after the forearm was in the sleeve earlier in the episode.")
+
+
+@term("sleeve_progress", "reward", SleeveProgress)
+class SleeveProgressTerm:
+    """How far the arm is inside the sleeve (m): the reference's r_dress (facts §2.5). Forearm in
+    the opening: distance of the opening's centre from the hand's end; upper arm in: the forearm's
+    length plus the centre's distance past the elbow; neither: minus the centre's distance to the
+    hand's end. See :func:`assistive_compiler.garment.sleeve_progress`.
+
+    With ``ordered`` (the default) the upper arm counts only once the forearm has been in the
+    sleeve earlier in the episode — forearm, then upper arm. The reference's cloth enforces that
+    order physically; here the held nodes follow the hand kinematically and would let an opening
+    swept sideways through the upper arm score without ever passing over the hand."""
+
+    def __init__(self) -> None:
+        self.forearm_seen = False
+
+    def reset(self) -> None:
+        self.forearm_seen = False
+
+    def __call__(self, snap, p) -> float:
+        from ..garment import sleeve_progress as r_dress
+
+        value = r_dress(snap.node_positions(p.opening), snap.position(p.shoulder), snap.position(p.elbow), snap.position(p.wrist),
+                        p.hand_beyond_wrist_m, p.beyond_elbow_m, p.beyond_shoulder_m, upper_arm_counts=self.forearm_seen or not p.ordered)
+        if 0.0 <= value:  # only the forearm branch (and the upper arm's) is non-negative
+            self.forearm_seen = True
+        return value
