@@ -532,12 +532,7 @@ def _settle_stage(rt: ResolvedTask, pc: _Precompute, body: int, joints: dict[str
                 for link in range(-1, p.getNumJoints(bid, physicsClientId=c)):
                     p.changeDynamics(bid, link, lateralFriction=stage.friction, physicsClientId=c)
     p.setGravity(0, 0, stage.gravity_mps2, physicsClientId=c)
-    import os
-    dbg = os.environ.get("AC_DEBUG_STAGE")
-    wl = pc.link_index(body, "right_wrist")
-    for _k in range(stage.steps):
-        if dbg and _k % 10 == 0:
-            print("stage", _k, [round(v, 3) for v in pc.link_pose(body, wl)[0]], {n: round(p.getJointState(body, joints[n], physicsClientId=c)[0], 2) for n in dynamic})
+    for _ in range(stage.steps):
         p.stepSimulation(physicsClientId=c)
         for n in held:  # static joints stay exactly where they settled
             p.resetJointState(body, joints[n], start[n], 0.0, physicsClientId=c)
