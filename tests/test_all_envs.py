@@ -17,6 +17,7 @@ def test_shipped_task_robot_pairs_are_registered():
     tasks = {i.split("/")[1].removesuffix("-v1") for i in IDS}
     expected = {f"{task}{robot}" for task in ("Feeding", "ScratchItch") for robot in ("PR2", "Jaco", "Baxter", "Sawyer", "Panda")}
     expected |= {"BedBathingJaco", "BedBathingBaxter"} | {f"Drinking{r}" for r in ("Jaco", "Baxter", "Sawyer", "Panda")}
+    expected |= {f"ArmManipulation{r}" for r in ("PR2", "Jaco", "Baxter", "Sawyer", "Panda")}
     assert tasks == expected
 
 
