@@ -682,7 +682,9 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measur
                 else:
                     starts.append(StartState(base_position=_round(base_pos), base_orientation=_round(base_orn), joints=_round(qs), tool_position=_round(first_goal)))
         if not starts:
-            raise _fail(rt, ("robot", "start", "tool_position_m"),
+            own = spec.robot.per_robot.get(rt.robot_name)
+            where = ("robot", "per_robot", rt.robot_name, "start", "tool_position_m") if own is not None and own.start is not None else ("robot", "start", "tool_position_m")
+            raise _fail(rt, where,
                         f"robot '{rt.robot_name}' cannot reach the start pose {tuple(start.tool_position_m)} (tool rpy {tuple(start.tool_rpy_deg)}°) without collision for person '{variant}'")
         m = measurements[variant]
         offsets = {}
