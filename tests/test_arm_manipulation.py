@@ -138,6 +138,27 @@ def test_the_hanging_arm_is_free_to_be_lifted(jaco):
     assert _link_pos(jaco, "right_wrist")[2] > z0 + 0.1
 
 
+def test_a_limited_range_leaves_the_static_limp_arm_where_it_started(jaco):
+    """The γ-scaled limits bind the person as an agent only (facts §1: enforced for the humans in
+    the agent list): with no human action and a zero robot action, a limited-range episode's
+    hanging arm stays put for 2 s, as an unimpaired one does (its settled pose lies outside γ·limits
+    for small γ; clamping or enforcing them would make the arm jump by itself)."""
+    checked = 0
+    for seed in range(40):
+        _, info = jaco.reset(seed=seed)
+        if info["impairment"]["kind"] != "limited_range":
+            continue
+        start = {link: _link_pos(jaco, link) for link in ("right_elbow", "right_wrist")}
+        for _ in range(20):
+            jaco.step(np.zeros(7))
+        for link, p0 in start.items():
+            assert np.linalg.norm(_link_pos(jaco, link) - p0) < 0.05, (seed, link, info["impairment"]["scale"])
+        checked += 1
+        if checked == 4:
+            break
+    assert checked == 4
+
+
 # --------------------------------------------------------------------------------------------
 # r_h and success
 
