@@ -526,14 +526,20 @@ class _Resolver:
                               "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
                               "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None})
         out = {"move": move, "waypoints": waypoints, "repeat_from": spec.scripted.repeat_from}
-        left = spec.scripted.left
-        if left is not None and len(self.sides) > 1:
-            base = ("scripted", "left")
-            out["left"] = {"move": self.point(left.move, base + ("move",)), "repeat_from": left.repeat_from,
-                           "waypoints": [{"to": self.point(w.to, base + ("waypoints", i, "to")), "offset_m": list(w.offset_m),
-                                          "tolerance_m": w.tolerance_m, "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
-                                          "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None}
-                                         for i, w in enumerate(left.waypoints)]}
+        for side in ("left", "right"):  # a two-arm robot: the left arm's part, and the right arm's own (replacing the main one)
+            arm = getattr(spec.scripted, side)
+            if arm is None or len(self.sides) < 2:
+                continue
+            base = ("scripted", side)
+            resolved = {"move": self.point(arm.move, base + ("move",)), "repeat_from": arm.repeat_from,
+                        "waypoints": [{"to": self.point(w.to, base + ("waypoints", i, "to")), "offset_m": list(w.offset_m),
+                                       "tolerance_m": w.tolerance_m, "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
+                                       "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None}
+                                      for i, w in enumerate(arm.waypoints)]}
+            if side == "left":
+                out["left"] = resolved
+            else:
+                out.update(resolved)
         return out
 
     def _success(self, spec: TaskSpec, reward_names: set[str]) -> float:

@@ -663,6 +663,11 @@ class Scripted(Strict):
         None, description="The left arm's waypoints when the robot acts with both arms (robot.arm: both, a two-arm robot); "
         "move/waypoints then drive the right arm. Ignored on one-arm robots."
     )
+    right: ScriptedArm | None = Field(
+        None, description="The right arm's part when the robot acts with both arms (robot.arm: both, a two-arm robot): it "
+        "replaces move/waypoints/repeat_from there, so that a two-arm script (e.g. lift with both hands) can differ from the "
+        "one-arm script that move/waypoints give. Ignored on one-arm robots."
+    )
 
     @model_validator(mode="after")
     def _repeat_in_range(self) -> "Scripted":
