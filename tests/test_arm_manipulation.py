@@ -159,6 +159,19 @@ def test_a_limited_range_leaves_the_static_limp_arm_where_it_started(jaco):
     assert checked == 4
 
 
+def test_scripted_right_replaces_the_main_script_on_two_arm_robots_only():
+    """scripted.right drives a two-arm robot's right arm; a one-arm robot keeps move/waypoints."""
+    from assistive_compiler.resolve import resolve
+    from assistive_compiler.spec.load import load_spec
+
+    loaded = load_spec(SPEC)
+    two, one = resolve(loaded, "pr2").scripted, resolve(loaded, "jaco").scripted
+    spec = loaded.spec.scripted
+    assert len(two["waypoints"]) == len(spec.right.waypoints) and len(one["waypoints"]) == len(spec.waypoints)
+    assert two["waypoints"][-1]["to"]["link"] == "waist" and one["waypoints"][-1]["to"]["link"] == "stomach"
+    assert "left" in two and "left" not in one
+
+
 # --------------------------------------------------------------------------------------------
 # r_h and success
 
