@@ -25,13 +25,13 @@ its episode's initial angle (stiffly, or compliantly where the spec says so; wea
 hold's force; tremor oscillates the hold's target), exactly the behaviour of the single-agent
 env. Switching from acting back to holding returns the joints to those initial angles.
 
-After every physics step, when the person is an agent of the step — it acts or tremors (facts
-§1: the limits are enforced "for every human in the agent list"; a static person, limited range or
-not, is not one):
+After every physics step, when the person acts, tremors or has a limited range of motion:
 
 * **hard joint limits** (facts §3.2): a movable joint past its limit (γ-scaled under the
   limited-range impairment, intersected with the URDF's) is reset to the limit with zero
-  velocity. Episodes start with every stiffly held joint inside these limits (the reference's
+  velocity — every movable joint while the person is an agent (acts or tremors: facts §1, "for
+  every human in the agent list"); on a static person only the stiffly held joints (standing in
+  for the limits the reference builds into the body), not the compliant (limp) ones. Episodes start with every stiffly held joint inside these limits (the reference's
   clamped ``set_joint_angles``); a compliant (limp) joint starts where the compile-time settle
   left it, clamped into the URDF's limits only. The reference settles a limp limb under the
   episode's γ-scaled limits at every reset; we settle once at compile time, and clamping a limp
@@ -184,9 +184,11 @@ class PersonController:
         self._arm_k = [movable.index(j) for j in ARM_LIMIT_JOINTS[self.arm_side]] if self.guard else []
         self.reverts = 0
         self._acting = False
-        # The hard limits are enforced only on a person in the agent list (acting or tremoring), as the
-        # reference does: a static person is not an agent there.
-        self._static_hook = bool(self._tremor)
+        # Hard limits: on every movable joint while the person is an agent (acts or tremors); on a static
+        # person only on its stiffly held joints (standing in for the reference's limits built into the
+        # body), never on its limp ones (see the module docstring).
+        self._limited_k = [k for k, j in enumerate(movable) if j not in compliant] if impairment.get("limits") else []
+        self._static_hook = bool(self._tremor) or bool(self._limited_k)
         if self.guard is not None:
             self.guard.reset([self.hold[k] for k in self._arm_k])
         self.world.after_physics_step = self.after_physics_step if self._static_hook else None
@@ -238,7 +240,9 @@ class PersonController:
         c, bid, idx = self.world.client, self.body_id, self.idx
         q = [s[0] for s in pb.getJointStates(bid, idx, physicsClientId=c)]
         lower, upper = self.lower, self.upper
-        for k, v in enumerate(q):
+        enforced = range(len(q)) if (self._acting or self._tremor) else self._limited_k
+        for k in enforced:
+            v = q[k]
             if v < lower[k]:
                 q[k] = lower[k]
                 pb.resetJointState(bid, idx[k], lower[k], 0.0, physicsClientId=c)
