@@ -65,6 +65,13 @@ class ResolvedTask:
     scripted: dict[str, Any] | None = None
     base_goals: list[dict[str, Any]] = field(default_factory=list)
     markers: dict[str, dict[str, Any]] = field(default_factory=dict)
+    #: The sides acting, in action order: ("right", "left") for a two-arm robot in a task with arm
+    #: 'both', else the one side (a one-arm robot's arm serves as either).
+    sides: tuple[str, ...] = ("right",)
+    #: Tools that are bodies of their own (one-arm robots: a tool ``one_arm_same_as`` another is not).
+    tool_uses: dict[str, Any] = field(default_factory=dict)
+    #: Tool names that refer to another tool's body on this robot (alias -> tool).
+    tool_aliases: dict[str, str] = field(default_factory=dict)
 
     @property
     def spec(self) -> TaskSpec:
@@ -82,6 +89,7 @@ class _Resolver:
         self.lib = library
         self.robot_name = robot_name
         self.problems: list[Problem] = []
+        self.tool_aliases: dict[str, str] = {}
 
     # -- helpers -----------------------------------------------------------------------------
     def at(self, *path: Any):
@@ -125,6 +133,9 @@ class _Resolver:
             raise SpecError(self.problems)
 
         self.robot = robot
+        self.sides = self._sides(spec)
+        self.tool_aliases = self._tool_aliases(spec, tools)
+        tools = {n: p for n, p in tools.items() if n not in self.tool_aliases}
         self.robot_urdf = self.lib.default_urdf("robots", self.robot_name)
         self.person_urdf = self.lib.default_urdf("people", spec.person.variants[0])
         self.tools, self.furniture, self.people = tools, furniture, people
@@ -141,27 +152,76 @@ class _Resolver:
             agent: [self._term(use, "observation", ("observations", agent, i), f"{agent}_{i}", 1.0) for i, use in enumerate(getattr(spec.observations, agent))]
             for agent in ("robot", "human")
         }
-        reward = [self._term(t, "reward", ("reward", i), t.name, t.weight) for i, t in enumerate(spec.reward)]
+        arms = len(self.sides)
+        reward = [self._term(t, "reward", ("reward", i), t.name, t.weight) for i, t in enumerate(spec.reward) if t.arms in (None, arms)]
         names_seen: dict[str, int] = {}
         for i, t in enumerate(spec.reward):
             if t.name in names_seen:
                 self.problem(("reward", i, "name"), f"reward term name '{t.name}' is already used by reward[{names_seen[t.name]}]")
             names_seen[t.name] = i
         reward += self._preferences(spec)
-        threshold = self._success(spec, {t.name for t in spec.reward})
+        threshold = self._success(spec, {t.name for t in spec.reward if t.arms in (None, arms)})
         scripted = self._scripted(spec)
         base_goals = [
             {"point": self.point(g.point, ("robot", "base_search", "goals", i, "point")), "offset_m": list(g.offset_m),
-             "oriented": g.oriented, "required": g.required}
+             "oriented": g.oriented, "required": g.required, "arm": (g.arm or "right") if len(self.sides) > 1 else self.sides[0]}
             for i, g in enumerate(spec.robot.base_search.goals)
         ]
+        for i, g in enumerate(spec.robot.base_search.goals):
+            if g.arm is not None and spec.robot.arm != "both":
+                self.problem(("robot", "base_search", "goals", i, "arm"), f"a goal names an arm only in a task acting with both arms (robot.arm: both); this task's arm is '{spec.robot.arm}'")
         if self.problems:
             raise SpecError(self.problems)
         return ResolvedTask(
             self.loaded, self.robot_name, robot, self.robot_urdf, tools, furniture, people, self.person_urdf,
             self.robot_links, self.joint_groups, {a: [t for t in ts if t] for a, ts in observations.items()},
             [t for t in reward if t], threshold, points, scripted, base_goals, markers,
+            self.sides, {n: u for n, u in spec.tools.items() if n not in self.tool_aliases}, self.tool_aliases,
         )
+
+    def _sides(self, spec: TaskSpec) -> tuple[str, ...]:
+        """The acting sides in action order (see ResolvedTask.sides)."""
+        part = self.robot.part
+        if spec.robot.arm == "both" and len(part.arms) > 1:
+            return ("right", "left")
+        return (spec.robot.arm if spec.robot.arm != "both" else "right",)
+
+    def _tool_aliases(self, spec: TaskSpec, tools: dict[str, LoadedPart]) -> dict[str, str]:
+        """Which tools share another tool's body on this robot, checking that every tool's hand is
+        one the robot acts with: on a robot acting with one arm, a tool in the other hand must be
+        ``one_arm_same_as`` a tool of the same part in the acting hand (facts §2.6)."""
+        aliases: dict[str, str] = {}
+        one_arm = len(self.sides) == 1
+        robot_arms = len(self.robot.part.arms)
+        for name, use in spec.tools.items():
+            path = ("tools", name)
+            other = use.one_arm_same_as
+            if other is not None:
+                if other not in spec.tools or other == name:
+                    pool = [t for t in spec.tools if t != name]
+                    self.problem(path + ("one_arm_same_as",), f"unknown tool '{other}'; expected one of {one_of(pool) or 'none'}{did_you_mean(other, pool)}")
+                    continue
+                target = spec.tools[other]
+                if target.one_arm_same_as is not None:
+                    self.problem(path + ("one_arm_same_as",), f"tool '{other}' is itself one_arm_same_as '{target.one_arm_same_as}'; name a tool that is a body of its own")
+                elif target.part != use.part:
+                    self.problem(path + ("one_arm_same_as",), f"tool '{other}' is a '{target.part}' but '{name}' is a '{use.part}'; one body can only stand for tools of the same part")
+                elif target.hand == use.hand:
+                    self.problem(path + ("one_arm_same_as",), f"tool '{other}' is already in the {use.hand} hand; one_arm_same_as names the tool in the other hand")
+                elif one_arm:
+                    aliases[name] = other
+                    continue
+            if one_arm and spec.robot.arm != "both" and robot_arms > 1 and use.hand != spec.robot.arm:
+                self.problem(path + ("hand",), f"tool '{name}' is held in the {use.hand} hand, but the task acts with the {spec.robot.arm} arm only; use hand: {spec.robot.arm} or robot.arm: both")
+        if one_arm:
+            held = [n for n in spec.tools if n not in aliases]
+            hands = {spec.tools[n].hand for n in held}
+            if len(hands) > 1 and (robot_arms == 1 or spec.robot.arm == "both"):
+                first = held[0]
+                for n in held[1:]:
+                    if spec.tools[n].hand != spec.tools[first].hand:
+                        self.problem(("tools", n, "hand"), f"robot '{self.robot_name}' acts with one arm, which would hold both '{first}' ({spec.tools[first].hand} hand) and '{n}' ({spec.tools[n].hand} hand); give '{n}' one_arm_same_as: {first} (one tool serving both hands) or a hand the arm already uses")
+        return aliases
 
     def _bodies(self, spec: TaskSpec) -> None:
         self.body_names: dict[str, str] = {"robot": "robot", "person": "person"}
@@ -241,7 +301,7 @@ class _Resolver:
             return None
         if self._conditional(value, path):
             return None
-        return value
+        return self.tool_aliases.get(value, value)
 
     def _conditional(self, body: str, path: tuple) -> bool:
         """True (and a problem) when ``body`` is furniture present only under a mounted robot."""
@@ -256,6 +316,8 @@ class _Resolver:
         if allow_target and value in self.spec.targets:
             return {"target": value}
         body, _, link = value.partition(".")
+        if body in self.body_names:
+            body = self.tool_aliases.get(body, body)  # a one-arm robot's second name for its tool
         if body not in self.body_names or self.body_names[body] == "particles":
             pool = [b for b, s in self.body_names.items() if s != "particles"] + (list(self.spec.targets) if allow_target else [])
             what = "target or body" if allow_target else "body"
@@ -351,6 +413,18 @@ class _Resolver:
         for i, choice in enumerate(person.impairments.choices):
             for k, ref in enumerate(getattr(choice, "joints", [])):
                 self.joints(ref, ("person", "impairments", "choices", i, "joints", k))
+        stage = person.placement.settle.then if person.placement.settle else None
+        if stage is not None:
+            base = ("person", "placement", "settle", "then")
+            for i, ref in enumerate(stage.dynamic):
+                group = self.joints(ref, base + ("dynamic", i))
+                if group and group["body"] != "person":
+                    self.problem(base + ("dynamic", i), f"dynamic joints must be person joint groups, got '{ref}'")
+            for name, deg in stage.joints_deg.items():
+                if name not in movable:
+                    self.problem(base + ("joints_deg", name), f"unknown person joint '{name}'; expected one of {one_of(movable)}{did_you_mean(name, movable)}", key=True)
+                elif movable[name].lower is not None and not (movable[name].lower - 1e-9 <= math.radians(deg) <= movable[name].upper + 1e-9):
+                    self.problem(base + ("joints_deg", name), f"{name} = {deg:g}° is outside the joint's limits {_deg_range(movable[name].lower, movable[name].upper)}")
         seat = person.placement.seated_on
         if seat is not None:
             if seat not in spec.scene.furniture:
@@ -538,7 +612,24 @@ class _Resolver:
                               "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
                               "face_normal_within_rad": math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None}
                              | ({"step_m": w.step_m} if w.step_m is not None else {}))  # absent when unset: other artifacts unchanged
-        return {"move": move, "waypoints": waypoints, "repeat_from": spec.scripted.repeat_from}
+        out = {"move": move, "waypoints": waypoints, "repeat_from": spec.scripted.repeat_from}
+        for side in ("left", "right"):  # a two-arm robot: the left arm's part, and the right arm's own (replacing the main one)
+            arm = getattr(spec.scripted, side)
+            if arm is None or len(self.sides) < 2:
+                continue
+            base = ("scripted", side)
+            resolved = {"move": self.point(arm.move, base + ("move",)), "repeat_from": arm.repeat_from,
+                        "waypoints": [{"to": self.point(w.to, base + ("waypoints", i, "to")), "offset_m": list(w.offset_m),
+                                       "tolerance_m": w.tolerance_m, "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
+                                       "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
+                                       "face_normal_within_rad": math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None}
+                                      | ({"step_m": w.step_m} if w.step_m is not None else {})
+                                      for i, w in enumerate(arm.waypoints)]}
+            if side == "left":
+                out["left"] = resolved
+            else:
+                out.update(resolved)
+        return out
 
     def _success(self, spec: TaskSpec, reward_names: set[str]) -> float:
         success = spec.success

@@ -356,7 +356,7 @@ def test_unknown_reward_term_kind(tmp_path, capsys):
         capsys,
         path,
         f"{at(text, 'action_nrom')}: unknown reward term 'action_nrom'; expected one of 'action_norm', 'closest_distance', "
-        "'contact_events', 'contact_force', 'distance', 'markers_cleared', 'particles_consumed', 'particles_lost', 'sleeve_progress', 'tilt' "
+        "'contact_events', 'contact_force', 'distance', 'markers_cleared', 'negative_distance_sum', 'particles_consumed', 'particles_lost', 'sleeve_progress', 'tilt' "
         "(did you mean 'action_norm'?)",
     )
 

@@ -177,12 +177,13 @@ def test_scripted_tool_turns_no_further_than_needed_to_face_the_itch(scratch):
     for seed in range(12):
         scratch.reset(seed=seed)
         policy._start_episode()
-        start = np.asarray(policy.keep_orn)
+        track = policy.tracks[0]
+        start = np.asarray(track.keep_orn)
         inward = -scratch.snap.normal(itch)
-        d0 = quat_rotate(start, policy.axis_in_point)
+        d0 = quat_rotate(start, track.axis_in_point)
         before = math.acos(np.clip(np.dot(d0, inward), -1, 1))
-        orn = np.asarray(policy._facing(start, inward, within))
-        d = quat_rotate(orn, policy.axis_in_point)
+        orn = np.asarray(policy._facing(track, start, inward, within))
+        d = quat_rotate(orn, track.axis_in_point)
         after = math.acos(np.clip(np.dot(d, inward), -1, 1))
         rotation = 2 * math.acos(min(1.0, abs(float(np.dot(orn, start)))))
         if before <= within:

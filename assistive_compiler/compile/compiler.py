@@ -220,7 +220,7 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
         params = dict(part.template.params) | (dict(part.mount_params) if name == mounted_on else {})
         params |= dict(use.params)  # the task's explicit parameters win (e.g. a mount on the person's left)
         emit(name, lib.template_path(rt.furniture[name]), params, rt.furniture[name].smap.value(("template", "path")))
-    for name, use in spec.tools.items():
+    for name, use in rt.tool_uses.items():
         part = rt.tools[name].part
         params = dict(part.template.params) | ({"mass_kg": use.mass_kg} if use.mass_kg else {})
         emit(name, lib.template_path(rt.tools[name]), params, rt.tools[name].smap.value(("template", "path")))
@@ -498,11 +498,53 @@ def _settle_person(rt: ResolvedTask, written: dict[str, Path], variant: str, mea
             p.stepSimulation(physicsClientId=c)
         pos, orn = pc.link_pose(body, -1)
         angles = {n: s[0] for n, s in zip(names, p.getJointStates(body, idx, physicsClientId=c))}
+        if settle.then is not None:
+            angles = _settle_stage(rt, pc, body, joints, names, angles, pos, orn)
         if not all(math.isfinite(v) for v in [*pos, *orn, *angles.values()]) or abs(pos[2]) > 10:
             raise _fail(rt, ("person", "placement", "settle"), f"person '{variant}' did not settle (the body left the scene); check placement.position_m")
         return _round(tuple(pos)), _round(tuple(orn)), {n: _round(a) for n, a in angles.items()}
     finally:
         pc.close()
+
+
+def _settle_stage(rt: ResolvedTask, pc: _Precompute, body: int, joints: dict[str, int], names: list[str],
+                  angles: dict[str, float], pos, orn) -> dict[str, float]:
+    """The settle's second stage (``placement.settle.then``): the settled base is fixed where it lies
+    and every joint held stiffly at its settled angle, except the stage's dynamic joint groups,
+    which are set to the stage's ``joints_deg`` and then move under the stage's gravity and weak
+    hold (the reference's arm manipulation: the right arm raised, then dropped to hang off the bed
+    for 100 steps at g −9.81). Returns every joint's angle afterwards (rad)."""
+    spec = rt.spec
+    stage = spec.person.placement.settle.then
+    p, c = pc.p, pc.client
+    dynamic: list[str] = []
+    for ref in stage.dynamic:
+        dynamic += [j for j in rt.joint_groups[ref]["joints"] if j not in dynamic]
+    start = dict(angles) | {j: math.radians(a) for j, a in stage.joints_deg.items()}
+    com_pos, com_orn = p.getBasePositionAndOrientation(body, physicsClientId=c)
+    p.createConstraint(body, -1, -1, -1, p.JOINT_FIXED, (0, 0, 0), (0, 0, 0), com_pos, (0, 0, 0, 1), com_orn, physicsClientId=c)
+    p.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0), physicsClientId=c)
+    for n in names:
+        p.resetJointState(body, joints[n], start[n], 0.0, physicsClientId=c)
+    held = [n for n in names if n not in dynamic]
+    p.setJointMotorControlArray(body, [joints[n] for n in held], p.POSITION_CONTROL, targetPositions=[start[n] for n in held],
+                                forces=[1e4] * len(held), physicsClientId=c)
+    if stage.hold is not None and dynamic:
+        p.setJointMotorControlArray(body, [joints[n] for n in dynamic], p.POSITION_CONTROL, targetPositions=[start[n] for n in dynamic],
+                                    positionGains=[stage.hold.position_gain] * len(dynamic), forces=[stage.hold.max_force_nm] * len(dynamic),
+                                    physicsClientId=c)
+    if stage.friction is not None:
+        for bid in range(p.getNumBodies(physicsClientId=c)):
+            if bid != body:
+                for link in range(-1, p.getNumJoints(bid, physicsClientId=c)):
+                    p.changeDynamics(bid, link, lateralFriction=stage.friction, physicsClientId=c)
+    p.setGravity(0, 0, stage.gravity_mps2, physicsClientId=c)
+    for _ in range(stage.steps):
+        p.stepSimulation(physicsClientId=c)
+        for n in held:  # static joints stay exactly where they settled
+            p.resetJointState(body, joints[n], start[n], 0.0, physicsClientId=c)
+    idx = [joints[n] for n in names]
+    return {n: s[0] for n, s in zip(names, p.getJointStates(body, idx, physicsClientId=c))}
 
 
 def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measurements, mounted_on, settled) -> Manifest:
@@ -557,8 +599,6 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measur
     offset = per_robot.base_offset_m if per_robot and per_robot.base_offset_m else (0.0, 0.0, 0.0)
     robot_id = pc.load(written["robot"], (0, 0, 0), (0, 0, 0, 1), True)
     robot_joints = pc.joint_index(robot_id)
-    side = spec.robot.arm if spec.robot.arm != "both" else "right"
-    _, arm = robot_part.arm_for(side)
     arm_joints = rt.joint_groups["robot.arm"]["joints"]
     infos = {j: p.getJointInfo(robot_id, robot_joints[j], physicsClientId=c) for j in arm_joints}
     lower = [infos[j][8] for j in arm_joints]
@@ -576,8 +616,7 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measur
     # Tools and the grip transform.
     tool_ids: dict[str, int] = {}
     attachments: list[ToolAttachment] = []
-    tool_name = next(iter(spec.tools), None)
-    for name, use in spec.tools.items():
+    for name, use in rt.tool_uses.items():
         tpart = rt.tools[name].part
         grip = robot_part.grips[tpart.name]
         _, hand = robot_part.arm_for(use.hand)
@@ -589,22 +628,35 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measur
                            fixed_base=False, gravity=use.gravity_mps2))
 
     # 3b. Base poses and start configurations, per person variant -----------------------------
-    start = spec.robot.start
-    tool_orn = _quat_from_rpy(tuple(math.radians(a) for a in start.tool_rpy_deg))
+    # One kinematic chain per acting side (a two-arm robot in a task with arm 'both' has two),
+    # each with its own start pose and the tool (or garment) in its hand.
     garment_grips = {}
     for gname, g in spec.garments.items():
         grip = robot_part.grips[g.held.grip]
         garment_grips[gname] = (robot_part.arm_for(g.held.hand)[1].tool_mount, _round(tuple(grip.position_m)), _round(_quat_from_rpy(grip.rpy_rad)))
-    if tool_name:
-        att = attachments[0]
-        inv_pos, inv_orn = p.invertTransform(att.position, att.orientation)
-    elif garment_grips:  # the start pose is the garment's held frame
-        _, gpos, gorn = next(iter(garment_grips.values()))
-        inv_pos, inv_orn = p.invertTransform(gpos, gorn)
-    else:
-        inv_pos, inv_orn = (0, 0, 0), (0, 0, 0, 1)
-    arm_kin = _ArmKinematics(pc, robot_id, pc.link_index(robot_id, arm.tool_mount), [robot_joints[j] for j in arm_joints], lower, upper,
-                             (inv_pos, inv_orn), tool_ids, list(furniture_ids.values()), robot_part.arm_for(side)[1].rest_rad)
+    arms: list[tuple[_ArmKinematics, Any, tuple]] = []  # (kinematics, start goal, tool orientation)
+    offset_in_action = 0
+    for side in rt.sides:
+        real_side, arm = robot_part.arm_for(side)
+        n = len(arm.joints)
+        side_start = _start_for(rt, side)
+        side_orn = _quat_from_rpy(tuple(math.radians(a) for a in side_start.tool_rpy_deg))
+        held = [k for k, (name, use) in enumerate(rt.tool_uses.items()) if robot_part.arm_for(use.hand)[0] == real_side]
+        held_garments = [garment_grips[gname][1:] for gname, g in spec.garments.items() if robot_part.arm_for(g.held.hand)[0] == real_side]
+        if held:
+            att = attachments[held[0]]
+            inv = p.invertTransform(att.position, att.orientation)
+            side_tools = {att.body: tool_ids[att.body]}
+        elif held_garments:  # the start pose is the garment's held frame
+            inv, side_tools = p.invertTransform(*held_garments[0]), {}
+        else:
+            inv, side_tools = ((0, 0, 0), (0, 0, 0, 1)), {}
+        kin = _ArmKinematics(pc, robot_id, pc.link_index(robot_id, arm.tool_mount), [robot_joints[j] for j in arm.joints],
+                             lower[offset_in_action:offset_in_action + n], upper[offset_in_action:offset_in_action + n],
+                             inv, side_tools, list(furniture_ids.values()), arm.rest_rad)
+        arms.append((kin, side_start, side_orn))
+        offset_in_action += n
+    arm_kin, start, tool_orn = arms[0]
     variants_out: list[PersonVariant] = []
     particle_sets: list[ParticleSet] = []
     placements: dict[str, Any] = {}
@@ -612,16 +664,21 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measur
         for other, pid in person_ids.items():  # only this variant in the scene
             pc.place(pid, person_pos[other] if other == variant else (0, 0, -20), person_orns[other])
         rng = np.random.default_rng(_seed(rt, variant))
-        arm_kin.person = person_ids[variant]
-        goals = [(tuple(start.tool_position_m), tool_orn, True, "the start pose")]
+        goals = []
+        for side, (kin, side_start, side_orn) in zip(rt.sides, arms):
+            kin.person = person_ids[variant]
+            what = "the start pose" if len(arms) == 1 else f"the {side} arm's start pose"
+            goals.append((tuple(side_start.tool_position_m), side_orn, True, what, kin, True))
         for g in rt.base_goals:
             where = np.asarray(_point_world(pc, rt, g["point"], person_ids[variant], variant, furniture_ids, tool_ids)) + g["offset_m"]
-            goals.append((tuple(where), tool_orn if g["oriented"] else None, g["required"], _describe_point(g["point"])))
+            k = rt.sides.index(g["arm"]) if g["arm"] in rt.sides else 0
+            kin, _, side_orn = arms[k]
+            goals.append((tuple(where), side_orn if g["oriented"] else None, g["required"], _describe_point(g["point"]), kin, False))
         if mount_pose is not None:
             bases = [(mount_pose, len(goals), 0.0)]
             placements[variant] = {"mounted_on": mounted_on}
         else:
-            bases = _search_base(rt, arm_kin, goals, offset, rng, carry)
+            bases = _search_base(rt, [a[0] for a in arms], goals, offset, rng, carry)
             placements[variant] = {"base_poses": [{"position": list(_round(b[0][0])), "yaw_rad": _round(_yaw(b[0][1])),
                                                    "goals_reached": b[1], "goals": len(goals), "jlwki": _round(b[2])} for b in bases]}
         starts: list[StartState] = []
@@ -630,14 +687,24 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measur
             arm_kin.place(base_pos, base_orn)
             if carry is not None:
                 carry.place(base_pos, base_orn)
+            for kin, _, _ in arms:
+                kin.set_arm(kin.rest)
             for s in range(per_base):
-                noise = np.zeros(3) if s == 0 else rng.uniform(-start.noise_m, start.noise_m, 3)
-                goal = tuple(np.asarray(start.tool_position_m) + noise)
-                q = arm_kin.reach(goal, tool_orn, rng, tries=24)
-                if q is not None:
-                    starts.append(StartState(base_position=_round(base_pos), base_orientation=_round(base_orn), joints=_round(list(q)), tool_position=_round(goal)))
+                qs, first_goal = [], None
+                for kin, side_start, side_orn in arms:
+                    noise = np.zeros(3) if s == 0 else rng.uniform(-side_start.noise_m, side_start.noise_m, 3)
+                    goal = tuple(np.asarray(side_start.tool_position_m) + noise)
+                    q = kin.reach(goal, side_orn, rng, tries=24)
+                    if q is None:
+                        break
+                    qs += list(q)
+                    first_goal = first_goal or goal
+                else:
+                    starts.append(StartState(base_position=_round(base_pos), base_orientation=_round(base_orn), joints=_round(qs), tool_position=_round(first_goal)))
         if not starts:
-            raise _fail(rt, ("robot", "start", "tool_position_m"),
+            own = spec.robot.per_robot.get(rt.robot_name)
+            where = ("robot", "per_robot", rt.robot_name, "start", "tool_position_m") if own is not None and own.start is not None else ("robot", "start", "tool_position_m")
+            raise _fail(rt, where,
                         f"robot '{rt.robot_name}' cannot reach the start pose {tuple(start.tool_position_m)} (tool rpy {tuple(start.tool_rpy_deg)}°) without collision for person '{variant}'")
         m = measurements[variant]
         offsets = {}
@@ -663,7 +730,7 @@ def _precompute(rt, pc: _Precompute, written, out_tmp, postures, movable, measur
         k = next(i for i, b in enumerate(bodies) if b.name == mounted_on)
         bodies[k] = bodies[k].model_copy(update={"position": _round(pos), "orientation": _round(orn),
                                                  "carried_by_robot": (_round(carry.inv_pos), _round(carry.inv_orn))})
-    for i, q in zip(arm_kin.arm_idx, first.joints):
+    for i, q in zip([i for kin, _, _ in arms for i in kin.arm_idx], first.joints):
         p.resetJointState(robot_id, i, q, physicsClientId=c)
 
     # 3c. Particles settle in their container at the nominal start pose ---------------------
@@ -887,13 +954,15 @@ class _Carried:
         return tuple(pos), tuple(orn)
 
 
-def _search_base(rt: ResolvedTask, arm: _ArmKinematics, goals, offset, rng, carry: _Carried | None = None):
+def _search_base(rt: ResolvedTask, arms: list, goals, offset, rng, carry: _Carried | None = None):
     """The paper's base-pose search, bounded: exactly ``attempts`` samples; the ``keep`` best by
-    (goals reached, Σ JLWKI), each reaching every required goal. Raises with the goal that no
-    sampled pose reached. With ``carry`` the base sits at the carried furniture's mount height and
+    (goals reached, Σ JLWKI), each reaching every required goal. ``goals`` are (position,
+    orientation or None, required, description, the arm's kinematics, is a start pose); each arm
+    starts from its rest pose. Raises with the goal that no sampled pose reached. With ``carry`` the base sits at the carried furniture's mount height and
     the furniture moves under every sampled base; a pose where it touches the person or other
     furniture is rejected."""
     search = rt.spec.robot.base_search
+    arm = arms[0]
     anchor = np.asarray(search.origin_m[:2]) + np.asarray(offset[:2])
     z = (carry.height if carry is not None else rt.robot.part.base_height_m) + (offset[2] if len(offset) > 2 else 0.0)
     found = []
@@ -903,7 +972,8 @@ def _search_base(rt: ResolvedTask, arm: _ArmKinematics, goals, offset, rng, carr
         yaw = math.radians(search.yaw_deg + rng.uniform(-search.yaw_noise_deg, search.yaw_noise_deg))
         pos, orn = (float(xy[0]), float(xy[1]), float(z)), _quat_from_rpy((0.0, 0.0, yaw))
         arm.place(pos, orn)
-        arm.set_arm(arm.rest)
+        for a in arms:
+            a.set_arm(a.rest)
         if carry is not None:
             carry.place(pos, orn)
             if any(arm.pc.touching(carry.body, o) for o in arm.obstacles if o != carry.body) or arm.pc.touching(carry.body, arm.person):
@@ -913,8 +983,8 @@ def _search_base(rt: ResolvedTask, arm: _ArmKinematics, goals, offset, rng, carr
         if any(arm.pc.touching(arm.robot, o) for o in arm.obstacles if carry is None or o != carry.body) or arm.pc.touching(arm.robot, arm.person):
             continue
         reached, score, ok = 0, 0.0, True
-        for k, (gpos, gorn, required, _name) in enumerate(goals):
-            q = arm.reach(gpos, gorn, rng, tries=2, tool_may_touch=k > 0)  # goal 0 is the start pose
+        for k, (gpos, gorn, required, _name, kin, is_start) in enumerate(goals):
+            q = kin.reach(gpos, gorn, rng, tries=2, tool_may_touch=not is_start)
             if q is None:
                 if required:
                     required_misses[k] += 1
@@ -922,7 +992,7 @@ def _search_base(rt: ResolvedTask, arm: _ArmKinematics, goals, offset, rng, carr
                     break
                 continue
             reached += 1
-            score += arm.jlwki(q)
+            score += kin.jlwki(q)
         if ok:
             found.append(((pos, orn), reached, score))
     if not found:
@@ -930,6 +1000,18 @@ def _search_base(rt: ResolvedTask, arm: _ArmKinematics, goals, offset, rng, carr
         raise _fail(rt, ("robot", "base_search"), f"robot '{rt.robot_name}' reaches {goals[worst][3]} from none of {search.attempts} sampled base poses (set robot.per_robot.{rt.robot_name}.base_offset_m or widen base_search)")
     found.sort(key=lambda f: (-f[1], -f[2]))
     return found[: search.keep]
+
+
+def _start_for(rt: ResolvedTask, side: str):
+    """The start pose of the acting side's tool: the left arm of a two-arm robot acting with both
+    arms starts at robot.start_left; the right (or only) arm at per_robot.<robot>.start, else robot.start."""
+    role = rt.spec.robot
+    if side == "left" and len(rt.sides) > 1:
+        if role.start_left is None:
+            raise _fail(rt, ("robot", "arm"), f"robot '{rt.robot_name}' acts with both arms here; give robot.start_left, the left arm's start pose")
+        return role.start_left
+    own = role.per_robot.get(rt.robot_name)
+    return own.start if own is not None and own.start is not None else role.start
 
 
 def _settle_particles(rt, pc, name, ps, tool_ids, furniture_ids, start, tool_orn) -> ParticleSet:
@@ -998,18 +1080,28 @@ def _inside_point(pc, body: int, link_name: str) -> tuple[float, float, float]:
 
 
 def _gripper(rt: ResolvedTask) -> tuple[list[str], list[float]]:
-    """The acting hand's finger joints and their positions for the held tool (or 'none')."""
-    spec, robot_part = rt.spec, rt.robot.part
-    gripper = robot_part.gripper.get(robot_part.arm_for(spec.robot.arm if spec.robot.arm != "both" else "right")[0])
-    tool_part = rt.tools[next(iter(spec.tools))].part.name if spec.tools else "none"
-    if spec.garments:  # the hand holds a garment: its grip's finger positions, else the empty hand's
-        tool_part = next(iter(spec.garments.values())).held.grip
-    grip_pos = gripper.positions.get(tool_part, gripper.positions.get("none", 0.0)) if gripper else 0.0
-    n_fingers = len(gripper.joints) if gripper else 0
-    grip_pos = [float(v) for v in grip_pos] if isinstance(grip_pos, list) else [float(grip_pos)] * n_fingers
-    if len(grip_pos) != n_fingers:
-        raise _fail(rt, ("tools",), f"robot '{rt.robot_name}' gives {len(grip_pos)} finger positions for '{tool_part}' but has {n_fingers} finger joints")
-    return (list(gripper.joints) if gripper else []), grip_pos
+    """The acting hands' finger joints and their positions for the tool each holds (or 'none')."""
+    robot_part = rt.robot.part
+    joints: list[str] = []
+    positions: list[float] = []
+    for side in rt.sides:
+        real_side = robot_part.arm_for(side)[0]
+        gripper = robot_part.gripper.get(real_side)
+        held = [use.part for use in rt.tool_uses.values() if robot_part.arm_for(use.hand)[0] == real_side]
+        if not held and len(rt.sides) == 1 and rt.tool_uses:
+            held = [next(iter(rt.tool_uses.values())).part]
+        tool_part = held[0] if held else "none"
+        garments = [g.held.grip for g in rt.spec.garments.values() if robot_part.arm_for(g.held.hand)[0] == real_side]
+        if garments:  # the hand holds a garment: its grip's finger positions, else the empty hand's
+            tool_part = garments[0]
+        grip_pos = gripper.positions.get(tool_part, gripper.positions.get("none", 0.0)) if gripper else 0.0
+        n_fingers = len(gripper.joints) if gripper else 0
+        grip_pos = [float(v) for v in grip_pos] if isinstance(grip_pos, list) else [float(grip_pos)] * n_fingers
+        if len(grip_pos) != n_fingers:
+            raise _fail(rt, ("tools",), f"robot '{rt.robot_name}' gives {len(grip_pos)} finger positions for '{tool_part}' but has {n_fingers} finger joints")
+        joints += list(gripper.joints) if gripper else []
+        positions += grip_pos
+    return joints, positions
 
 
 def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lower, upper, movable, placements, garments=()) -> Manifest:

@@ -29,53 +29,87 @@ STALL_STEPS = 10  # steps without getting STALL_GAIN_M closer before moving on t
 STALL_GAIN_M = 0.002
 
 
+class _Track:
+    """One arm's part of the script: the moved point, its waypoints, its end effector and the
+    action columns of its joints."""
+
+    def __init__(self, env, section: dict, mount_link: str, joints: list[str]):
+        snap, m = env.snap, env.manifest
+        self.move = snap.point(section["move"])
+        self.waypoints = [(snap.point(w["to"]), np.asarray(w["offset_m"]), w["tolerance_m"], w.get("normal_offset_m", 0.0),
+                           w.get("axis_offset_m", 0.0)) for w in section["waypoints"]]
+        self.orientations = [pb.getQuaternionFromEuler(w["rpy_rad"]) if w.get("rpy_rad") else None for w in section["waypoints"]]
+        self.face_normal = [w.get("face_normal_within_rad") for w in section["waypoints"]]
+        self.steps_m = [w.get("step_m") for w in section["waypoints"]]
+        self.repeat_from = section.get("repeat_from")
+        robot = env.world.robot
+        self.ee_link = robot.links[mount_link]
+        self.ee_point = snap.point({"body": "robot", "link": mount_link})
+        order = list(m.robot.arm_joints)
+        self.action_cols = [order.index(j) for j in joints]
+
+
 class ScriptedPolicy:
-    """Callable ``obs -> action`` bound to one :class:`~assistive_compiler.runtime.env.AssistiveEnv`."""
+    """Callable ``obs -> action`` bound to one :class:`~assistive_compiler.runtime.env.AssistiveEnv`.
+
+    With a ``left`` section (a two-arm robot acting with both arms) the right arm follows the main
+    waypoints and the left arm its own, each solved by its own IK call every step."""
 
     def __init__(self, env):
         m = env.manifest
         if m.scripted is None:
             raise ValueError(f"task '{m.task}' has no scripted: section, so there is no scripted policy for it")
         self.env = env
-        snap = env.snap
-        self.move = snap.point(m.scripted["move"])
-        self.waypoints = [(snap.point(w["to"]), np.asarray(w["offset_m"]), w["tolerance_m"], w.get("normal_offset_m", 0.0),
-                           w.get("axis_offset_m", 0.0)) for w in m.scripted["waypoints"]]
-        self.orientations = [pb.getQuaternionFromEuler(w["rpy_rad"]) if w.get("rpy_rad") else None for w in m.scripted["waypoints"]]
-        self.face_normal = [w.get("face_normal_within_rad") for w in m.scripted["waypoints"]]
-        self.repeat_from = m.scripted.get("repeat_from")
-        self.steps_m = [w.get("step_m") for w in m.scripted["waypoints"]]
+        links = m.robot.links
+        if m.scripted.get("left") is not None:
+            self.tracks = [_Track(env, m.scripted, links["right_tool_mount"], m.joint_groups["robot.right_arm"]["joints"]),
+                           _Track(env, m.scripted["left"], links["left_tool_mount"], m.joint_groups["robot.left_arm"]["joints"])]
+        else:
+            self.tracks = [_Track(env, m.scripted, links["tool_mount"], list(m.robot.arm_joints))]
         robot = env.world.robot
-        self.ee_link = robot.links[m.robot.links["tool_mount"]]
-        self.ee_point = snap.point({"body": "robot", "link": m.robot.links["tool_mount"]})
         c = env.world.client
         movable = [j for j in range(pb.getNumJoints(robot.id, physicsClientId=c)) if pb.getJointInfo(robot.id, j, physicsClientId=c)[2] != pb.JOINT_FIXED]
         self.movable = movable
-        self.cols = [movable.index(i) for i in env.arm_idx]
+        for track in self.tracks:
+            track.cols = [movable.index(env.arm_idx[k]) for k in track.action_cols]
         self.lo = [pb.getJointInfo(robot.id, j, physicsClientId=c)[8] for j in movable]
         self.hi = [pb.getJointInfo(robot.id, j, physicsClientId=c)[9] for j in movable]
         self.ranges = [max(h - l, 1e-3) for l, h in zip(self.lo, self.hi)]
 
+    @property
+    def index(self) -> int:
+        """The current waypoint of the first (right or only) arm."""
+        return self.tracks[0].index
+
+    def _goal(self, track: _Track | None = None) -> tuple[np.ndarray, float]:
+        """The current waypoint's position (world, m) and tolerance."""
+        track = track or self.tracks[0]
+        to, offset, tol, along_normal, along_axis = track.waypoints[track.index]
+        snap = self.env.snap
+        return snap.position(to) + offset + along_normal * snap.normal(to) + along_axis * snap.axis(to), tol
+
     def _start_episode(self) -> None:
         snap = self.env.snap
-        # The moved point rides rigidly on the end effector: remember its pose in the EE frame,
-        # and the orientation to keep.
-        ee_pos, ee_orn = snap.position(self.ee_point), snap.orientation(self.ee_point)
-        pt_pos, pt_orn = snap.position(self.move), snap.orientation(self.move)
-        inv = pb.invertTransform(ee_pos.tolist(), ee_orn.tolist())
-        self.point_in_ee = pb.multiplyTransforms(inv[0], inv[1], pt_pos.tolist(), pt_orn.tolist())
-        self.keep_orn = pt_orn.tolist()
-        # The tool's pointing axis (end effector → moved point), in the moved point's link frame.
-        d = pt_pos - ee_pos
-        d = d / max(float(np.linalg.norm(d)), 1e-9)
-        self.axis_in_point = np.asarray(quat_rotate(quat_conj(pt_orn), d))
-        self.index = 0
-        self._best, self._since_best = float("inf"), 0
+        for track in self.tracks:
+            # The moved point rides rigidly on the end effector: remember its pose in the EE frame,
+            # and the orientation to keep.
+            ee_pos, ee_orn = snap.position(track.ee_point), snap.orientation(track.ee_point)
+            pt_pos, pt_orn = snap.position(track.move), snap.orientation(track.move)
+            inv = pb.invertTransform(ee_pos.tolist(), ee_orn.tolist())
+            track.point_in_ee = pb.multiplyTransforms(inv[0], inv[1], pt_pos.tolist(), pt_orn.tolist())
+            track.keep_orn = pt_orn.tolist()
+            # The tool's pointing axis (end effector → moved point), in the moved point's link frame.
+            d = pt_pos - ee_pos
+            d = d / max(float(np.linalg.norm(d)), 1e-9)
+            track.axis_in_point = np.asarray(quat_rotate(quat_conj(pt_orn), d))
+            track.index = 0
+            track.best, track.since_best = float("inf"), 0
 
-    def _facing(self, orn, inward: np.ndarray, within: float) -> list[float]:
-        """``orn`` turned by the smallest rotation that brings the pointing axis within ``within``
-        (rad) of the unit vector ``inward`` (world); unchanged when it already is."""
-        d = quat_rotate(np.asarray(orn), self.axis_in_point)
+    @staticmethod
+    def _facing(track: _Track, orn, inward: np.ndarray, within: float) -> list[float]:
+        """``orn`` turned by the smallest rotation that brings the track's pointing axis within
+        ``within`` (rad) of the unit vector ``inward`` (world); unchanged when it already is."""
+        d = quat_rotate(np.asarray(orn), track.axis_in_point)
         angle = math.acos(max(-1.0, min(1.0, float(np.dot(d, inward)))))
         if angle <= within:
             return list(orn)
@@ -89,46 +123,42 @@ class ScriptedPolicy:
         q = np.concatenate([k * math.sin(turn / 2), [math.cos(turn / 2)]])
         return quat_mul(q, np.asarray(orn)).tolist()
 
-    def _goal(self) -> tuple[np.ndarray, float]:
-        """The current waypoint's position (world, m) and tolerance."""
-        to, offset, tol, along_normal, along_axis = self.waypoints[self.index]
-        snap = self.env.snap
-        return snap.position(to) + offset + along_normal * snap.normal(to) + along_axis * snap.axis(to), tol
-
     def __call__(self, obs) -> np.ndarray:
         env = self.env
         if env.steps == 0:  # first action of an episode
             self._start_episode()
-        snap = env.snap
-        goal, tol = self._goal()
-        error = float(np.linalg.norm(snap.position(self.move) - goal))
-        if error < self._best - STALL_GAIN_M:
-            self._best, self._since_best = error, 0
-        else:
-            self._since_best += 1
-        last = self.index == len(self.waypoints) - 1
-        if (not last or self.repeat_from is not None) and (error <= tol or self._since_best >= STALL_STEPS):
-            self.index = self.index + 1 if not last else self.repeat_from
-            self._best, self._since_best = float("inf"), 0
-            goal, tol = self._goal()
-        step = self.steps_m[self.index]
-        if step is not None:  # a straight line from where the point is: IK aims at most step_m ahead
-            here = snap.position(self.move)
-            ahead = goal - here
-            distance = float(np.linalg.norm(ahead))
-            if distance > step:
-                goal = here + ahead * (step / distance)
-        # End-effector pose that puts the moved point at the goal with the kept orientation.
-        inv_pos, inv_orn = pb.invertTransform(*self.point_in_ee)
-        orn = self.orientations[self.index] or self.keep_orn
-        if self.face_normal[self.index] is not None:
-            orn = self._facing(orn, -snap.normal(self.waypoints[self.index][0]), self.face_normal[self.index])
-        ee_pos, ee_orn = pb.multiplyTransforms(goal.tolist(), orn, inv_pos, inv_orn)
         c = env.world.client
         robot = env.world.robot.id
         rest = [pb.getJointState(robot, j, physicsClientId=c)[0] for j in self.movable]
-        sol = pb.calculateInverseKinematics(robot, self.ee_link, ee_pos, ee_orn, lowerLimits=self.lo, upperLimits=self.hi,
-                                            jointRanges=self.ranges, restPoses=rest, maxNumIterations=50, physicsClientId=c)
-        q_goal = np.array([sol[k] for k in self.cols])
-        q = np.array([rest[k] for k in self.cols])
-        return np.clip((q_goal - q) / env.delta_scale, -1.0, 1.0).astype(np.float32)
+        action = np.zeros(len(env.arm_idx), dtype=np.float32)
+        for track in self.tracks:
+            goal, tol = self._goal(track)
+            error = float(np.linalg.norm(env.snap.position(track.move) - goal))
+            if error < track.best - STALL_GAIN_M:
+                track.best, track.since_best = error, 0
+            else:
+                track.since_best += 1
+            last = track.index == len(track.waypoints) - 1
+            if (not last or track.repeat_from is not None) and (error <= tol or track.since_best >= STALL_STEPS):
+                track.index = track.index + 1 if not last else track.repeat_from
+                track.best, track.since_best = float("inf"), 0
+                goal, tol = self._goal(track)
+            step = track.steps_m[track.index]
+            if step is not None:  # a straight line from where the point is: IK aims at most step_m ahead
+                here = env.snap.position(track.move)
+                ahead = goal - here
+                distance = float(np.linalg.norm(ahead))
+                if distance > step:
+                    goal = here + ahead * (step / distance)
+            # End-effector pose that puts the moved point at the goal with the kept orientation.
+            inv_pos, inv_orn = pb.invertTransform(*track.point_in_ee)
+            orn = track.orientations[track.index] or track.keep_orn
+            if track.face_normal[track.index] is not None:
+                orn = self._facing(track, orn, -env.snap.normal(track.waypoints[track.index][0]), track.face_normal[track.index])
+            ee_pos, ee_orn = pb.multiplyTransforms(goal.tolist(), orn, inv_pos, inv_orn)
+            sol = pb.calculateInverseKinematics(robot, track.ee_link, ee_pos, ee_orn, lowerLimits=self.lo, upperLimits=self.hi,
+                                                jointRanges=self.ranges, restPoses=rest, maxNumIterations=50, physicsClientId=c)
+            q_goal = np.array([sol[k] for k in track.cols])
+            q = np.array([rest[k] for k in track.cols])
+            action[track.action_cols] = np.clip((q_goal - q) / env.delta_scale, -1.0, 1.0)
+        return action

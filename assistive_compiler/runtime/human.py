@@ -29,7 +29,14 @@ After every physics step, when the person acts, tremors or has a limited range o
 
 * **hard joint limits** (facts §3.2): a movable joint past its limit (γ-scaled under the
   limited-range impairment, intersected with the URDF's) is reset to the limit with zero
-  velocity (episodes also start with every movable joint inside these limits);
+  velocity — every movable joint while the person is an agent (acts or tremors: facts §1, "for
+  every human in the agent list"); on a static person only the stiffly held joints (standing in
+  for the limits the reference builds into the body), not the compliant (limp) ones. Episodes start with every stiffly held joint inside these limits (the reference's
+  clamped ``set_joint_angles``); a compliant (limp) joint starts where the compile-time settle
+  left it, clamped into the URDF's limits only. The reference settles a limp limb under the
+  episode's γ-scaled limits at every reset; we settle once at compile time, and clamping a limp
+  joint into a narrower range, away from its rest, would only make the limb fall by itself at
+  the start of the episode. So a static person's limp joints do not feel a limited range;
 * **pose-dependent arm limits** (facts §3.6), only while the person acts and only when the policy
   joints include a whole arm's shoulder (3 axes) and elbow — the right arm if its shoulder is
   controlled, else the left: :class:`~assistive_compiler.person.arm_limits.ArmLimitGuard` with
@@ -136,8 +143,14 @@ class PersonController:
             if j in scaled:
                 lower[k], upper[k] = max(lower[k], scaled[j][0]), min(upper[k], scaled[j][1])
         self.lower, self.upper = lower, upper
-        for k, j in enumerate(movable):  # start inside the limits
-            angles[j] = min(max(angles[j], lower[k]), upper[k])
+        # Start inside the limits: a stiffly held joint inside these (γ-scaled) ones; a compliant (limp)
+        # joint inside the URDF's only — clamped into a narrower range away from where the compile-time
+        # settle left it, it would fall by itself at the start of the episode (see the module docstring).
+        compliant = set(m.person.compliant_joints)
+        urdf_lower, urdf_upper = self._urdf_limits[variant.name]
+        for k, j in enumerate(movable):
+            lo, hi = (urdf_lower[k], urdf_upper[k]) if j in compliant else (lower[k], upper[k])
+            angles[j] = min(max(angles[j], lo), hi)
         idx = [person.joints[j] for j in movable]
         for i, j in zip(idx, movable):
             pb.resetJointState(person.id, i, angles[j], physicsClientId=c)
@@ -147,7 +160,6 @@ class PersonController:
         # weakness scales the force of the joints it names.
         strength = impairment.get("strength", 1.0)
         weak = set(impairment.get("joints", ()))
-        compliant = set(m.person.compliant_joints)
         self.hold_gains = [m.person.compliant_gain if j in compliant else m.person.hold_gain for j in movable]
         self.hold_forces = [(m.person.compliant_force if j in compliant else m.person.hold_force)
                             * (strength if j in weak else 1.0) for j in movable]
@@ -172,7 +184,11 @@ class PersonController:
         self._arm_k = [movable.index(j) for j in ARM_LIMIT_JOINTS[self.arm_side]] if self.guard else []
         self.reverts = 0
         self._acting = False
-        self._static_hook = bool(self._tremor) or bool(impairment.get("limits"))
+        # Hard limits: on every movable joint while the person is an agent (acts or tremors); on a static
+        # person only on its stiffly held joints (standing in for the reference's limits built into the
+        # body), never on its limp ones (see the module docstring).
+        self._limited_k = [k for k, j in enumerate(movable) if j not in compliant] if impairment.get("limits") else []
+        self._static_hook = bool(self._tremor) or bool(self._limited_k)
         if self.guard is not None:
             self.guard.reset([self.hold[k] for k in self._arm_k])
         self.world.after_physics_step = self.after_physics_step if self._static_hook else None
@@ -224,7 +240,9 @@ class PersonController:
         c, bid, idx = self.world.client, self.body_id, self.idx
         q = [s[0] for s in pb.getJointStates(bid, idx, physicsClientId=c)]
         lower, upper = self.lower, self.upper
-        for k, v in enumerate(q):
+        enforced = range(len(q)) if (self._acting or self._tremor) else self._limited_k
+        for k in enforced:
+            v = q[k]
             if v < lower[k]:
                 q[k] = lower[k]
                 pb.resetJointState(bid, idx[k], lower[k], 0.0, physicsClientId=c)

@@ -266,6 +266,30 @@ class Settle(Strict):
     gravity_mps2: float = Field(-1.0, ge=-20, lt=0, description="Gravity while settling, m/s² (the reference: −1).")
     joint_noise_rad: float = Field(0.1, ge=0, le=1, description="Half-width of the uniform noise on every joint angle, rad.")
     friction: float | None = Field(None, ge=0, description="Friction of the furniture while settling (the reference: 5); None keeps it.")
+    then: "SettleStage | None" = Field(
+        None, description="A second compile-time stage after settling (e.g. an arm dropped to hang off the bed, facts §2.6)."
+    )
+
+
+class StageHold(Strict):
+    """The weak position hold of a settle stage's dynamic joints (towards the stage's start angles)."""
+
+    max_force_nm: float = Field(gt=0, description="Motor force limit, N·m (the reference's arm manipulation: 0.01 × strength 1).")
+    position_gain: float = Field(gt=0, le=1, description="Position gain (the reference: 0.05).")
+
+
+class SettleStage(Strict):
+    """A compile-time stage after settling: the settled base is fixed and every joint is held at its
+    settled angle, except the ``dynamic`` joint groups, which are first set to ``joints_deg`` (the
+    others keep theirs) and then move freely under ``gravity_mps2`` and a weak ``hold`` for
+    ``steps`` physics steps. The resulting angles are stored like the settled ones."""
+
+    joints_deg: dict[Name, float] = Field(default_factory=dict, description="Joint angles set before the stage, degrees by joint name.")
+    dynamic: list[Ref] = Field(min_length=1, description="Person joint groups left free during the stage, e.g. person.right_arm.")
+    hold: StageHold | None = Field(None, description="Weak hold of the dynamic joints (None: limp).")
+    gravity_mps2: float = Field(-9.81, ge=-20, lt=0, description="Gravity during the stage, m/s².")
+    steps: int = Field(100, ge=1, le=5000, description="Physics steps of the stage (the reference: 100).")
+    friction: float | None = Field(None, ge=0, description="Friction of the furniture during the stage (the reference: 0.3); None keeps the settle's.")
 
 
 class Placement(Strict):
@@ -345,6 +369,10 @@ class Goal(Strict):
     offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Offset from that point, world frame, metres.")
     oriented: bool = Field(False, description="Also reach the tool's start orientation (else position only).")
     required: bool = Field(False, description="A base pose that cannot reach this goal is discarded.")
+    arm: Literal["right", "left"] | None = Field(
+        None, description="Which arm reaches it when the robot acts with both arms (robot.arm: both); None: the right "
+        "(acting) arm. A one-arm robot reaches every goal with its arm."
+    )
 
 
 class BaseSearch(Strict):
@@ -367,6 +395,7 @@ class PerRobot(Strict):
     """Task settings that differ per robot (the reference's per-task robot tables)."""
 
     base_offset_m: Vec3 | None = Field(None, description="Base position offset from the mount or the search anchor, m (the reference's toc_base_pos_offset).")
+    start: StartGoal | None = Field(None, description="This robot's start pose, replacing robot.start (e.g. a one-arm robot's single start in a two-arm task).")
 
 
 class RobotRole(Strict):
@@ -387,7 +416,11 @@ class RobotRole(Strict):
     )
     gravity_mps2: float | None = Field(0.0, ge=-20, le=0, description="Gravity on the robot (0: compensated).")
     control: RobotControl = Field(default_factory=RobotControl, description="Arm control.")
-    start: StartGoal = Field(description="Start pose of the end effector.")
+    start: StartGoal = Field(description="Start pose of the tool of the acting arm (the right arm when arm is 'both').")
+    start_left: StartGoal | None = Field(
+        None, description="Start pose of the left arm's tool when arm is 'both' and the robot has two arms (one-arm robots "
+        "use start, or per_robot.<robot>.start)."
+    )
     base_search: BaseSearch = Field(default_factory=BaseSearch, description="Base placement of robots that are not mounted.")
     per_robot: dict[Name, PerRobot] = Field(default_factory=dict, description="Per-robot settings by robot name.")
 
@@ -397,6 +430,8 @@ class RobotRole(Strict):
             from ..errors import did_you_mean
 
             raise ValueError(f"@default: default robot '{self.default}' is not in supported {self.supported}{did_you_mean(self.default, self.supported)}")
+        if self.start_left is not None and self.arm != "both":
+            raise ValueError(f"@start_left: start_left is the left arm's start in a task acting with both arms, but this task's arm is '{self.arm}'; remove it or set arm: both")
         return self
 
 
@@ -407,6 +442,11 @@ class ToolUse(Strict):
     hand: Literal["right", "left"] = Field(description="Which hand holds it (single-arm robots: their only hand).")
     gravity_mps2: float | None = Field(0.0, ge=-20, le=0, description="Gravity on the tool (0: weightless).")
     mass_kg: float | None = Field(None, gt=0, description="Mass override in kg (None: the part's mass).")
+    one_arm_same_as: Name | None = Field(
+        None, description="On a robot acting with one arm (which serves as both hands), this tool is the named tool, held "
+        "in the other hand: one body that both names refer to (the reference's single-arm arm manipulation, facts §2.6). "
+        "Two-arm robots acting with both arms hold both tools.",
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -626,6 +666,10 @@ class RewardTerm(TermUse):
 
     name: Name = Field(description="Name of this term in info and logs.")
     weight: float = Field(description="Multiplier of the term's value (negative to penalise).")
+    arms: Literal[1, 2] | None = Field(
+        None, description="Only for robots acting with this many arms (2: a two-arm robot in a task with arm 'both'); "
+        "None: every robot. E.g. the reference's single-arm arm manipulation doubles a distance term."
+    )
 
 
 class Observations(Strict):
@@ -714,6 +758,20 @@ class Waypoint(Strict):
     )
 
 
+class ScriptedArm(Strict):
+    """The left arm's part of a scripted baseline when the robot acts with both arms."""
+
+    move: Ref = Field(description="The point the left arm moves, e.g. scooper_left.blade.")
+    waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order; the last is held unless repeat_from is given.")
+    repeat_from: int | None = Field(None, ge=0, description="After the last waypoint, go on from this index; None holds the last.")
+
+    @model_validator(mode="after")
+    def _repeat_in_range(self) -> "ScriptedArm":
+        if self.repeat_from is not None and self.repeat_from >= len(self.waypoints):
+            raise ValueError(f"@repeat_from: repeat_from {self.repeat_from} is not a waypoint index (0..{len(self.waypoints) - 1})")
+        return self
+
+
 class Scripted(Strict):
     """A privileged baseline controller (IK each step) that moves a point of the tool through
     waypoints, keeping the tool's start orientation. It shows the task is solvable and checks the
@@ -723,6 +781,15 @@ class Scripted(Strict):
     waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order; the last is held unless repeat_from is given.")
     repeat_from: int | None = Field(
         None, ge=0, description="After the last waypoint, go on from this index (e.g. to rub back and forth); None holds the last."
+    )
+    left: ScriptedArm | None = Field(
+        None, description="The left arm's waypoints when the robot acts with both arms (robot.arm: both, a two-arm robot); "
+        "move/waypoints then drive the right arm. Ignored on one-arm robots."
+    )
+    right: ScriptedArm | None = Field(
+        None, description="The right arm's part when the robot acts with both arms (robot.arm: both, a two-arm robot): it "
+        "replaces move/waypoints/repeat_from there, so that a two-arm script (e.g. lift with both hands) can differ from the "
+        "one-arm script that move/waypoints give. Ignored on one-arm robots."
     )
 
     @model_validator(mode="after")

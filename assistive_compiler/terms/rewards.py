@@ -8,7 +8,7 @@ import math
 from typing import Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from ..quat import quat_rotate
 from .registry import BodiesRef, BodyRef, MarkersRef, NodesRef, Params, ParticlesRef, PointRef, term
@@ -17,6 +17,17 @@ from .registry import BodiesRef, BodyRef, MarkersRef, NodesRef, Params, Particle
 class Distance(Params):
     a: PointRef
     b: PointRef
+
+
+class DistanceSum(Params):
+    a: list[PointRef] = Field(min_length=1, description="First point of each pair.")
+    b: list[PointRef] = Field(min_length=1, description="Second point of each pair (as many as a).")
+
+    @model_validator(mode="after")
+    def _paired(self) -> "DistanceSum":
+        if len(self.a) != len(self.b):
+            raise ValueError(f"a and b must pair up: a has {len(self.a)} points, b has {len(self.b)}")
+        return self
 
 
 class ActionNorm(Params):
@@ -36,6 +47,14 @@ class ContactForce(Params):
 def distance(snap, p) -> float:
     """Euclidean distance between two points (m)."""
     return math.dist(snap.position(p.a), snap.position(p.b))
+
+
+@term("negative_distance_sum", "reward", DistanceSum)
+def negative_distance_sum(snap, p) -> float:
+    """−Σᵢ ‖aᵢ − bᵢ‖ over paired points (m; 0 when every pair coincides), e.g. the reference's arm
+    manipulation r_h = −‖p_elbow − p_stomach‖ − ‖p_wrist − p_waist‖: a value whose running max a
+    success threshold can bound."""
+    return -sum(math.dist(snap.position(a), snap.position(b)) for a, b in zip(p.a, p.b))
 
 
 @term("action_norm", "reward", ActionNorm)
