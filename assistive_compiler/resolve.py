@@ -598,38 +598,34 @@ class _Resolver:
     def _scripted(self, spec: TaskSpec) -> dict[str, Any] | None:
         if spec.scripted is None:
             return None
-        move = self.point(spec.scripted.move, ("scripted", "move"))
-        waypoints = []
-        for i, w in enumerate(spec.scripted.waypoints):
-            to = self.point(w.to, ("scripted", "waypoints", i, "to"))
-            used = {"normal_offset_m": w.normal_offset_m != 0.0, "axis_offset_m": w.axis_offset_m != 0.0,
-                    "face_normal_within_deg": w.face_normal_within_deg is not None}
-            for key in used:
-                if used[key] and not (w.to in spec.targets and spec.targets[w.to].surface_of):
-                    self.problem(("scripted", "waypoints", i, key), f"{key} needs a target drawn on a surface (surface_of); '{w.to}' is not one")
-            waypoints.append({"to": to, "offset_m": list(w.offset_m), "tolerance_m": w.tolerance_m,
-                              "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
-                              "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
-                              "face_normal_within_rad": math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None}
-                             | ({"step_m": w.step_m} if w.step_m is not None else {}))  # absent when unset: other artifacts unchanged
-        out = {"move": move, "waypoints": waypoints, "repeat_from": spec.scripted.repeat_from}
+        out = self._script(spec, spec.scripted, ("scripted",))
         for side in ("left", "right"):  # a two-arm robot: the left arm's part, and the right arm's own (replacing the main one)
             arm = getattr(spec.scripted, side)
             if arm is None or len(self.sides) < 2:
                 continue
-            base = ("scripted", side)
-            resolved = {"move": self.point(arm.move, base + ("move",)), "repeat_from": arm.repeat_from,
-                        "waypoints": [{"to": self.point(w.to, base + ("waypoints", i, "to")), "offset_m": list(w.offset_m),
-                                       "tolerance_m": w.tolerance_m, "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
-                                       "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
-                                       "face_normal_within_rad": math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None}
-                                      | ({"step_m": w.step_m} if w.step_m is not None else {})
-                                      for i, w in enumerate(arm.waypoints)]}
+            resolved = self._script(spec, arm, ("scripted", side))
             if side == "left":
                 out["left"] = resolved
             else:
                 out.update(resolved)
         return out
+
+    def _script(self, spec: TaskSpec, script, base: tuple) -> dict[str, Any]:
+        """One arm's script (``move``, ``waypoints``, ``repeat_from``) with its references resolved."""
+        waypoints = []
+        for i, w in enumerate(script.waypoints):
+            to = self.point(w.to, base + ("waypoints", i, "to"))
+            used = {"normal_offset_m": w.normal_offset_m != 0.0, "axis_offset_m": w.axis_offset_m != 0.0,
+                    "face_normal_within_deg": w.face_normal_within_deg is not None}
+            for key in used:
+                if used[key] and not (w.to in spec.targets and spec.targets[w.to].surface_of):
+                    self.problem(base + ("waypoints", i, key), f"{key} needs a target drawn on a surface (surface_of); '{w.to}' is not one")
+            waypoints.append({"to": to, "offset_m": list(w.offset_m), "tolerance_m": w.tolerance_m,
+                              "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
+                              "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
+                              "face_normal_within_rad": math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None}
+                             | ({"step_m": w.step_m} if w.step_m is not None else {}))  # absent when unset: other artifacts unchanged
+        return {"move": self.point(script.move, base + ("move",)), "waypoints": waypoints, "repeat_from": script.repeat_from}
 
     def _success(self, spec: TaskSpec, reward_names: set[str]) -> float:
         success = spec.success
