@@ -30,7 +30,8 @@ def _env(spec: str, robot: str | None, out: str | None = None, **kwargs):
 
 
 def rollout(env, policy, seed: int) -> dict:
-    """One episode: return, success, summed term values, mean force on the person."""
+    """One episode: return, success, each term's unweighted values summed over the episode (the
+    reward is Σ weight × value: see ``term_weights`` in ``run --json``), mean force on the person (N)."""
     obs, info = env.reset(seed=seed)
     total, terms, forces = 0.0, {}, []
     done = False
@@ -68,7 +69,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     rate = sum(e["success"] for e in episodes) / len(episodes)
     if args.json:
         print(json.dumps({"task": env.manifest.task, "robot": env.manifest.robot_name, "policy": args.policy,
-                          "episodes": episodes, "success_rate": rate,
+                          "term_weights": weights, "episodes": episodes, "success_rate": rate,
                           "mean_return": float(np.mean([e["return"] for e in episodes]))}, indent=1))
         return 0
     print(f"{env.manifest.gym_id}  policy={args.policy}  episodes={len(episodes)}  seed={args.seed}")

@@ -447,6 +447,9 @@ def test_cli_run_json(artifact, capsys):
         assert isinstance(ep["return"], float) and ep["success"] is False
         assert set(ep["terms"]) >= {"distance_to_mouth", "food_eaten", "food_spilled"}
     assert report["success_rate"] == 0.0
+    # terms are unweighted episode sums; with term_weights they add up to the return
+    for ep in report["episodes"]:
+        assert sum(report["term_weights"][k] * v for k, v in ep["terms"].items()) == pytest.approx(ep["return"], rel=1e-9, abs=1e-9)
 
 
 # ---------------------------------------------------------------------------------------------
