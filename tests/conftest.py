@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pybullet as pb
 import pytest
 import xacro
 import yourdfpy
@@ -19,6 +20,14 @@ FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
 def artifact(tmp_path_factory) -> Path:
     """Feeding compiled for Jaco, once per test session."""
     return compile_task(FEEDING, "jaco", tmp_path_factory.mktemp("feeding-artifact") / "feeding-jaco").out_dir
+
+
+@pytest.fixture
+def cid():
+    """A private pybullet DIRECT client for one test."""
+    client = pb.connect(pb.DIRECT)
+    yield client
+    pb.disconnect(client)
 
 
 @pytest.fixture(scope="module")

@@ -111,13 +111,6 @@ def yaw_matrix(yaw: float) -> np.ndarray:
     return np.array([[math.cos(yaw), -math.sin(yaw), 0], [math.sin(yaw), math.cos(yaw), 0], [0, 0, 1]])
 
 
-@pytest.fixture
-def cid():
-    client = pb.connect(pb.DIRECT)
-    yield client
-    pb.disconnect(client)
-
-
 # --------------------------------------------------------------------------------------------
 # (a) the template
 

@@ -124,13 +124,6 @@ def assert_links_physical(root) -> None:
             assert kinds and set(kinds) <= {"box", "cylinder", "sphere"}, kinds
 
 
-@pytest.fixture
-def cid():
-    client = pb.connect(pb.DIRECT)
-    yield client
-    pb.disconnect(client)
-
-
 @pytest.fixture(scope="module")
 def out_dir(tmp_path_factory) -> Path:
     return tmp_path_factory.mktemp("scene_templates")

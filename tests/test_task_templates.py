@@ -132,13 +132,6 @@ def in_frame(cid: int, body: int, points) -> np.ndarray:
     return np.array([pb.multiplyTransforms(*inv, p, (0, 0, 0, 1))[0] for p in points])
 
 
-@pytest.fixture
-def cid():
-    client = pb.connect(pb.DIRECT)
-    yield client
-    pb.disconnect(client)
-
-
 @pytest.fixture(scope="module")
 def out_dir(tmp_path_factory) -> Path:
     return tmp_path_factory.mktemp("task_templates")
