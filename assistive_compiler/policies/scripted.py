@@ -76,14 +76,8 @@ class ScriptedPolicy:
         self.hi = [pb.getJointInfo(robot.id, j, physicsClientId=c)[9] for j in movable]
         self.ranges = [max(h - l, 1e-3) for l, h in zip(self.lo, self.hi)]
 
-    @property
-    def index(self) -> int:
-        """The current waypoint of the first (right or only) arm."""
-        return self.tracks[0].index
-
-    def _goal(self, track: _Track | None = None) -> tuple[np.ndarray, float]:
-        """The current waypoint's position (world, m) and tolerance."""
-        track = track or self.tracks[0]
+    def _goal(self, track: _Track) -> tuple[np.ndarray, float]:
+        """The track's current waypoint position (world, m) and tolerance."""
         to, offset, tol, along_normal, along_axis = track.waypoints[track.index]
         snap = self.env.snap
         return snap.position(to) + offset + along_normal * snap.normal(to) + along_axis * snap.axis(to), tol
