@@ -12,11 +12,7 @@ import numpy as np
 import pybullet as pb
 
 from .snapshot import Snapshot
-from .world import PARK, World
-
-
-def _rotation(q) -> np.ndarray:
-    return np.asarray(pb.getMatrixFromQuaternion(q), dtype=float).reshape(3, 3)
+from .world import PARK, World, rotation_matrix
 
 
 class MarkerSystem:
@@ -47,7 +43,7 @@ class MarkerSystem:
         snap = self.snap
         out = np.empty((len(self.remaining[name]), 3))
         for slot, index, offsets in self._groups[name]:
-            out[index] = snap.pos[slot] + offsets @ _rotation(snap.orn[slot]).T
+            out[index] = snap.pos[slot] + offsets @ rotation_matrix(snap.orn[slot]).T
         return out
 
     def update(self) -> None:

@@ -30,11 +30,7 @@ import pybullet as pb
 
 from ..artifact import Container, ParticleSet
 from .snapshot import ParticleEvents, PointHandle, Snapshot
-from .world import PARK, World
-
-
-def _rotation(orn) -> np.ndarray:
-    return np.asarray(pb.getMatrixFromQuaternion(orn), dtype=float).reshape(3, 3)
+from .world import PARK, World, rotation_matrix
 
 
 class ParticleSystem:
@@ -70,7 +66,7 @@ class ParticleSystem:
         else:
             s = pb.getLinkState(holder.id, link, computeLinkVelocity=1, computeForwardKinematics=1, physicsClientId=c)
             com, lin, ang = s[0], s[6], s[7]
-        return np.asarray(pos), _rotation(orn), np.asarray(com), np.asarray(lin), np.asarray(ang)
+        return np.asarray(pos), rotation_matrix(orn), np.asarray(com), np.asarray(lin), np.asarray(ang)
 
     def _tilt(self, name: str, rot: np.ndarray, lin: np.ndarray) -> float:
         """Effective tilt of a container (radians): its +z against −(g − a)."""
@@ -205,7 +201,7 @@ class ParticleSystem:
                 box = ps.outside_of
                 holder = w.bodies[box.body]
                 fpos, forn = w.link_frame(holder, holder.links[box.link])
-                inside = self._inside(box, (positions - np.asarray(fpos)) @ _rotation(forn))
+                inside = self._inside(box, (positions - np.asarray(fpos)) @ rotation_matrix(forn))
             to_centre = np.linalg.norm(positions - centre, axis=1) if centre is not None else None
             to_anchor = np.linalg.norm(positions - anchor, axis=1) if anchor is not None else None
             for j, k in enumerate(idx):

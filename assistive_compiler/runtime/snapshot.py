@@ -17,7 +17,7 @@ import numpy as np
 import pybullet as pb
 
 from ..quat import quat_conj, quat_mul, quat_rotate  # noqa: F401  (re-exported)
-from .world import World
+from .world import World, rotation_matrix
 
 
 CLOSEST_SLACK_M = 0.05  # closest_distance first looks this far beyond its last answer (m); any value gives the same result
@@ -86,7 +86,7 @@ class Snapshot:
         # pybullet reports a soft body's contact forces of its last solver sub-step only: scale them
         # back to the physics step (experiments/dressing_report.md: then Σ|f_n| ≈ the weight it rests on).
         sub_steps = max(1, world.m.sim.sub_steps)
-        self.force_scale: dict[int, float] = {g.soft_id: float(sub_steps) for g in getattr(world, "garments", [])}
+        self.force_scale: dict[int, float] = {g.soft_id: float(sub_steps) for g in world.garments}
 
     # -- binding ------------------------------------------------------------------------------
     def body_key(self, name: str) -> str:
@@ -184,7 +184,7 @@ class Snapshot:
 
     def set_frame(self, name: str, pos, orn) -> None:
         """Fix an observation frame for the episode (the robot's and the person's bases do not move)."""
-        rot = np.asarray(pb.getMatrixFromQuaternion(orn), dtype=float).reshape(3, 3)
+        rot = rotation_matrix(orn)
         self.frames[name] = (np.asarray(pos, dtype=float), np.asarray(orn, dtype=float), rot.T)
 
     # -- what terms read ----------------------------------------------------------------------
@@ -316,7 +316,7 @@ class Snapshot:
         scale = self.force_scale
         for cp in self.contacts(a, b):
             if centre is None or np.linalg.norm(np.subtract(cp[5], centre)) <= radius:
-                total += cp[9] * (scale.get(cp[1]) or scale.get(cp[2]) or 1.0 if scale else 1.0)
+                total += cp[9] * (scale.get(cp[1]) or scale.get(cp[2]) or 1.0)
         return total
 
     def contact_force_and_count(self, a: str, b, distance: float) -> tuple[float, int]:

@@ -40,6 +40,11 @@ from ..artifact import Manifest
 PARK = (0.0, 500.0, 50.0)  # where inactive bodies (other person variants, removed particles) wait: far away, above the infinite floor, m
 
 
+def rotation_matrix(orn) -> np.ndarray:
+    """3×3 rotation matrix of a quaternion (x, y, z, w): its columns are the frame's axes in world coordinates."""
+    return np.asarray(pb.getMatrixFromQuaternion(orn), dtype=float).reshape(3, 3)
+
+
 @dataclass
 class BodyHandle:
     """A loaded body: its pybullet id and name → index tables (base link is index -1)."""
@@ -268,7 +273,7 @@ class World:
         for g in self.garments:
             pos, orn = self.held_pose(g)
             pb.resetBasePositionAndOrientation(g.anchor_id, pos, orn, physicsClientId=c)
-            rot = np.asarray(pb.getMatrixFromQuaternion(orn), dtype=float).reshape(3, 3)
+            rot = rotation_matrix(orn)
             world = g.nodes_in_held @ rot.T + np.asarray(pos)
             pb.resetMeshData(g.soft_id, vertices=world.tolist(), physicsClientId=c)
             pb.resetBaseVelocity(g.soft_id, (0, 0, 0), (0, 0, 0), physicsClientId=c)
