@@ -438,11 +438,24 @@ def absolute_mesh_paths(urdf_xml: str, base: Path) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
-def _policy_joints(rt: ResolvedTask) -> list[str]:
+def _group_joints(rt: ResolvedTask, refs) -> list[str]:
+    """The person joints of joint-group references (``person.policy`` included), in order, once each."""
     out: list[str] = []
-    for ref in rt.spec.person.control.policy_joints:
-        out += [j for j in rt.joint_groups[ref]["joints"] if j not in out]
+    for ref in refs:
+        group = _policy_joints(rt) if ref == "person.policy" else rt.joint_groups[ref]["joints"]
+        out += [j for j in group if j not in out]
     return out
+
+
+def _policy_joints(rt: ResolvedTask) -> list[str]:
+    return _group_joints(rt, rt.spec.person.control.policy_joints)
+
+
+def _set_friction(pc: _Precompute, body: int, friction: float) -> None:
+    """Lateral friction of every link of ``body`` (base included)."""
+    p, c = pc.p, pc.client
+    for link in range(-1, p.getNumJoints(body, physicsClientId=c)):
+        p.changeDynamics(body, link, lateralFriction=friction, physicsClientId=c)
 
 
 def _observed_person_joints(rt: ResolvedTask) -> set[str]:
@@ -474,8 +487,7 @@ def _settle_person(rt: ResolvedTask, written: dict[str, Path], variant: str, mea
         for name, use in _present_furniture(rt, placed_only=True).items():
             fid = pc.load(written[name], use.position_m, _quat_from_rpy(tuple(math.radians(a) for a in use.rpy_deg)), True)
             if settle.friction is not None:
-                for link in range(-1, p.getNumJoints(fid, physicsClientId=c)):
-                    p.changeDynamics(fid, link, lateralFriction=settle.friction, physicsClientId=c)
+                _set_friction(pc, fid, settle.friction)
         part = rt.people[variant].part
         args = measurements.xacro_args() | {"fixed_joints": "", "skin_rgba": " ".join(repr(float(v)) for v in part.skin_rgba)}
         limp = written["robot"].with_name(f".settle_{variant}.urdf")
@@ -517,9 +529,7 @@ def _settle_stage(rt: ResolvedTask, pc: _Precompute, body: int, joints: dict[str
     spec = rt.spec
     stage = spec.person.placement.settle.then
     p, c = pc.p, pc.client
-    dynamic: list[str] = []
-    for ref in stage.dynamic:
-        dynamic += [j for j in rt.joint_groups[ref]["joints"] if j not in dynamic]
+    dynamic = _group_joints(rt, stage.dynamic)
     start = dict(angles) | {j: math.radians(a) for j, a in stage.joints_deg.items()}
     com_pos, com_orn = p.getBasePositionAndOrientation(body, physicsClientId=c)
     p.createConstraint(body, -1, -1, -1, p.JOINT_FIXED, (0, 0, 0), (0, 0, 0), com_pos, (0, 0, 0, 1), com_orn, physicsClientId=c)
@@ -536,8 +546,7 @@ def _settle_stage(rt: ResolvedTask, pc: _Precompute, body: int, joints: dict[str
     if stage.friction is not None:
         for bid in range(p.getNumBodies(physicsClientId=c)):
             if bid != body:
-                for link in range(-1, p.getNumJoints(bid, physicsClientId=c)):
-                    p.changeDynamics(bid, link, lateralFriction=stage.friction, physicsClientId=c)
+                _set_friction(pc, bid, stage.friction)
     p.setGravity(0, 0, stage.gravity_mps2, physicsClientId=c)
     for _ in range(stage.steps):
         p.stepSimulation(physicsClientId=c)
@@ -1166,11 +1175,7 @@ def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lowe
 
 def _impairment_joints(rt: ResolvedTask, choice) -> list[str]:
     """The person joints an impairment choice names (joint-group references resolved)."""
-    joints: list[str] = []
-    for ref in getattr(choice, "joints", []):
-        group = _policy_joints(rt) if ref == "person.policy" else rt.joint_groups[ref]["joints"]
-        joints += [j for j in group if j not in joints]
-    return joints
+    return _group_joints(rt, getattr(choice, "joints", []))
 
 
 def _impairment_json(rt: ResolvedTask, choice) -> dict[str, Any]:
