@@ -122,6 +122,23 @@ def test_right_arm_hangs_off_the_bed_after_the_compile_time_stage(jaco):
     assert jaco.manifest.person.compliant_joints == jaco.manifest.person.variants[0].movable_joints
 
 
+def test_immovable_links_of_different_bodies_never_collide_and_moving_ones_do(jaco):
+    """The supine person's hips and stomach are kept as links of their own (self-collision) on
+    fixed joints: they rest on the mattress but can never move, so no contact between them and
+    the bed is computed; the arm lying on the mattress still touches it."""
+    w = jaco.world
+    jaco.reset(seed=0)
+    rng = np.random.default_rng(0)
+    person = w.variant_bodies[w.active_variant.name]
+    still = {person.links["stomach"], person.links["waist"]}
+    pairs = set()
+    for _ in range(20):
+        jaco.step(rng.uniform(-1, 1, jaco.action_space.shape))
+        pairs |= {cp[4] for cp in pb.getContactPoints(bodyA=w.bodies["bed"].id, bodyB=person.id, physicsClientId=w.client)}
+    assert pairs and not pairs & still, pairs
+    assert pairs <= {person.links[n] for n in ("right_pecs", "right_shoulder", "right_elbow", "right_wrist")}, pairs
+
+
 def test_the_hanging_arm_is_free_to_be_lifted(jaco):
     _reset_unimpaired(jaco, "male_50th")
     w, c = jaco.world, jaco.world.client

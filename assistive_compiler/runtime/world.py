@@ -121,6 +121,7 @@ class World:
             if joints:
                 pb.setJointMotorControlArray(bid, joints, pb.VELOCITY_CONTROL, forces=[0.0] * len(joints), physicsClientId=c)
 
+        self._skip_immovable_pairs()
         self.robot = self.bodies["robot"]
         self.variant_bodies = {v.name: self.bodies[v.body] for v in self.m.person.variants}
         self.active_variant = self.m.person.variants[0]
@@ -151,6 +152,33 @@ class World:
             links[info[12].decode()] = j
         ipos, iorn = pb.getDynamicsInfo(bid, -1, physicsClientId=c)[3:5]
         return BodyHandle(name, bid, links, joints, pb.invertTransform(ipos, iorn))
+
+    def _skip_immovable_pairs(self) -> None:
+        """No collision between links that can never move, of different bodies.
+
+        Pybullet makes every link of a multibody that has a mass a dynamic collider, even one
+        held by fixed joints to a fixed base (a supine person's hips kept as their own link for
+        self-collision, lying on the mattress), and then computes and solves its contacts with the
+        furniture every physics step: about ten contacts that move nothing and cost an eighth of an
+        Arm Manipulation step. Those pairs are filtered out once, at build; contacts of anything
+        that moves are unchanged, and no term reads a force between two immovable bodies.
+        """
+        c = self.client
+        still: list[tuple[int, list[int]]] = [(self.ground, [-1])]
+        for body in self.m.bodies:
+            if not body.fixed_base:
+                continue
+            bid = self.bodies[body.name].id
+            moving = {l for l, _ in self._moving_links(bid)}
+            links = [l for l in range(-1, pb.getNumJoints(bid, physicsClientId=c))
+                     if l not in moving and pb.getCollisionShapeData(bid, l, physicsClientId=c)]
+            if links:
+                still.append((bid, links))
+        for i, (a, links_a) in enumerate(still):
+            for b, links_b in still[i + 1:]:
+                for la in links_a:
+                    for lb in links_b:
+                        pb.setCollisionFilterPair(a, b, la, lb, 0, physicsClientId=c)
 
     def _set_self_collision(self, handle: BodyHandle) -> None:
         """Self-collision of a person body (facts §3.3): every link pair off, then the pairs the
