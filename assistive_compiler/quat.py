@@ -8,10 +8,11 @@ import numpy as np
 
 
 def quat_rotate(q, v) -> np.ndarray:
-    """Rotate vector ``v`` by unit quaternion ``q`` (x, y, z, w). Scalar arithmetic: for one
-    3-vector this is ~20× faster than numpy's cross products."""
-    x, y, z, w = q
-    vx, vy, vz = v
+    """Rotate vector ``v`` by unit quaternion ``q`` (x, y, z, w). Scalar arithmetic on Python
+    floats: for one 3-vector this is ~20× faster than numpy's cross products (and ~4× faster than
+    the same arithmetic on numpy scalars, hence ``_floats``)."""
+    x, y, z, w = _floats(q)
+    vx, vy, vz = _floats(v)
     tx, ty, tz = 2.0 * (y * vz - z * vy), 2.0 * (z * vx - x * vz), 2.0 * (x * vy - y * vx)
     return np.array([
         vx + w * tx + (y * tz - z * ty),
@@ -20,13 +21,18 @@ def quat_rotate(q, v) -> np.ndarray:
     ])
 
 
+def _floats(a):
+    """A numpy array as a list of Python floats (other sequences as they are)."""
+    return a.tolist() if isinstance(a, np.ndarray) else a
+
+
 def quat_conj(q: np.ndarray) -> np.ndarray:
     return np.array([-q[0], -q[1], -q[2], q[3]])
 
 
 def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
+    ax, ay, az, aw = _floats(a)
+    bx, by, bz, bw = _floats(b)
     return np.array([
         aw * bx + ax * bw + ay * bz - az * by,
         aw * by - ax * bz + ay * bw + az * bx,

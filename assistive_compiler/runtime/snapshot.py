@@ -10,6 +10,7 @@ Units: metres, m/s, newtons; quaternions (x, y, z, w); world frame unless a meth
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -312,10 +313,10 @@ class Snapshot:
         """Σ normal force (N) of contacts between any body of ``a`` and any of ``b``; with ``near``,
         only contacts whose point on ``a`` lies within ``radius`` of that point."""
         total = 0.0
-        centre = self.position(near) if near is not None else None
+        centre = self.position(near).tolist() if near is not None else None
         scale = self.force_scale
         for cp in self.contacts(a, b):
-            if centre is None or np.linalg.norm(np.subtract(cp[5], centre)) <= radius:
+            if centre is None or math.dist(cp[5], centre) <= radius:
                 total += cp[9] * (scale.get(cp[1]) or scale.get(cp[2]) or 1.0)
         return total
 

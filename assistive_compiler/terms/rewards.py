@@ -46,7 +46,7 @@ class ContactForce(Params):
 @term("distance", "reward", Distance)
 def distance(snap, p) -> float:
     """Euclidean distance between two points (m)."""
-    return math.dist(snap.position(p.a), snap.position(p.b))
+    return math.dist(snap.position(p.a).tolist(), snap.position(p.b).tolist())  # lists: math.dist is slow on numpy scalars
 
 
 @term("negative_distance_sum", "reward", DistanceSum)
@@ -54,7 +54,7 @@ def negative_distance_sum(snap, p) -> float:
     """−Σᵢ ‖aᵢ − bᵢ‖ over paired points (m; 0 when every pair coincides), e.g. the reference's arm
     manipulation r_h = −‖p_elbow − p_stomach‖ − ‖p_wrist − p_waist‖: a value whose running max a
     success threshold can bound."""
-    return -sum(math.dist(snap.position(a), snap.position(b)) for a, b in zip(p.a, p.b))
+    return -sum(math.dist(snap.position(a).tolist(), snap.position(b).tolist()) for a, b in zip(p.a, p.b))
 
 
 @term("action_norm", "reward", ActionNorm)
@@ -108,7 +108,7 @@ class ContactEventCounter:
         self.last = None
 
     def __call__(self, snap, p) -> float:
-        centre = snap.position(p.target)
+        centre = snap.position(p.target).tolist()
         near = [cp for cp in snap.contacts(p.tool, p.on) if math.dist(cp[5], centre) <= p.radius_m]
         if not near:
             return 0.0
