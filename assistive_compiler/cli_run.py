@@ -160,7 +160,19 @@ print(json.dumps({"import_s": import_s, "heavy_modules_on_import": heavy,
 """
 
 
-def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int) -> dict:
+#: Env steps/s of the reference implementation (Assistive Gym v1.0 on stock pybullet, random actions,
+#: 200-step episodes, one process, a 2-core shared machine like ours), per (task, robot) it was
+#: measured for: shared/reference/performance-anchors.md. Dressing does not run on stock pybullet.
+REFERENCE_STEPS_PER_S = {
+    ("scratch_itch", "jaco"): 423, ("scratch_itch", "pr2"): 188, ("scratch_itch", "sawyer"): 428, ("scratch_itch", "baxter"): 312,
+    ("bed_bathing", "jaco"): 156,
+    ("feeding", "jaco"): 248, ("feeding", "pr2"): 135, ("feeding", "sawyer"): 237, ("feeding", "baxter"): 199,
+    ("drinking", "jaco"): 37,
+    ("arm_manipulation", "jaco"): 216,
+}
+
+
+def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, seed: int = 0) -> dict:
     """Speed figures of one (task, robot), all taken in this one run (medians over repeats)."""
     import tempfile
 
@@ -186,10 +198,10 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int) -
             physics[0] += time.perf_counter() - t0
 
         world.step_physics = timed  # type: ignore[method-assign]
-        env.action_space.seed(0)
+        env.action_space.seed(seed)
         env_rates, raw_rates, overhead = [], [], []
         for r in range(repeats):
-            env.reset(seed=r)
+            env.reset(seed=seed + r)
             physics[0] = 0.0
             t0 = time.perf_counter()
             for _ in range(steps):
@@ -201,9 +213,9 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int) -
         # Both agents acting (co-optimisation, step_agents), where the person has policy joints.
         coop_rates = []
         if env.human_action_space is not None:
-            env.human_action_space.seed(0)
+            env.human_action_space.seed(seed)
             for r in range(repeats):
-                env.reset(seed=r)
+                env.reset(seed=seed + r)
                 t0 = time.perf_counter()
                 for _ in range(steps):
                     env.step_agents(env.action_space.sample(), env.human_action_space.sample())
@@ -237,6 +249,8 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int) -
         "task": m.task, "robot": m.robot_name, "gym_id": m.gym_id,
         "obs_size": sum(t.size for t in m.observations["robot"]), "action_size": len(m.robot.arm_joints),
         "env_steps_per_s": round(env_med, 1),
+        "reference_env_steps_per_s": REFERENCE_STEPS_PER_S.get((m.task, m.robot_name)),
+        "vs_reference": round(env_med / REFERENCE_STEPS_PER_S[(m.task, m.robot_name)], 2) if (m.task, m.robot_name) in REFERENCE_STEPS_PER_S else None,
         "raw_physics_steps_per_s": round(raw_med, 1),
         "env_over_raw": round(env_med / raw_med, 3),
         "env_overhead_us_per_step": round(statistics.median(overhead), 1),
@@ -252,14 +266,24 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int) -
     }
 
 
+_BENCH_TABLE = ("task", "robot", "env_steps_per_s", "raw_physics_steps_per_s", "reset_ms_median", "reference_env_steps_per_s", "vs_reference")
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
-    result = bench(args.spec, args.robot, args.steps, args.resets, args.repeats)
+    results = [bench(spec, args.robot, args.steps, args.resets, args.repeats, args.seed) for spec in args.specs]
     if args.json:
-        print(json.dumps(result, indent=1))
+        print(json.dumps(results[0] if len(results) == 1 else results, indent=1))
         return 0
-    width = max(len(k) for k in result)
-    for key, value in result.items():
-        print(f"{key:<{width}}  {value}")
+    if len(results) == 1:
+        width = max(len(k) for k in results[0])
+        for key, value in results[0].items():
+            print(f"{key:<{width}}  {value}")
+        return 0
+    # Several tasks: one row each (taken one after the other in this run; medians over repeats).
+    rows = [list(_BENCH_TABLE)] + [["-" if r[k] is None else str(r[k]) for k in _BENCH_TABLE] for r in results]
+    widths = [max(len(row[i]) for row in rows) for i in range(len(_BENCH_TABLE))]
+    for row in rows:
+        print("  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip())
     return 0
 
 
@@ -435,8 +459,10 @@ def add_commands(sub) -> None:
     p.add_argument("--out-dir", dest="out_dir", help="artifact directory")
     p.set_defaults(func=cmd_render)
 
-    p = sub.add_parser("bench", help="speed figures taken in one run: steps/s vs raw physics, resets, compile, import, RSS")
-    common(p, policy=False)
+    p = sub.add_parser("bench", help="speed figures taken in one run: steps/s vs raw physics and the reference, resets, compile, import, RSS")
+    p.add_argument("specs", nargs="+", metavar="spec", help="task spec file(s); several print one row each")
+    p.add_argument("--robot", help="robot (default: each spec's default)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the first repeat's episode and of the random actions")
     p.add_argument("--steps", type=int, default=400, help="env steps per repeat")
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--resets", type=int, default=100)

@@ -452,6 +452,26 @@ def test_cli_run_json(artifact, capsys):
         assert sum(report["term_weights"][k] * v for k, v in ep["terms"].items()) == pytest.approx(ep["return"], rel=1e-9, abs=1e-9)
 
 
+@pytest.mark.slow
+def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys):
+    """bench puts the reference's measured rate beside ours (performance-anchors: Feeding Jaco 248
+    env steps/s; none for a task the reference cannot run), and with several specs prints a table."""
+    from assistive_compiler.cli import main
+
+    dressing = SPEC.parent / "dressing.yaml"
+    rc = main(["bench", str(SPEC), str(dressing), "--robot", "jaco", "--steps", "10", "--repeats", "1", "--resets", "2", "--json"])
+    assert rc == 0
+    feeding, dressed = json.loads(capsys.readouterr().out)
+    assert feeding["reference_env_steps_per_s"] == 248
+    assert feeding["vs_reference"] == round(feeding["env_steps_per_s"] / 248, 2)
+    assert dressed["task"] == "dressing" and dressed["reference_env_steps_per_s"] is None and dressed["vs_reference"] is None
+    rc = main(["bench", str(SPEC), str(dressing), "--robot", "jaco", "--steps", "10", "--repeats", "1", "--resets", "2"])
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert lines[0].split() == ["task", "robot", "env_steps_per_s", "raw_physics_steps_per_s", "reset_ms_median", "reference_env_steps_per_s", "vs_reference"]
+    assert lines[1].split()[:2] == ["feeding", "jaco"] and lines[1].split()[5] == "248"
+    assert lines[2].split()[:2] == ["dressing", "jaco"] and lines[2].split()[5:] == ["-", "-"]
+
+
 # ---------------------------------------------------------------------------------------------
 # 12. light import
 
