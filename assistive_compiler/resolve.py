@@ -598,7 +598,12 @@ class _Resolver:
     def _scripted(self, spec: TaskSpec) -> dict[str, Any] | None:
         if spec.scripted is None:
             return None
-        out = self._script(spec, spec.scripted, ("scripted",))
+        known = self.lib.names("robots")
+        for name in spec.scripted.per_robot:  # may name robots a spec extending this one supports
+            if name not in known:
+                self.problem(("scripted", "per_robot", name), f"per_robot names unknown robot '{name}'; expected one of {one_of(known)}{did_you_mean(name, known)}", key=True)
+        own = spec.scripted.per_robot.get(self.robot_name)
+        out = self._script(spec, own, ("scripted", "per_robot", self.robot_name)) if own is not None else self._script(spec, spec.scripted, ("scripted",))
         for side in ("left", "right"):  # a two-arm robot: the left arm's part, and the right arm's own (replacing the main one)
             arm = getattr(spec.scripted, side)
             if arm is None or len(self.sides) < 2:
@@ -625,7 +630,8 @@ class _Resolver:
                               "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
                               "face_normal_within_rad": math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None}
                              | ({"step_m": w.step_m} if w.step_m is not None else {}))  # absent when unset: other artifacts unchanged
-        return {"move": self.point(script.move, base + ("move",)), "waypoints": waypoints, "repeat_from": script.repeat_from}
+        move, where = (script.move, base + ("move",)) if script.move is not None else (spec.scripted.move, ("scripted", "move"))  # a robot's own script may keep the task's point
+        return {"move": self.point(move, where), "waypoints": waypoints, "repeat_from": script.repeat_from}
 
     def _success(self, spec: TaskSpec, reward_names: set[str]) -> float:
         success = spec.success

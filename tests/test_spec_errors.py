@@ -507,6 +507,26 @@ def test_referring_to_furniture_present_only_when_mounted(tmp_path, capsys):
     check(capsys, path, f"{at(text, 'nightstand')}: furniture 'nightstand' {CONDITIONAL}")
 
 
+def test_scripted_per_robot_names_known_robots(tmp_path, capsys):
+    text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    jacco:\n      waypoints: [{{to: person.right_elbow}}]\n"
+    path = write(tmp_path, text)
+    robots = Library().names("robots")
+    check(capsys, path, f"{at(text, 'jacco')}: per_robot names unknown robot 'jacco'; expected one of {one_of(robots)} (did you mean 'jaco'?)")
+
+
+def test_scripted_per_robot_waypoints_are_checked_where_written(tmp_path, capsys):
+    text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    jaco:\n      waypoints: [{{to: person.right_elbow}}]\n      repeat_from: 1\n"
+    path = write(tmp_path, text)
+    line, column = at(text, "repeat_from: 1").split(":")
+    check(capsys, path, f"{line}:{int(column) + len('repeat_from: ')}: scripted.per_robot.jaco.repeat_from: "
+                        "repeat_from 1 is not a waypoint index (0..0)")
+    text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    jaco:\n      waypoints: [{{to: person.right_elbw}}]\n"
+    path = write(tmp_path, text)
+    lines = problems(capsys, path)
+    assert len(lines) == 1 and lines[0].startswith(f"{display(path)}:{at(text, 'person.right_elbw')}: ") \
+        and "unknown link 'right_elbw' of person" in lines[0] and lines[0].endswith("(did you mean 'right_elbow'?)")
+
+
 def test_searched_mount_needs_furniture_present_only_when_mounted(tmp_path, capsys):
     text = f"extends: {BATHING}\nscene:\n  furniture:\n    nightstand: {{part: nightstand, only_when_mounted: false}}\n"
     path = write(tmp_path, text)

@@ -104,6 +104,26 @@ def test_facing_a_normal_needs_a_surface_target(tmp_path):
     assert "face_normal_within_deg needs a target drawn on a surface (surface_of); 'person.right_wrist' is not one" in err.text
 
 
+def test_scripted_per_robot_replaces_the_waypoints_for_that_robot_only(tmp_path):
+    """scripted.per_robot.<robot> gives that robot its own waypoints (and repeat_from); it keeps the
+    task's moved point unless it names one; other robots follow the task's waypoints."""
+    from assistive_compiler.resolve import resolve
+    from assistive_compiler.spec.load import load_spec
+
+    path = tmp_path / "own.yaml"
+    path.write_text(f"extends: {TASKS / 'bed_bathing.yaml'}\nscripted:\n  per_robot:\n    sawyer:\n      waypoints:\n"
+                    "        - {to: person.right_elbow, offset_m: [0, 0, 0.1]}\n        - {to: person.right_wrist, rpy_deg: [-30, 0, 90]}\n"
+                    "      repeat_from: 0\n    panda:\n      move: wiper.pad\n      waypoints: [{to: person.right_shoulder}]\n")
+    loaded = load_spec(path)
+    task = loaded.spec.scripted
+    sawyer, panda, jaco = (resolve(loaded, r).scripted for r in ("sawyer", "panda", "jaco"))
+    assert [w["to"]["link"] for w in sawyer["waypoints"]] == ["right_elbow", "right_wrist"]
+    assert sawyer["repeat_from"] == 0 and sawyer["waypoints"][1]["rpy_rad"] == pytest.approx([math.radians(-30), 0.0, math.radians(90)])
+    assert sawyer["move"] == jaco["move"] and panda["move"] != jaco["move"]
+    assert len(panda["waypoints"]) == 1 and panda["repeat_from"] is None
+    assert len(jaco["waypoints"]) == len(task.waypoints) and jaco["repeat_from"] == task.repeat_from
+
+
 class _capture:
     """Collect what the CLI prints on stderr."""
 

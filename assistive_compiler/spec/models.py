@@ -772,6 +772,21 @@ class ScriptedArm(Strict):
         return self
 
 
+class ScriptedRobot(Strict):
+    """One robot's own script: its waypoints replace the task's for that robot (robots differ in
+    reach and in the wrist orientations they can hold, so one set of waypoints rarely suits all)."""
+
+    move: Ref | None = Field(None, description="The point moved; None: the task's scripted.move.")
+    waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order, replacing scripted.waypoints for this robot; the last is held unless repeat_from is given.")
+    repeat_from: int | None = Field(None, ge=0, description="After the last waypoint, go on from this index (replacing scripted.repeat_from); None holds the last.")
+
+    @model_validator(mode="after")
+    def _repeat_in_range(self) -> "ScriptedRobot":
+        if self.repeat_from is not None and self.repeat_from >= len(self.waypoints):
+            raise ValueError(f"@repeat_from: repeat_from {self.repeat_from} is not a waypoint index (0..{len(self.waypoints) - 1})")
+        return self
+
+
 class Scripted(Strict):
     """A privileged baseline controller (IK each step) that moves a point of the tool through
     waypoints, keeping the tool's start orientation. It shows the task is solvable and checks the
@@ -790,6 +805,10 @@ class Scripted(Strict):
         None, description="The right arm's part when the robot acts with both arms (robot.arm: both, a two-arm robot): it "
         "replaces move/waypoints/repeat_from there, so that a two-arm script (e.g. lift with both hands) can differ from the "
         "one-arm script that move/waypoints give. Ignored on one-arm robots."
+    )
+    per_robot: dict[Name, ScriptedRobot] = Field(
+        default_factory=dict, description="Scripts by robot name: the named robot follows its own move/waypoints/repeat_from "
+        "instead of the ones above (left/right still apply to two-arm robots acting with both arms)."
     )
 
     @model_validator(mode="after")
