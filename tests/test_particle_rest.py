@@ -86,6 +86,24 @@ def test_held_upright_cup_carries_its_water_for_a_whole_episode(env):
         assert pb.getBasePositionAndOrientation(pid, physicsClientId=c)[0][1] > 100
 
 
+def test_parked_particles_are_put_back_up_before_they_reach_the_ground(env):
+    """Carried (parked) water falls under the world's gravity far from the scene; every
+    ``repark_steps`` env steps it goes back to its parking spot, so it never lands on the ground
+    plane (where 64 resting contacts would cost solver work every physics step)."""
+    env.reset(seed=0)
+    w, c = env.world, env.world.client
+    ids = w.particles["water"]
+    assert env.particles.repark_steps == 31  # free fall from 50 m to 1 m: 3.16 s of 0.1 s env steps
+    lowest = math.inf
+    for _ in range(3 * env.particles.repark_steps):
+        env.step(np.zeros(env.action_space.shape))
+        assert env.particles.carried["water"].all()
+        z = [pb.getBasePositionAndOrientation(pid, physicsClientId=c)[0][2] for pid in ids]
+        lowest = min(lowest, min(z))
+        assert not any(pb.getContactPoints(bodyA=pid, bodyB=w.ground, physicsClientId=c) for pid in ids)
+    assert 1.0 < lowest < 40.0  # they did fall, tens of metres
+
+
 def test_tipping_past_the_limit_releases_the_water_and_past_90_degrees_pours_it(env):
     env.reset(seed=0)
     tip_cup(env, 0, 110, 10)

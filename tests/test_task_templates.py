@@ -353,14 +353,19 @@ def test_cup_holds_water_upright(out_dir, cid):
     r = np.hypot(local[:, 0], local[:, 1])
     assert (r < CUP_INNER_R).all(), r.max()
     assert local[:, 2].min() > 0.0 and local[:, 2].max() < 0.03
+    # The floor is one flat box: the resting water has at most 2 contact points with the cup per
+    # particle on average (16 floor sectors meeting at the axis gave ~190 for the 64 particles,
+    # up to 13 for one near the axis, all of them rows for the solver every physics step).
+    contacts = sum(len(pb.getContactPoints(bodyA=cup, bodyB=b, physicsClientId=cid)) for b in water)
+    assert contacts <= 2 * len(water), contacts
 
 
-@pytest.mark.parametrize("tilt_deg", [60, 120])
+@pytest.mark.parametrize("tilt_deg", [30, 45, 60, 75, 120])
 def test_cup_pours_when_tilted_but_never_leaks(out_dir, cid, tilt_deg):
     """As the runtime holds it: a dynamic cup on a fixed constraint (max force 500). After the
     water has settled the constraint turns the cup about x over 0.6 s. At 60 degrees all the
-    water stays in; at 120 degrees most of it pours out over the rim. No particle ever passes
-    through the wall or the floor."""
+    water stays in (at 30-75 degrees too); at 120 degrees most of it pours out over the rim. No
+    particle ever passes through the wall or the floor."""
     _setup(cid)
     cup, _ = load_quiet(cid, render(CUP, out_dir), pos=(0, 0, 1.0), fixed=False)
     hold = pb.createConstraint(cup, -1, -1, -1, pb.JOINT_FIXED, [0, 0, 0], [0, 0, 0], [0, 0, 1.0],

@@ -1,11 +1,17 @@
 """Particle lifecycles (food, water): active → consumed (reached the target) | lost (left its
 container); the first contact of an active particle with ``hit_body`` counts once as a hit.
 
-Removed particles are parked far away, apart from each other, at rest and without gravity
-compensation, so they touch nothing; they come back at reset. Nothing else about them changes: a
-mass of 0 would make them static objects for good, and changing collision filters re-inserts
-them in the broadphase, which reorders contact pairs — either would make an episode depend on the
-ones before it. Events are evaluated once per env step, as in the reference.
+Removed particles are parked far away (``PARK``, 50 m up), apart from each other, at rest and
+without gravity compensation, so they touch nothing; they come back at reset. A parked particle
+falls under the world's gravity, so before it could reach the ground plane (where its contact
+would cost solver work every physics step: 64 of them on the ground made a Drinking env step with
+the water carried ~0.3 ms, a sixth, slower) it is put back at
+its parking spot at rest: every :attr:`ParticleSystem.repark_steps` env steps after it was
+parked (a function of the episode's history only, so seeded episodes replay exactly). Nothing
+else about them changes: a mass of 0 would make them static objects for good, changing collision
+filters re-inserts them in the broadphase, which reorders contact pairs, and Bullet's sleeping
+does not restore a multibody's velocity when it wakes — each would make an episode depend on the
+ones before it or change the physics. Events are evaluated once per env step, as in the reference.
 
 **Resting in a container** (a set's ``rest``, optional): while the container's effective tilt —
 the angle between its axis (+z) and the apparent "up" −(g − a), a its acceleration over the last
@@ -51,6 +57,12 @@ class ParticleSystem:
         self._container_velocity: dict[str, np.ndarray] = {}  # at the end of the last env step, world frame, m/s
         self._dt = world.m.sim.time_step * world.m.sim.frame_skip
         self._gravity = np.array([0.0, 0.0, world.m.sim.gravity])
+        #: Env steps a parked particle may fall before it is put back at its parking spot: the free
+        #: fall from PARK's height to 1 m above the ground (linear damping only slows it); None
+        #: when the world has no downward gravity.
+        g = -world.world_gravity
+        self.repark_steps = max(1, int(math.sqrt(2.0 * (PARK[2] - 1.0) / g) / self._dt)) if g > 0 else None
+        self._parked_age: dict[int, tuple[int, int]] = {}  # parked particle id → (env steps since parked, index k in its set)
 
     # -- containers ------------------------------------------------------------------------------
     def _container_state(self, box: Container):
@@ -104,7 +116,7 @@ class ParticleSystem:
         for k in np.flatnonzero(carried):
             p = pos + rot @ at[k]
             v = lin + np.cross(ang, p - com)
-            w.parked.discard(ids[k])
+            self._unpark(ids[k])
             pb.resetBasePositionAndOrientation(ids[k], p.tolist(), (0, 0, 0, 1), physicsClientId=c)
             pb.resetBaseVelocity(ids[k], v.tolist(), (0, 0, 0), physicsClientId=c)
         carried[:] = False
@@ -118,7 +130,7 @@ class ParticleSystem:
             holder = w.bodies[ps.attach]
             frame_pos, frame_orn = w.link_frame(holder, holder.links[ps.attach_link])
             for pid, local in zip(ids, ps.start_positions):
-                w.parked.discard(pid)
+                self._unpark(pid)
                 pos, _ = pb.multiplyTransforms(frame_pos, frame_orn, local, (0, 0, 0, 1))
                 pb.resetBasePositionAndOrientation(pid, pos, (0, 0, 0, 1), physicsClientId=c)
                 pb.resetBaseVelocity(pid, (0, 0, 0), (0, 0, 0), physicsClientId=c)
@@ -164,15 +176,33 @@ class ParticleSystem:
         self._carry(ps, ids, free, full)
 
     def _park(self, pid: int, k: int) -> None:
+        """Put particle ``pid`` (index ``k`` in its set) at its parking spot, at rest."""
         c = self.world.client
         pb.resetBasePositionAndOrientation(pid, (PARK[0] - 5.0 - 0.1 * k, PARK[1], PARK[2]), (0, 0, 0, 1), physicsClientId=c)
         pb.resetBaseVelocity(pid, (0, 0, 0), (0, 0, 0), physicsClientId=c)
         self.world.parked.add(pid)
+        self._parked_age[pid] = (0, k)
+
+    def _unpark(self, pid: int) -> None:
+        """Particle ``pid`` is back in the scene (the caller places it)."""
+        self.world.parked.discard(pid)
+        self._parked_age.pop(pid, None)
+
+    def _age_parked(self) -> None:
+        """Once per env step: parked particles that have fallen for ``repark_steps`` go back up."""
+        if self.repark_steps is None:
+            return
+        for pid, (age, k) in list(self._parked_age.items()):
+            if age + 1 >= self.repark_steps:
+                self._park(pid, k)
+            else:
+                self._parked_age[pid] = (age + 1, k)
 
     def update(self) -> None:
         """Evaluate this step's events (after physics, after the snapshot refresh)."""
         w, c, snap = self.world, self.world.client, self.snap
         base_velocity, closest = pb.getBaseVelocity, pb.getClosestPoints
+        self._age_parked()
         for ps, ids, target in self.sets:
             ev = ParticleEvents()
             active, hit = self.active[ps.name], self.hit[ps.name]
