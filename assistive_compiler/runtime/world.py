@@ -161,7 +161,10 @@ class World:
         self-collision, lying on the mattress), and then computes and solves its contacts with the
         furniture every physics step: about ten contacts that move nothing and cost an eighth of an
         Arm Manipulation step. Those pairs are filtered out once, at build; contacts of anything
-        that moves are unchanged, and no term reads a force between two immovable bodies.
+        that moves are unchanged, and no term reads a force between two immovable bodies. Only
+        pairs with such a link get a filter: setting one re-inserts the bodies in the broadphase,
+        which reorders the solver's contact rows, so scenes without such links keep their
+        trajectories bit for bit.
         """
         c = self.client
         still: list[tuple[int, list[int]]] = [(self.ground, [-1])]
@@ -178,7 +181,8 @@ class World:
             for b, links_b in still[i + 1:]:
                 for la in links_a:
                     for lb in links_b:
-                        pb.setCollisionFilterPair(a, b, la, lb, 0, physicsClientId=c)
+                        if la >= 0 or lb >= 0:  # two fixed bases are static colliders: Bullet never pairs them
+                            pb.setCollisionFilterPair(a, b, la, lb, 0, physicsClientId=c)
 
     def _set_self_collision(self, handle: BodyHandle) -> None:
         """Self-collision of a person body (facts §3.3): every link pair off, then the pairs the
