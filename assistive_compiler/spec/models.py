@@ -758,21 +758,26 @@ class Waypoint(Strict):
     )
 
 
-class ScriptedArm(Strict):
+class _WaypointScript(Strict):
+    """A list of waypoints with an optional repeat_from (ScriptedArm, ScriptedRobot, Scripted)."""
+
+    @model_validator(mode="after")
+    def _repeat_in_range(self) -> "_WaypointScript":
+        if self.repeat_from is not None and self.repeat_from >= len(self.waypoints):  # type: ignore[attr-defined]
+            raise ValueError(f"@repeat_from: repeat_from {self.repeat_from} is not a waypoint index (0..{len(self.waypoints) - 1})")  # type: ignore[attr-defined]
+        return self
+
+
+class ScriptedArm(_WaypointScript):
     """The left arm's part of a scripted baseline when the robot acts with both arms."""
 
     move: Ref = Field(description="The point the left arm moves, e.g. scooper_left.blade.")
     waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order; the last is held unless repeat_from is given.")
     repeat_from: int | None = Field(None, ge=0, description="After the last waypoint, go on from this index; None holds the last.")
 
-    @model_validator(mode="after")
-    def _repeat_in_range(self) -> "ScriptedArm":
-        if self.repeat_from is not None and self.repeat_from >= len(self.waypoints):
-            raise ValueError(f"@repeat_from: repeat_from {self.repeat_from} is not a waypoint index (0..{len(self.waypoints) - 1})")
-        return self
 
 
-class ScriptedRobot(Strict):
+class ScriptedRobot(_WaypointScript):
     """One robot's own script: its waypoints replace the task's for that robot (robots differ in
     reach and in the wrist orientations they can hold, so one set of waypoints rarely suits all)."""
 
@@ -780,14 +785,9 @@ class ScriptedRobot(Strict):
     waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order, replacing scripted.waypoints for this robot; the last is held unless repeat_from is given.")
     repeat_from: int | None = Field(None, ge=0, description="After the last waypoint, go on from this index (replacing scripted.repeat_from); None holds the last.")
 
-    @model_validator(mode="after")
-    def _repeat_in_range(self) -> "ScriptedRobot":
-        if self.repeat_from is not None and self.repeat_from >= len(self.waypoints):
-            raise ValueError(f"@repeat_from: repeat_from {self.repeat_from} is not a waypoint index (0..{len(self.waypoints) - 1})")
-        return self
 
 
-class Scripted(Strict):
+class Scripted(_WaypointScript):
     """A privileged baseline controller (IK each step) that moves a point of the tool through
     waypoints, keeping the tool's start orientation. It shows the task is solvable and checks the
     reward wiring; it is not a learned policy."""
@@ -810,12 +810,6 @@ class Scripted(Strict):
         default_factory=dict, description="Scripts by robot name: the named robot follows its own move/waypoints/repeat_from "
         "instead of the ones above (left/right still apply to two-arm robots acting with both arms)."
     )
-
-    @model_validator(mode="after")
-    def _repeat_in_range(self) -> "Scripted":
-        if self.repeat_from is not None and self.repeat_from >= len(self.waypoints):
-            raise ValueError(f"@repeat_from: repeat_from {self.repeat_from} is not a waypoint index (0..{len(self.waypoints) - 1})")
-        return self
 
 
 # --------------------------------------------------------------------------------------------
