@@ -13,10 +13,9 @@ import pybullet as pb
 import pytest
 
 from assistive_compiler.cli import main
-from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.paths import display, specs_dir
-from assistive_compiler.runtime.env import AssistiveEnv
 from assistive_compiler.terms.registry import terms
+from helpers import at, compiled_env
 
 SPEC = specs_dir() / "tasks" / "arm_manipulation.yaml"
 FEEDING = specs_dir() / "tasks" / "feeding.yaml"
@@ -24,21 +23,14 @@ MATTRESS_TOP_M = 0.73
 MATTRESS_EDGE_X_M = -0.1 - 0.95 / 2  # bed at x -0.1, mattress 0.95 m wide: the person's right side is -x
 
 
-def _env(tmp_path_factory, robot: str):
-    out = tmp_path_factory.mktemp(f"am-{robot}") / f"arm_manipulation-{robot}"
-    env = AssistiveEnv(compile_task(SPEC, robot, out).out_dir)
-    yield env
-    env.close()
-
-
 @pytest.fixture(scope="module")
 def jaco(tmp_path_factory):
-    yield from _env(tmp_path_factory, "jaco")
+    yield from compiled_env(tmp_path_factory, SPEC, "jaco")
 
 
 @pytest.fixture(scope="module")
 def pr2(tmp_path_factory):
-    yield from _env(tmp_path_factory, "pr2")
+    yield from compiled_env(tmp_path_factory, SPEC, "pr2")
 
 
 def _link_pos(env, link: str) -> np.ndarray:
@@ -221,11 +213,6 @@ def test_success_is_the_running_max_of_unweighted_r_h(jaco):
 # Located errors for the new fields
 
 
-def _at(text: str, needle: str) -> str:
-    index = text.index(needle)
-    return f"{text.count(chr(10), 0, index) + 1}:{index - (text.rfind(chr(10), 0, index) + 1) + 1}"
-
-
 def _errors(tmp_path, capsys, text: str) -> list[str]:
     path = tmp_path / "spec.yaml"
     path.write_text(text)
@@ -238,21 +225,21 @@ def _errors(tmp_path, capsys, text: str) -> list[str]:
 def test_start_left_in_a_one_arm_task_is_refused(tmp_path, capsys):
     text = f"extends: {FEEDING}\nrobot:\n  start_left: {{tool_position_m: [0, 0, 1]}}\n"
     assert _errors(tmp_path, capsys, text) == [
-        f"{_at(text, '{tool_')}: robot.start_left: start_left is the left arm's start in a task acting with both arms, "
+        f"{at(text, '{tool_')}: robot.start_left: start_left is the left arm's start in a task acting with both arms, "
         "but this task's arm is 'right'; remove it or set arm: both"]
 
 
 def test_a_tool_in_a_hand_the_task_does_not_act_with_is_refused(tmp_path, capsys):
     text = f"extends: {FEEDING}\ntools:\n  spoon: {{part: spoon, hand: left}}\n"
     errors = _errors(tmp_path, capsys, text)
-    assert f"{_at(text, 'left')}: tool 'spoon' is held in the left hand, but the task acts with the right arm only; use hand: right or robot.arm: both" in errors
+    assert f"{at(text, 'left')}: tool 'spoon' is held in the left hand, but the task acts with the right arm only; use hand: right or robot.arm: both" in errors
 
 
 def test_two_tools_on_one_arm_need_one_arm_same_as(tmp_path, capsys):
     text = (f"extends: {SPEC}\ntools:\n  scooper_right: {{part: scooper, hand: right}}\n"
             "  scooper_left: {part: scooper, hand: left, one_arm_same_as: null}\n")
     errors = _errors(tmp_path, capsys, text)
-    assert f"{_at(text, 'left, one')}: robot 'jaco' acts with one arm, which would hold both 'scooper_right' (right hand) and " \
+    assert f"{at(text, 'left, one')}: robot 'jaco' acts with one arm, which would hold both 'scooper_right' (right hand) and " \
         "'scooper_left' (left hand); give 'scooper_left' one_arm_same_as: scooper_right (one tool serving both hands) or a hand the arm already uses" in errors
 
 
@@ -260,12 +247,12 @@ def test_one_arm_same_as_names_a_tool_of_the_same_part_in_the_other_hand(tmp_pat
     text = (f"extends: {SPEC}\ntools:\n  scooper_right: {{part: scooper, hand: right}}\n"
             "  scooper_left: {part: scooper, hand: left, one_arm_same_as: scoper_right}\n")
     errors = _errors(tmp_path, capsys, text)
-    assert f"{_at(text, 'scoper_right')}: unknown tool 'scoper_right'; expected one of 'scooper_right' (did you mean 'scooper_right'?)" in errors
+    assert f"{at(text, 'scoper_right')}: unknown tool 'scoper_right'; expected one of 'scooper_right' (did you mean 'scooper_right'?)" in errors
 
 
 def test_a_goal_arm_in_a_one_arm_task_and_an_unknown_stage_group_are_refused(tmp_path, capsys):
     text = (f"extends: {SPEC}\nrobot:\n  arm: right\n  start_left: null\n  base_search:\n    goals:\n      - {{point: person.waist, arm: left}}\n"
             "person:\n  placement:\n    settle:\n      then: {dynamic: [person.rigt_arm]}\n")
     errors = _errors(tmp_path, capsys, text)
-    assert any(e.startswith(f"{_at(text, 'left}')}: a goal names an arm only in a task acting with both arms") for e in errors), errors
-    assert any(e.startswith(f"{_at(text, 'person.rigt_arm')}: unknown joint group 'person.rigt_arm'") for e in errors), errors
+    assert any(e.startswith(f"{at(text, 'left}')}: a goal names an arm only in a task acting with both arms") for e in errors), errors
+    assert any(e.startswith(f"{at(text, 'person.rigt_arm')}: unknown joint group 'person.rigt_arm'") for e in errors), errors

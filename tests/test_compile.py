@@ -32,6 +32,7 @@ from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.errors import SpecError
 from assistive_compiler.library import Library
 from assistive_compiler.paths import display, specs_dir
+from helpers import at
 
 REPO = Path(__file__).resolve().parents[1]
 FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
@@ -43,12 +44,6 @@ UNREACHABLE_MESSAGE = (
     "robot 'jaco' cannot reach the start pose (3.0, 3.0, 3.0) (tool rpy (0.0, 0.0, -90.0)°) "
     "without collision for person 'male_50th'"
 )
-
-
-def at(text: str, needle: str) -> str:
-    """``LINE:COL`` (1-based) of the first ``needle`` in ``text``."""
-    index = text.index(needle)
-    return f"{text.count(chr(10), 0, index) + 1}:{index - (text.rfind(chr(10), 0, index) + 1) + 1}"
 
 
 def snapshot(directory: Path) -> dict[str, bytes]:

@@ -12,9 +12,9 @@ import pybullet as pb
 import pytest
 
 from assistive_compiler.cli import main
-from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.garment import ring_encloses_segment, sleeve_node_sets, sleeve_progress
 from assistive_compiler.paths import specs_dir
+from helpers import compiled_env
 
 DRESSING = specs_dir() / "tasks" / "dressing.yaml"
 
@@ -139,12 +139,7 @@ def test_unknown_garment_and_grip_and_collision_body_are_located(tmp_path):
 
 @pytest.fixture(scope="module")
 def env(tmp_path_factory):
-    from assistive_compiler.runtime.env import AssistiveEnv
-
-    out = tmp_path_factory.mktemp("dressing") / "dressing-jaco"
-    env = AssistiveEnv(compile_task(DRESSING, "jaco", out).out_dir)
-    yield env
-    env.close()
+    yield from compiled_env(tmp_path_factory, DRESSING, "jaco")
 
 
 def _nodes(env) -> np.ndarray:

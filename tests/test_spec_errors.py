@@ -22,6 +22,7 @@ from assistive_compiler.library import Library
 from assistive_compiler.paths import display
 from assistive_compiler.spec.load import load_spec
 from assistive_compiler.yamlsrc import loads_located
+from helpers import at
 
 REPO = Path(__file__).resolve().parents[1]
 FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
@@ -37,16 +38,6 @@ FOOD_EATEN = "  - {name: food_eaten, term: particles_consumed, weight: 20.0, par
 
 # --------------------------------------------------------------------------------------------
 # helpers
-
-
-def at(text: str, needle: str, occurrence: int = 1) -> str:
-    """``LINE:COL`` (1-based) of the ``occurrence``-th ``needle`` in ``text``."""
-    index = -1
-    for _ in range(occurrence):
-        index = text.index(needle, index + 1)
-    line = text.count("\n", 0, index) + 1
-    column = index - (text.rfind("\n", 0, index) + 1) + 1
-    return f"{line}:{column}"
 
 
 def write(tmp_path: Path, text: str, name: str = "spec.yaml") -> Path:

@@ -17,16 +17,14 @@ from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.paths import specs_dir
 from assistive_compiler.runtime.env import AssistiveEnv
 from assistive_compiler.terms.registry import terms
+from helpers import compiled_env
 
 TASKS = specs_dir() / "tasks"
 
 
 def _env(tmp_path_factory, task: str):
     """An env of the shipped ``task`` for Jaco, compiled into a fresh directory."""
-    out = tmp_path_factory.mktemp(task) / f"{task}-jaco"
-    env = AssistiveEnv(compile_task(TASKS / f"{task}.yaml", "jaco", out).out_dir)
-    yield env
-    env.close()
+    yield from compiled_env(tmp_path_factory, TASKS / f"{task}.yaml", "jaco")
 
 
 @pytest.fixture(scope="module")
