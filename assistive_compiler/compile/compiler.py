@@ -798,6 +798,7 @@ def _settle_garment(rt: ResolvedTask, name: str, g, out_tmp: Path, grip, held_or
                    bending_stiffness=phys.bending_stiffness, friction=phys.friction,
                    collides_with=list(g.collides_with) if g.collides_with is not None else None, rgba=tuple(g.rgba))
 
+
 def _capsule(limbs: dict, link: str) -> Capsule:
     cap = limbs[link]
     return Capsule(link=link, start=_round(cap.start), end=_round(cap.end), radius=_round(cap.radius))

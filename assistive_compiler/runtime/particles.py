@@ -71,13 +71,13 @@ class ParticleSystem:
         w, c = self.world, self.world.client
         holder = w.bodies[box.body]
         link = holder.links[box.link]
-        pos, orn = w.link_frame(holder, link)
         if link == -1:
+            pos, orn = w.base_frame(holder)
             com = pb.getBasePositionAndOrientation(holder.id, physicsClientId=c)[0]
             lin, ang = pb.getBaseVelocity(holder.id, physicsClientId=c)
-        else:
+        else:  # one query: the link's URDF frame (what link_frame reads), its centre of mass and velocities
             s = pb.getLinkState(holder.id, link, computeLinkVelocity=1, computeForwardKinematics=1, physicsClientId=c)
-            com, lin, ang = s[0], s[6], s[7]
+            pos, orn, com, lin, ang = s[4], s[5], s[0], s[6], s[7]
         return np.asarray(pos), rotation_matrix(orn), np.asarray(com), np.asarray(lin), np.asarray(ang)
 
     def _tilt(self, name: str, rot: np.ndarray, lin: np.ndarray) -> float:
