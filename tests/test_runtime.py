@@ -149,6 +149,23 @@ def test_a_seeded_reset_replays_the_episode_whatever_came_before(make_env):
     assert np.array_equal(first, fresh) and np.array_equal(first_rew, fresh_rew)
 
 
+def test_a_parked_variant_sleeps_and_wakes_without_changing_episodes(make_env):
+    """The variant a reset does not draw is parked asleep (Bullet skips its dynamics and motor
+    rows); a later reset that draws it wakes it, and its episode equals the same seed's episode
+    in a fresh env, whichever variant slept before."""
+    env = make_env()
+    drawn: dict[str, int] = {}
+    for seed in range(40):
+        env.reset(seed=seed)
+        drawn.setdefault(env.world.active_variant.name, seed)
+    assert len(drawn) == 2
+    actions = np.random.default_rng(5).uniform(-1.0, 1.0, (40, 7)).astype(np.float32)
+    first, second = drawn.values()
+    fresh = {seed: rollout(make_env(), seed, actions)[0] for seed in (first, second)}
+    for seed in (first, second, first, second):  # each wakes after the other slept
+        assert np.array_equal(rollout(env, seed, actions)[0], fresh[seed])
+
+
 def test_reset_with_the_same_seed_repeats_the_reset(env):
     rng = np.random.default_rng(5)
     for seed in (0, 3, 11):

@@ -164,6 +164,7 @@ class AssistiveEnv(gym.Env):
             body = m.body(v.body)
             parked = (PARK[0] + 10.0 * i, PARK[1], PARK[2])
             w.set_base_frame(w.variant_bodies[v.name], body.position if v.name == variant.name else parked, body.orientation)
+            w.set_asleep(w.variant_bodies[v.name], v.name != variant.name)
         person = w.variant_bodies[variant.name]
         # Joint angles (randomised), the impairment, and the hold: all drawn and set by the person controller.
         impairment = self.impairment = self.human.reset(variant, rng)
