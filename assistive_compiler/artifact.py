@@ -136,8 +136,9 @@ class Robot(_Model):
     action_scale: float = Field(description="Target change per unit action per physics step, rad.")
     position_gain: float = Field(description="Arm position gain.")
     max_force: float = Field(description="Arm force limit, N·m.")
-    gripper_joints: list[str] = Field(description="Gripper joints, held at gripper_position.")
-    gripper_position: list[float] = Field(description="Target of each gripper joint (rad or m).")
+    gripper_joints: list[str] = Field(description="The acting hands' finger joints (welded at gripper_position: see welded_joints).")
+    gripper_position: list[float] = Field(description="The task's grip: each finger joint's value (rad or m).")
+    welded_joints: dict[str, float] = Field(default_factory=dict, description="Moving joints of the robot's URDF that the task never drives, made fixed in the artifact's robot.urdf at these values (rad or m): fingers at the grip, the rest at 0 (both within the joint's limits).")
     placement: dict[str, Any] = Field(default_factory=dict, description="How the base was placed: mount, or the search's kept poses with goals reached and JLWKI.")
 
 

@@ -3,7 +3,8 @@
 Steps, in order:
 
 1. **Render** every body from its xacro template (the person once per variant, with the task's
-   static joints baked into fixed joints at their posture angles).
+   static joints baked into fixed joints at their posture angles; the robot with every joint the
+   task does not drive welded: fingers at the task's grip, the rest at 0).
 2. **Lint** each URDF (:mod:`.lint`); a failing scene is refused with the template, element and
    problem named.
 3. **Precompute** in a private pybullet DIRECT client: seat the person on the furniture's seat,
@@ -61,7 +62,7 @@ from ..spec.load import LoadedSpec, load_spec
 from ..spec.models import scalar_bounds
 from ..terms.registry import SizeContext, terms
 from .lint import lint_urdf
-from .merge import merge_fixed_links
+from .merge import merge_fixed_links, weld_joints
 from .render import render_template, urdf_info
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
@@ -214,6 +215,8 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
         written["robot"].write_text(xml)
     else:
         emit("robot", lib.template_path(rt.robot), robot_part.template.params, rt.robot.smap.value(("template", "path")))
+    welded = _robot_welds(rt, written["robot"].read_text())
+    written["robot"].write_text(weld_joints(written["robot"].read_text(), welded))
     mounted_on = spec.robot.mount_on if robot_part.mountable else None
     for name, use in _present_furniture(rt).items():
         part = rt.furniture[name].part
@@ -256,6 +259,7 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
         manifest = _precompute(rt, pc, written, out_tmp, postures, movable_ordered, measurements, mounted_on, settled)
     finally:
         pc.close()
+    manifest = manifest.model_copy(update={"robot": manifest.robot.model_copy(update={"welded_joints": welded})})
 
     # 4. Merge each person's static links into as few rigid links as possible: a seated person
     #    with a movable head goes from 43 links to 5, which is most of a step's physics cost.
@@ -1087,6 +1091,26 @@ def _inside_point(pc, body: int, link_name: str) -> tuple[float, float, float]:
     inertial_pos, inertial_orn = p.getDynamicsInfo(body, link, physicsClientId=c)[3:5]
     pos, _ = p.multiplyTransforms(inertial_pos, inertial_orn, local_pos, (0, 0, 0, 1))
     return tuple(pos)
+
+
+def _robot_welds(rt: ResolvedTask, urdf_xml: str) -> dict[str, float]:
+    """Every moving robot joint the task does not drive, and the value it keeps all episode:
+    fingers at the task's grip (:func:`_gripper`), anything else (an idle arm, a head, finger
+    tips) at 0; both clamped into the joint's limits, where the limit would hold it. They are
+    welded (made fixed joints) in the artifact's URDF: Bullet builds a motor row for every moving
+    joint every physics step, and each row costs in proportion to the robot's joint count, so a
+    Jaco's six finger joints cost about a seventh of a Scratch Itch step while holding still."""
+    driven = set(rt.joint_groups["robot.arm"]["joints"])
+    finger_joints, grip = _gripper(rt)
+    held = dict(zip(finger_joints, grip))
+    welds: dict[str, float] = {}
+    for name, joint in urdf_info(urdf_xml).joints.items():
+        if joint.type in ("revolute", "continuous", "prismatic") and name not in driven:
+            value = held.get(name, 0.0)
+            if joint.lower is not None and joint.upper is not None and joint.lower <= joint.upper:
+                value = min(max(value, joint.lower), joint.upper)
+            welds[name] = value
+    return welds
 
 
 def _gripper(rt: ResolvedTask) -> tuple[list[str], list[float]]:

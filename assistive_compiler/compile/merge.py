@@ -29,6 +29,10 @@ were computed from: the 6e-17 that 1 - 1 leaves) are written as 0, and every flo
 with ``repr``. Elements that are not touched keep their text. The output
 is deterministic: same input, same bytes.
 
+`weld_joints` turns moving joints into ``fixed`` ones at given values (a robot's fingers at the
+task's grip): the joint's origin becomes ``T_J * motion(axis, value)`` and its motion elements
+(``<axis>``, ``<limit>``, ``<dynamics>``, ...) are dropped. Same number rules and output.
+
 Pure Python + numpy + ``xml.etree``; no pybullet.
 """
 
@@ -37,12 +41,12 @@ from __future__ import annotations
 import copy
 import math
 import xml.etree.ElementTree as ET
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["MergedFrame", "merge_fixed_links"]
+__all__ = ["MergedFrame", "merge_fixed_links", "weld_joints"]
 
 _SIGNIFICANT_DIGITS = 12
 _RELATIVE_ZERO = 1e-12
@@ -445,3 +449,58 @@ def merge_fixed_links(
     _reindent(root)
     text = '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
     return text, frames
+
+
+# --------------------------------------------------------------------------- welding
+
+_MOTION_TAGS = ("axis", "limit", "dynamics", "calibration", "safety_controller", "mimic")
+
+
+def _axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+    """Rotation by ``angle`` (rad) about the unit vector ``axis`` (Rodrigues)."""
+    x, y, z = axis
+    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    return np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
+
+
+def weld_joints(urdf_xml: str, values: Mapping[str, float]) -> str:
+    """Make each joint named in ``values`` ``fixed`` at that value: rad for ``revolute`` and
+    ``continuous`` joints (a rotation about the joint's axis), m for ``prismatic`` ones (a shift
+    along it). The child link then sits exactly where it sat with the joint at that value.
+
+    Raises ValueError when the document is not well-formed, a name is not a joint of the
+    document, a joint is of another type (fixed, floating, planar) or a number is not finite.
+    """
+    try:
+        root = ET.fromstring(urdf_xml)
+    except ET.ParseError as exc:
+        raise ValueError(f"not well-formed XML: {exc}") from None
+    joints = {joint.get("name"): joint for joint in root.findall("joint")}
+    unknown = sorted(set(values) - set(joints))
+    if unknown:
+        raise ValueError(f"no joint named {', '.join(repr(n) for n in unknown)} in the document")
+    for name, value in values.items():
+        joint = joints[name]
+        kind = joint.get("type")
+        if kind not in ("revolute", "continuous", "prismatic"):
+            raise ValueError(f"joint {name!r} is {kind!r}; only revolute, continuous and prismatic joints can be welded")
+        if not math.isfinite(value):
+            raise ValueError(f"joint {name!r}: value {value!r} is not a finite number")
+        axis_elem = joint.find("axis")
+        axis = _parse_vector(axis_elem.get("xyz"), f"joint {name!r} <axis xyz>") if axis_elem is not None else np.array([1.0, 0.0, 0.0])
+        norm = float(np.linalg.norm(axis))
+        if norm == 0.0:
+            raise ValueError(f"joint {name!r} has a zero axis")
+        axis = axis / norm
+        if kind == "prismatic":
+            motion = _Pose(np.eye(3), axis * float(value))
+        else:
+            motion = _Pose(_axis_rotation(axis, float(value)), np.zeros(3))
+        origin = _origin_pose(joint, f"joint {name!r}")
+        _write_origin(joint, origin * motion, index=0)
+        joint.set("type", "fixed")
+        for tag in _MOTION_TAGS:
+            for elem in joint.findall(tag):
+                joint.remove(elem)
+    _reindent(root)
+    return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"

@@ -115,7 +115,6 @@ class AssistiveEnv(gym.Env):
         self.arm_idx = [robot.joints[j] for j in m.robot.arm_joints]
         self.lower = np.array(m.robot.joint_lower)
         self.upper = np.array(m.robot.joint_upper)
-        self.gripper_idx = [robot.joints[j] for j in m.robot.gripper_joints]
         self.delta_scale = m.robot.action_scale * m.sim.frame_skip
         self._gains = [m.robot.position_gain] * len(self.arm_idx)
         self._forces = [m.robot.max_force] * len(self.arm_idx)
@@ -179,7 +178,7 @@ class AssistiveEnv(gym.Env):
             reset_term()
         if m.success.fraction_of is not None:
             self.success_threshold = m.success.threshold * self.markers.count(m.success.fraction_of)
-        # Robot: one precomputed start — base pose and arm configuration (no IK), gripper at its task position.
+        # Robot: one precomputed start — base pose and arm configuration (no IK); the fingers are welded at the grip (compiler).
         k = int(rng.integers(len(variant.starts)))
         start = variant.starts[k]
         w.set_base_frame(w.robot, start.base_position, start.base_orientation)
@@ -188,11 +187,6 @@ class AssistiveEnv(gym.Env):
             pb.resetJointState(w.robot.id, i, q, physicsClientId=c)
         pb.setJointMotorControlArray(w.robot.id, self.arm_idx, pb.POSITION_CONTROL, targetPositions=q0,
                                      positionGains=self._gains, forces=self._forces, physicsClientId=c)
-        if self.gripper_idx:
-            for i, q in zip(self.gripper_idx, m.robot.gripper_position):
-                pb.resetJointState(w.robot.id, i, q, physicsClientId=c)
-            pb.setJointMotorControlArray(w.robot.id, self.gripper_idx, pb.POSITION_CONTROL, targetPositions=m.robot.gripper_position,
-                                         positionGains=[0.05] * len(self.gripper_idx), forces=[500.0] * len(self.gripper_idx), physicsClientId=c)
         # Tools follow the hand exactly.
         for att in m.tools:
             link_pos, link_orn = w.link_frame(w.robot, w.robot.links[att.parent_link])
