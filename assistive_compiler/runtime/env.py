@@ -20,9 +20,10 @@ joint angles, one of the precomputed start configurations, furniture noise, floo
 without reloading anything or solving IK (about a millisecond).
 
 Reproducibility: ``reset(seed=s)`` gives the same episode for the same actions, bit for bit,
-whatever the env did before — when the world has stepped since it was built, a seeded reset
-rebuilds the physics client (tens of milliseconds), because Bullet keeps solver caches that no
-saved state covers. Unseeded resets reuse the world; their episodes follow the seed sequence
+whatever the env did before — when the world has been reset or stepped since it was built, a
+seeded reset rebuilds the physics client (tens of milliseconds), because Bullet keeps solver and
+collision caches that no saved state covers (even a reset's collision pass leaves broadphase
+pairs behind). Unseeded resets reuse the world; their episodes follow the seed sequence
 but can differ in the last digits from a replay.
 """
 
@@ -130,7 +131,9 @@ class AssistiveEnv(gym.Env):
         self.action_space = gym.spaces.Box(-1.0, 1.0, (len(self.arm_idx),), np.float32)
         self.steps = 0
         self.success_metric: float | None = None
-        self._stepped = False
+        #: Whether the world has seen anything since it was built (a reset runs collision
+        #: detection, a step physics): a seeded reset then rebuilds it, to replay bit for bit.
+        self._used = False
         # The person: holds, impairments, the human agent's policy joints (see runtime/human.py).
         self.human = PersonController(self.world, m, self.artifact_dir)
         n_human = len(m.person.policy_joints)
@@ -150,9 +153,9 @@ class AssistiveEnv(gym.Env):
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
         rng = self.np_random
-        if seed is not None and self._stepped:
+        if seed is not None and self._used:
             self.world.rebuild()
-        self._stepped = False
+        self._used = True
         m, w, c = self.manifest, self.world, self.world.client
         w.restore()
         # Person variant: the drawn one in place, the others parked.
@@ -245,7 +248,6 @@ class AssistiveEnv(gym.Env):
         self.snap.actions["human"] = np.zeros(0) if human is None else human
         self.particles.before_physics()
         w.step_physics()
-        self._stepped = True
         self.steps += 1
         self.snap.actions["robot"] = raw
         self.snap.refresh()
