@@ -269,6 +269,7 @@ class Sim(_Model):
     gravity: float = Field(description="World gravity along z, m/s².")
     sub_steps: int = Field(description="Solver sub-steps.")
     solver_iterations: int = Field(description="Solver iterations.")
+    contact_breaking_threshold: float = Field(0.02, description="Contact breaking threshold, m (see bullet.connect).")
     ground_friction: tuple[float, float] = Field(description="Floor friction, uniform [low, high] per reset.")
 
 

@@ -9,6 +9,7 @@ import pytest
 import xacro
 import yourdfpy
 
+from assistive_compiler.bullet import connect
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.runtime.env import AssistiveEnv
 
@@ -24,8 +25,8 @@ def artifact(tmp_path_factory) -> Path:
 
 @pytest.fixture
 def cid():
-    """A private pybullet DIRECT client for one test."""
-    client = pb.connect(pb.DIRECT)
+    """A private pybullet DIRECT client for one test, with the package's engine settings."""
+    client = connect()
     yield client
     pb.disconnect(client)
 

@@ -52,6 +52,7 @@ from ..artifact import (
     TermUse,
     ToolAttachment,
 )
+from ..bullet import connect
 from ..errors import Problem, SpecError
 from ..library import PERSON_TEMPLATE_RELPATH, Library
 from ..paths import display, templates_dir
@@ -133,11 +134,11 @@ def _quat_from_rpy(rpy: tuple[float, float, float]) -> tuple[float, float, float
 class _Precompute:
     """A private pybullet world used only at compile time."""
 
-    def __init__(self) -> None:
+    def __init__(self, contact_breaking_threshold: float) -> None:
         import pybullet
 
         self.p = pybullet
-        self.client = pybullet.connect(pybullet.DIRECT)
+        self.client = connect(contact_breaking_threshold)
 
     def close(self) -> None:
         self.p.disconnect(self.client)
@@ -254,7 +255,7 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
         emit(f"person_{variant}", templates_dir() / PERSON_TEMPLATE_RELPATH, args, rt.loaded.smap.value(("person", "variants", i)))
 
     # 3. Precompute (on the unmerged bodies) -------------------------------------------------
-    pc = _Precompute()
+    pc = _Precompute(rt.spec.sim.solver.contact_breaking_threshold_m)
     try:
         manifest = _precompute(rt, pc, written, out_tmp, postures, movable_ordered, measurements, mounted_on, settled)
     finally:
@@ -363,7 +364,7 @@ def _finish_person(rt: ResolvedTask, manifest: Manifest, out_tmp: Path, pairs: l
     if pairs:
         import pybullet
 
-        pc = _Precompute()
+        pc = _Precompute(rt.spec.sim.solver.contact_breaking_threshold_m)
         try:
             p, c = pc.p, pc.client
             touching: set[tuple[str, str]] = set()
@@ -480,7 +481,7 @@ def _settle_person(rt: ResolvedTask, written: dict[str, Path], variant: str, mea
     frame) and joint angles (rad). Deterministic per (task, robot, variant)."""
     spec = rt.spec
     settle = spec.person.placement.settle
-    pc = _Precompute()
+    pc = _Precompute(rt.spec.sim.solver.contact_breaking_threshold_m)
     p, c = pc.p, pc.client
     try:
         p.setTimeStep(spec.sim.time_step_s, physicsClientId=c)
@@ -776,9 +777,8 @@ def _settle_garment(rt: ResolvedTask, name: str, g, out_tmp: Path, grip, held_or
     write_obj(obj, np.round(held_verts, 6), faces, name=name)
     sets = {k: [int(i) for i in v] for k, v in sleeve_node_sets(shape.rings, shape.segments).items()}
     anchored = sets[g.held.nodes]
-    c = pb.connect(pb.DIRECT)
+    c = connect(spec.sim.solver.contact_breaking_threshold_m, deformable=True)
     try:
-        pb.resetSimulation(pb.RESET_USE_DEFORMABLE_WORLD, physicsClientId=c)
         pb.setTimeStep(spec.sim.time_step_s, physicsClientId=c)
         pb.setPhysicsEngineParameter(numSubSteps=spec.sim.solver.sub_steps, physicsClientId=c)
         pb.setGravity(0, 0, g.settle.gravity_mps2, physicsClientId=c)
@@ -1177,6 +1177,7 @@ def _manifest(rt, bodies, variants, attachments, particle_sets, arm_joints, lowe
         sources=[display(f) for f in rt.loaded.files],
         sim=Sim(time_step=spec.sim.time_step_s, frame_skip=spec.sim.frame_skip, episode_steps=spec.sim.episode_steps,
                 gravity=spec.sim.gravity_mps2, sub_steps=spec.sim.solver.sub_steps, solver_iterations=spec.sim.solver.iterations,
+                contact_breaking_threshold=spec.sim.solver.contact_breaking_threshold_m,
                 ground_friction=ground),
         bodies=bodies,
         person=Person(variants=variants, policy_joints=_policy_joints(rt), position_gain=gains.position_gain, max_force=gains.max_force_nm,

@@ -25,6 +25,8 @@ import tempfile
 from pathlib import Path
 from typing import Iterator
 
+from ..bullet import connect
+
 __all__ = [
     "check_with_urdfdom",
     "check_with_yourdfpy",
@@ -238,7 +240,7 @@ def pybullet_load_warnings(
         ]
     load_failure: str | None = None
     with captured_c_output() as printed:
-        client = pybullet.connect(pybullet.DIRECT)
+        client = connect()
         if client < 0:
             load_failure = "pybullet.connect(DIRECT) failed"
         else:

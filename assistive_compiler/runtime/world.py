@@ -36,6 +36,7 @@ import numpy as np
 import pybullet as pb
 
 from ..artifact import Manifest
+from ..bullet import connect, use_contact_breaking_threshold
 
 PARK = (0.0, 500.0, 50.0)  # where inactive bodies (other person variants, removed particles) wait: far away, beyond the floor's edge, m
 FLOOR_HALF_M = 20.0  # the floor slab's half width, m: the scene sits near the origin
@@ -93,11 +94,9 @@ class World:
         self._build()
 
     def _build(self) -> None:
-        self.client = pb.connect(pb.DIRECT)
+        self.client = connect(self.m.sim.contact_breaking_threshold, deformable=bool(self.m.garments))  # cloth needs Bullet's deformable world
         c = self.client
         sim = self.m.sim
-        if self.m.garments:  # cloth needs Bullet's deformable world, chosen before anything is loaded
-            pb.resetSimulation(pb.RESET_USE_DEFORMABLE_WORLD, physicsClientId=c)
         pb.setPhysicsEngineParameter(numSolverIterations=sim.solver_iterations, deterministicOverlappingPairs=1, physicsClientId=c)
 
         # The floor: a slab, top face at z = 0, not a GEOM_PLANE. A plane's bounding box is
@@ -393,6 +392,7 @@ class World:
         """Advance one env step (frame_skip physics steps) with per-body gravity compensation."""
         after = self.after_physics_step
         garments = bool(self.garments)
+        use_contact_breaking_threshold(self.client, self.m.sim.contact_breaking_threshold)  # process-wide in pybullet
         for _ in range(self.m.sim.frame_skip):
             self._apply_gravity_compensation()
             pb.stepSimulation(physicsClientId=self.client)
@@ -461,6 +461,7 @@ class World:
         Some solver state still survives (see :meth:`rebuild` for bit-exact replay).
         """
         c = self.client
+        use_contact_breaking_threshold(c, self.m.sim.contact_breaking_threshold)  # process-wide in pybullet
         pb.restoreState(self.initial_state, physicsClientId=c)
         for k, bid in enumerate(self._all_bodies):
             pb.resetBasePositionAndOrientation(bid, (PARK[0] + 1000.0 + 10.0 * k, PARK[1], PARK[2]), (0, 0, 0, 1), physicsClientId=c)
