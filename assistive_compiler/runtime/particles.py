@@ -3,11 +3,11 @@ container); the first contact of an active particle with ``hit_body`` counts onc
 
 Removed particles are parked far away (``PARK``, 50 m up), apart from each other, at rest and
 without gravity compensation, so they touch nothing; they come back at reset. A parked particle
-falls under the world's gravity, so before it could reach the ground plane (where its contact
-would cost solver work every physics step: 64 of them on the ground made a Drinking env step with
-the water carried ~0.3 ms, a sixth, slower) it is put back at
-its parking spot at rest: every :attr:`ParticleSystem.repark_steps` env steps after it was
-parked (a function of the episode's history only, so seeded episodes replay exactly). Nothing
+falls under the world's gravity, so it is put back at its parking spot at rest before it could
+fall 49 m: every :attr:`ParticleSystem.repark_steps` env steps after it was parked (a function
+of the episode's history only, so seeded episodes replay exactly). Under the old infinite ground
+plane, 64 of them landing made a Drinking env step with the water carried a sixth slower; the
+floor slab does not reach the parking area, and reparking keeps their positions bounded. Nothing
 else about them changes: a mass of 0 would make them static objects for good, changing collision
 filters re-inserts them in the broadphase, which reorders contact pairs, and Bullet's sleeping
 does not restore a multibody's velocity when it wakes — each would make an episode depend on the

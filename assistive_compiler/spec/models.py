@@ -91,7 +91,7 @@ class Solver(Strict):
 
 
 class Ground(Strict):
-    """The floor plane at z = 0."""
+    """The floor (its top face at z = 0)."""
 
     friction: Scalar = Field(
         default_factory=lambda: Uniform(uniform=(0.025, 0.5)),
