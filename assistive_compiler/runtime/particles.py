@@ -97,8 +97,8 @@ class ParticleSystem:
         return (r2 <= box.radius ** 2) & (local[:, 2] >= -box.radius) & (local[:, 2] <= box.height)
 
     def _positions(self, ids: list[int]) -> np.ndarray:
-        c = self.world.client
-        return np.array([pb.getBasePositionAndOrientation(pid, physicsClientId=c)[0] for pid in ids], dtype=float).reshape(-1, 3)
+        c, pose = self.world.client, pb.getBasePositionAndOrientation
+        return np.array([pose(pid, c)[0] for pid in ids], dtype=float).reshape(-1, 3)  # positional: pybullet parses keywords slowly
 
     def _carry(self, ps: ParticleSet, ids: list[int], which: np.ndarray, local: np.ndarray) -> None:
         """Park the particles ``which`` (bool mask) and remember their container-frame positions."""

@@ -412,14 +412,15 @@ class World:
                 (bid, next(((0.0, 0.0, fz) for l, fz in zip(links, forces) if l == -1), None),
                  [l for l in links if l >= 0], [(0.0, 0.0, fz) for l, fz in zip(links, forces) if l >= 0])
                 for bid, links, forces in self.gravity_groups])
+        # Positional arguments: pybullet parses keywords slowly (0.5 µs per force here, up to 90 per env step).
         for bid, base_force, children, child_forces in plan[1]:
             if bid in parked:
                 continue
             if base_force is not None:
-                apply(bid, -1, base_force, base_pose(bid, physicsClientId=c)[0], world, physicsClientId=c)
+                apply(bid, -1, base_force, base_pose(bid, c)[0], world, c)
             if children:
                 for link, force, state in zip(children, child_forces, link_states(bid, children, physicsClientId=c)):
-                    apply(bid, link, force, state[0], world, physicsClientId=c)
+                    apply(bid, link, force, state[0], world, c)
 
     def set_asleep(self, handle: BodyHandle, asleep: bool) -> None:
         """Put a parked body to sleep, or wake it (and keep it from sleeping).
