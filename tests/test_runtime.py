@@ -149,10 +149,12 @@ def test_a_seeded_reset_replays_the_episode_whatever_came_before(make_env):
     assert np.array_equal(first, fresh) and np.array_equal(first_rew, fresh_rew)
 
 
-def test_a_parked_variant_sleeps_and_wakes_without_changing_episodes(make_env):
+def test_seeded_episodes_of_either_variant_replay_after_any_draws(make_env):
     """The variant a reset does not draw is parked asleep (Bullet skips its dynamics and motor
-    rows); a later reset that draws it wakes it, and its episode equals the same seed's episode
-    in a fresh env, whichever variant slept before."""
+    rows). Seeded episodes of both variants, alternating, after 40 resets without a step, equal
+    the same seeds' episodes in fresh envs. (Those unstepped resets once left collision state
+    behind that a seeded reset did not rebuild. Seeded resets rebuild the world, so this does not
+    check a wake inside one world: unseeded episodes are not promised bit-exact.)"""
     env = make_env()
     drawn: dict[str, int] = {}
     for seed in range(40):

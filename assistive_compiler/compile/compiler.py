@@ -216,8 +216,9 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
         written["robot"].write_text(xml)
     else:
         emit("robot", lib.template_path(rt.robot), robot_part.template.params, rt.robot.smap.value(("template", "path")))
-    welded = _robot_welds(rt, written["robot"].read_text())
-    written["robot"].write_text(weld_joints(written["robot"].read_text(), welded))
+    robot_xml = written["robot"].read_text()
+    welded = _robot_welds(rt, robot_xml)
+    written["robot"].write_text(weld_joints(robot_xml, welded))
     mounted_on = spec.robot.mount_on if robot_part.mountable else None
     for name, use in _present_furniture(rt).items():
         part = rt.furniture[name].part
