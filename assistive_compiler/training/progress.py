@@ -35,9 +35,9 @@ class Progress:
         self.run, self.weights = run, weights
         self.writer = SummaryWriter(str(run.tb / "episodes"))
         self.start_steps, self.t0 = start_steps, time.perf_counter()
-        self.wall_before = self._previous_wall()
-        self.pending: list[tuple[float, bool, dict[str, float]]] = []
-        self.episodes = 0
+        self.wall_before, self.episodes = self._previous_totals()
+        #: (episodes, mean return, success rate, each term's mean weighted episode sum) since the last update
+        self.pending: list[tuple[int, float, float, dict[str, float]]] = []
         self.last_return: float | None = None
         self.bar = tqdm(total=total_steps, initial=start_steps, unit="step", unit_scale=True, file=sys.stderr,
                         disable=quiet, dynamic_ncols=True, desc="train")
@@ -48,16 +48,22 @@ class Progress:
         if new:
             self._rows.writerow(CURVE_FIELDS)
 
-    def _previous_wall(self) -> float:
-        """Wall seconds already spent by the run before this session (resumed runs)."""
+    def _previous_totals(self) -> tuple[float, int]:
+        """Wall seconds and episodes of the run before this session (resumed runs)."""
         if not self.run.curve_csv.is_file():
-            return 0.0
-        rows = list(csv.DictReader(self.run.curve_csv.open()))
-        return float(rows[-1]["wall_s"]) if rows else 0.0
+            return 0.0, 0
+        with self.run.curve_csv.open() as f:
+            rows = list(csv.DictReader(f))
+        return (float(rows[-1]["wall_s"]), int(rows[-1]["episodes"])) if rows else (0.0, 0)
 
     def episode(self, ret: float, success: bool, term_sums: dict[str, float]) -> None:
         """One finished episode: its return, success and unweighted term sums."""
-        self.pending.append((float(ret), bool(success), dict(term_sums)))
+        self.pending.append((1, float(ret), float(success), {n: w * term_sums.get(n, 0.0) for n, w in self.weights.items()}))
+
+    def episodes_summary(self, count: int, mean_return: float, success_rate: float, weighted_term_means: dict[str, float]) -> None:
+        """``count`` finished episodes given by their means (engines that aggregate episodes
+        themselves); ``weighted_term_means``: each term's weighted episode sum, averaged."""
+        self.pending.append((count, float(mean_return), float(success_rate), dict(weighted_term_means)))
 
     def update(self, steps: int) -> dict[str, float]:
         """Record the episodes since the last update at ``steps`` env steps; returns the scalars."""
@@ -65,12 +71,13 @@ class Progress:
         rate = (steps - self.start_steps) / elapsed if elapsed > 0 else 0.0
         scalars: dict[str, float] = {"Perf/steps_per_s": rate}
         if self.pending:
-            returns = [r for r, _, _ in self.pending]
-            scalars["Episode/return"] = float(np.mean(returns))
-            scalars["Episode/success_rate"] = float(np.mean([s for _, s, _ in self.pending]))
-            for name, weight in self.weights.items():
-                scalars[f"Episode_Reward/{name}"] = float(np.mean([weight * t.get(name, 0.0) for _, _, t in self.pending]))
-            self.episodes += len(self.pending)
+            counts = np.array([c for c, _, _, _ in self.pending], dtype=float)
+            mean = lambda values: float(np.dot(counts, values) / counts.sum())  # noqa: E731
+            scalars["Episode/return"] = mean([r for _, r, _, _ in self.pending])
+            scalars["Episode/success_rate"] = mean([s for _, _, s, _ in self.pending])
+            for name in self.weights:
+                scalars[f"Episode_Reward/{name}"] = mean([t.get(name, 0.0) for _, _, _, t in self.pending])
+            self.episodes += int(counts.sum())
             self.last_return = scalars["Episode/return"]
             self._rows.writerow([steps, round(self.wall_before + elapsed, 3), self.episodes, scalars["Episode/return"],
                                  scalars["Episode/success_rate"], round(rate, 1)])
