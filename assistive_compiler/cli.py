@@ -13,7 +13,7 @@ import os
 import sys
 from typing import Callable, Sequence
 
-from .errors import SpecError
+from .errors import SpecError, UsageError
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 
@@ -88,6 +88,11 @@ def task_schema() -> dict:
 
 
 def cmd_schema(args: argparse.Namespace) -> int:
+    if args.training:
+        from .training.config import training_schema
+
+        print(json.dumps(training_schema(), indent=2, sort_keys=True))
+        return EXIT_OK
     if args.terms:
         from .terms.registry import terms
 
@@ -143,6 +148,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("schema", help="print the JSON Schema of a task spec (or --terms: the term library)")
     p.add_argument("--terms", action="store_true", help="list registered terms and their parameters instead")
+    p.add_argument("--training", action="store_true", help="print the JSON Schema of a training config (specs/training/*.yaml) instead")
     p.set_defaults(func=cmd_schema)
 
     _add_runtime_commands(sub)
@@ -155,6 +161,9 @@ def _add_runtime_commands(sub) -> None:
     except ImportError:  # pragma: no cover - the runtime commands ship with the package
         return
     cli_run.add_commands(sub)
+    from . import cli_train
+
+    cli_train.add_commands(sub)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -165,6 +174,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return func(args)
     except SpecError as exc:
         _print_problems(exc)
+        return EXIT_BAD_INPUT
+    except UsageError as exc:
+        print(f"error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)

@@ -13,7 +13,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from ..errors import SpecError
+from ..errors import SpecError, UsageError
 from ..paths import display
 from ..yamlsrc import load_located
 
@@ -99,7 +99,7 @@ class TrainingConfig(Strict):
         try:
             return TrainingConfig.model_validate(data)
         except ValidationError as exc:
-            raise SpecError.at("<command line>", "; ".join(e["msg"] for e in exc.errors())) from None
+            raise UsageError("; ".join(e["msg"] for e in exc.errors())) from None
 
 
 def load_training_config(path: str | Path) -> TrainingConfig:

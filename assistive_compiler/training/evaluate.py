@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import SpecError
+from ..errors import UsageError
 from ..paths import display
 from .run_dir import RunDir, RunInfo
 
@@ -21,7 +21,7 @@ from .run_dir import RunDir, RunInfo
 def latest_checkpoint(run: RunDir) -> tuple[int, Path]:
     found = run.latest_checkpoint()
     if found is None:
-        raise SpecError.at(display(run.path), "run has no complete checkpoint yet (checkpoints/step_*/COMPLETE)")
+        raise UsageError(f"{display(run.path)}: the run has no complete checkpoint yet (checkpoints/step_*/COMPLETE)")
     return found
 
 

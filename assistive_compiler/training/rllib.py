@@ -15,13 +15,14 @@ filter); ``ppo.normalize_*`` are SB3's.
 
 from __future__ import annotations
 
+import os
 import socket
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import SpecError
+from ..errors import UsageError
 from .config import TrainingConfig
 from .progress import Progress
 from .run_dir import RunDir
@@ -30,6 +31,7 @@ ENV_NAME = "assistive_compiler"
 AGENTS = ("robot", "human")
 SINGLE_MODULE = "default_policy"
 CONNECT_TIMEOUT_S = 3.0
+GCS_WAIT_VAR = "RAY_gcs_server_port_wait_time_s"
 
 
 def make_rllib_env(env_config: dict):
@@ -53,11 +55,11 @@ def check_address(address: str) -> None:
     target = address.split("://", 1)[-1]
     host, _, port = target.rpartition(":")
     if not host or not port.isdigit():
-        raise SpecError.at("<command line>", f"--address: expected HOST:PORT or ray://HOST:PORT (e.g. 10.0.0.5:6379), got '{address}'")
+        raise UsageError(f"--address: expected HOST:PORT or ray://HOST:PORT (e.g. 10.0.0.5:6379), got '{address}'")
     try:
         socket.create_connection((host, int(port)), timeout=CONNECT_TIMEOUT_S).close()
     except OSError as exc:
-        raise SpecError.at("<command line>", f"--address: no Ray cluster reachable at {address} ({exc.strerror or exc}); "
+        raise UsageError(f"--address: no Ray cluster reachable at {address} ({exc.strerror or exc}); "
                                              "start one with `ray start --head` there, or leave out --address to train locally") from None
 
 
@@ -69,7 +71,20 @@ def init_ray(address: str | None, envs: int) -> None:
         return
     if address:
         check_address(address)
-        ray.init(address=address, log_to_driver=False)
+        # Something answers at the address; give Ray a few seconds (not its default 20) to find a
+        # cluster there. The variable is read when connecting, by this process only.
+        previous = os.environ.get(GCS_WAIT_VAR)
+        os.environ[GCS_WAIT_VAR] = str(int(CONNECT_TIMEOUT_S))
+        try:
+            ray.init(address=address, log_to_driver=False)
+        except (ConnectionError, RuntimeError) as exc:
+            raise UsageError(f"--address: no Ray cluster at {address} ({str(exc).splitlines()[0]}); "
+                             "start one with `ray start --head` there, or leave out --address to train locally") from None
+        finally:
+            if previous is None:
+                os.environ.pop(GCS_WAIT_VAR, None)
+            else:
+                os.environ[GCS_WAIT_VAR] = previous
     else:
         ray.init(num_cpus=max(2, envs + 1), include_dashboard=False, log_to_driver=False)
 
@@ -158,7 +173,7 @@ def save_checkpoint(run: RunDir, algo, steps: int) -> Path:
 def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, coop: bool, resume: bool,
           address: str | None = None, quiet: bool = False) -> dict:
     """Train (or continue) the run to ``config.total_steps`` env steps; Ctrl-C checkpoints and returns."""
-    init_ray(address, config.envs)
+    init_ray(address, config.envs)  # train.train has already started or attached; a no-op then
     latest = run.latest_checkpoint() if resume else None
     start_steps = latest[0] if latest else 0
     algo = build_config(run, config, weights, coop).build_algo()

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import yaml
 
-from ..errors import SpecError
+from ..errors import SpecError, UsageError
 from ..paths import display
 from .config import TrainingConfig
 
@@ -87,7 +87,7 @@ class RunDir:
         """The run's ``run.json``; a clear error when ``path`` is not a run directory."""
         file = self.path / RUN_FILE
         if not file.is_file():
-            raise SpecError.at(display(self.path), f"not a run directory (no {RUN_FILE}); `assistive-compiler train` writes one")
+            raise UsageError(f"{display(self.path)}: not a run directory (no {RUN_FILE}); `assistive-compiler train` writes one")
         return RunInfo(**json.loads(file.read_text()))
 
     def create(self, info: RunInfo, artifact_src: Path) -> None:

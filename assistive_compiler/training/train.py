@@ -10,7 +10,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from ..errors import SpecError
+from ..errors import SpecError, UsageError
 from ..paths import display
 from .config import TrainingConfig, load_training_config
 from .run_dir import RunDir, check_resumable, new_run_info
@@ -22,13 +22,13 @@ def choose_engine(engine: str, coop: bool, address: str | None) -> str:
     from ..errors import did_you_mean, one_of
 
     if engine not in ENGINES:
-        raise SpecError.at("<command line>", f"--engine: unknown engine '{engine}'; expected one of {one_of(ENGINES)}{did_you_mean(engine, ENGINES)}")
+        raise UsageError(f"--engine: unknown engine '{engine}'; expected one of {one_of(ENGINES)}{did_you_mean(engine, ENGINES)}")
     if engine == "auto":
         return "rllib" if coop or address else "sb3"
     if engine == "sb3" and coop:
-        raise SpecError.at("<command line>", "--coop trains two policies (robot and human): use --engine rllib (or auto)")
+        raise UsageError("--coop trains two policies (robot and human): use --engine rllib (or auto)")
     if engine == "sb3" and address:
-        raise SpecError.at("<command line>", "--address attaches to a Ray cluster: use --engine rllib (or auto)")
+        raise UsageError("--address attaches to a Ray cluster: use --engine rllib (or auto)")
     return engine
 
 
@@ -65,6 +65,10 @@ def train(spec: str, *, robot: str | None, config_path: str, coop: bool = False,
     """Train a policy for ``spec`` and ``robot`` as ``config_path`` says; returns the run's summary."""
     engine = choose_engine(engine, coop, address)
     config: TrainingConfig = load_training_config(config_path).with_overrides(steps=steps, seed=seed, envs=envs)
+    if engine == "rllib":
+        from .rllib import init_ray
+
+        init_ray(address, config.envs)  # an unreachable cluster fails here, before anything is written
     result, robot = compile_for_run(spec, robot, coop)
     manifest = result.manifest
     run = RunDir(out or default_run_dir(manifest.task, robot, coop, config.seed))
@@ -72,7 +76,7 @@ def train(spec: str, *, robot: str | None, config_path: str, coop: bool = False,
         info = check_resumable(run, manifest.content_hash, robot, coop, engine)
         config = info.training_config.with_overrides(steps=steps)
     elif run.exists():
-        raise SpecError.at(display(run.path), "run directory already holds a run; pass --resume to continue it, or choose another --out")
+        raise UsageError(f"{display(run.path)}: the run directory already holds a run; pass --resume to continue it, or choose another --out")
     else:
         run.create(new_run_info(spec, manifest, robot, coop, engine, config), result.out_dir)
     weights = reward_weights(manifest)
