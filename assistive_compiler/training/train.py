@@ -65,11 +65,11 @@ def train(spec: str, *, robot: str | None, config_path: str, coop: bool = False,
     """Train a policy for ``spec`` and ``robot`` as ``config_path`` says; returns the run's summary."""
     engine = choose_engine(engine, coop, address)
     config: TrainingConfig = load_training_config(config_path).with_overrides(steps=steps, seed=seed, envs=envs)
+    result, robot = compile_for_run(spec, robot, coop)
     if engine == "rllib":
         from .rllib import init_ray
 
-        init_ray(address, config.envs)  # an unreachable cluster fails here, before anything is written
-    result, robot = compile_for_run(spec, robot, coop)
+        init_ray(address, config.envs)  # an unreachable cluster fails here, before the run directory is written
     manifest = result.manifest
     run = RunDir(out or default_run_dir(manifest.task, robot, coop, config.seed))
     if resume:
