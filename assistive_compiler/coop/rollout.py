@@ -1,0 +1,92 @@
+"""Co-optimisation episodes and speed: :func:`rollout_coop` (one episode of both agents, summed)
+and :func:`bench_coop` (single- vs multi-agent env steps/s of one artifact, in one run)."""
+
+from __future__ import annotations
+
+import statistics
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .parallel import AssistiveParallelEnv
+from .policies import agent_policy
+
+__all__ = ["rollout_coop", "bench_coop"]
+
+
+def rollout_coop(env: AssistiveParallelEnv, robot_policy: Any, human_policy: Any, seed: int) -> dict:
+    """One episode with both agents acting (policies as :func:`~.policies.agent_policy` takes them).
+    Returns the shared return, success, each term's unweighted values summed over the episode,
+    the mean force on the person (N) and the arm-limit reverts of the episode."""
+    obs, _ = env.reset(seed=seed)
+    act = {"robot": agent_policy(env, "robot", robot_policy, seed), "human": agent_policy(env, "human", human_policy, seed)}
+    total, terms, forces = 0.0, {}, []
+    while env.agents:
+        obs, rewards, _, _, infos = env.step({agent: act[agent](obs[agent]) for agent in env.possible_agents})
+        info = infos["human"]
+        total += rewards["robot"]
+        for name, value in info["terms"].items():
+            terms[name] = terms.get(name, 0.0) + value
+        forces.append(info["total_force_on_human"])
+    return {
+        "seed": seed,
+        "return": total,
+        "success": bool(info["task_success"]),
+        "success_metric": info["success_metric"],
+        "mean_force_on_human_n": float(np.mean(forces)),
+        "arm_limit_reverts": info["arm_limit_reverts"],
+        "terms": terms,
+    }
+
+
+def bench_coop(artifact_dir: str | Path, steps: int = 200, repeats: int = 5, seed: int = 0) -> dict:
+    """Env steps/s of one artifact as the single-agent env (the robot acts, the person is static)
+    and as the multi-agent env (the PettingZoo step with both agents acting), random actions,
+    ``repeats`` episodes of ``steps`` each, interleaved (the order alternates) in this one run;
+    medians, and their ratio."""
+    env = AssistiveParallelEnv(artifact_dir)
+    single, multi = env.env, env
+    rng = np.random.default_rng(seed)
+    shapes = {agent: env.action_space(agent).shape for agent in env.possible_agents}
+
+    def draw(agent: str) -> np.ndarray:
+        return rng.uniform(-1.0, 1.0, shapes[agent]).astype(np.float32)
+
+    def run_single(episode_seed: int) -> float:
+        single.reset(seed=episode_seed)
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            single.step(draw("robot"))
+        return steps / (time.perf_counter() - t0)
+
+    def run_multi(episode_seed: int) -> float:
+        multi.reset(seed=episode_seed)
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            multi.step({"robot": draw("robot"), "human": draw("human")})
+        return steps / (time.perf_counter() - t0)
+
+    rates: dict[str, list[float]] = {"single": [], "multi": []}
+    try:
+        for r in range(repeats):
+            order = (("single", run_single), ("multi", run_multi))
+            for name, run in order if r % 2 == 0 else order[::-1]:
+                rates[name].append(run(seed + r))
+        reverts = env.env.human.reverts
+    finally:
+        env.close()
+    s, mu = statistics.median(rates["single"]), statistics.median(rates["multi"])
+    m = env.env.manifest
+    return {
+        "task": m.task, "robot": m.robot_name, "name": env.metadata["name"],
+        "human_action_size": int(shapes["human"][0]), "human_obs_size": int(env.observation_space("human").shape[0]),
+        "single_agent_env_steps_per_s": round(s, 1),
+        "multi_agent_env_steps_per_s": round(mu, 1),
+        "multi_over_single": round(mu / s, 3),
+        "arm_limit_reverts_last_episode": reverts,
+        "steps_per_repeat": steps, "repeats": repeats,
+        "notes": "same artifact and world; single: env.step (robot acts, person static); multi: the PettingZoo step, "
+                 "both agents random; episodes interleaved, order alternating; medians over repeats",
+    }
