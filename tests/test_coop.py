@@ -9,6 +9,7 @@ uses, so each shipped task × robot compiles once per session.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -219,3 +220,43 @@ def test_rollout_coop_with_a_holding_person_is_the_single_agent_rollout(feeding,
     assert got["return"] == expected["return"] and got["success"] == expected["success"] and got["terms"] == expected["terms"]
     moving = rollout_coop(feeding, "scripted", "random", seed=3)
     assert moving["return"] != expected["return"]
+
+
+# ---------------------------------------------------------------------------------------------
+# the CLI
+
+
+def test_cli_run_coop(artifact, capsys):
+    from assistive_compiler.cli import main
+
+    base = ["run", str(TASKS / "feeding.yaml"), "--robot", "jaco", "--episodes", "1", "--seed", "3", "--json", "--quiet", "--out", str(artifact)]
+    assert main(base) == 0
+    plain = json.loads(capsys.readouterr().out)
+    assert main(base + ["--coop", "--human-policy", "hold"]) == 0
+    held = json.loads(capsys.readouterr().out)
+    assert held["human_policy"] == "hold" and held["episodes"][0]["return"] == plain["episodes"][0]["return"]
+    assert main(base + ["--coop", "--human-policy", "random"]) == 0
+    moving = json.loads(capsys.readouterr().out)
+    assert moving["episodes"][0]["return"] != plain["episodes"][0]["return"]
+
+
+def test_cli_bench_coop(capsys):
+    from assistive_compiler.cli import main
+
+    assert main(["bench", str(TASKS / "feeding.yaml"), "--robot", "jaco", "--coop", "--steps", "20", "--repeats", "1", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["name"] == "FeedingJacoHuman-v1" and (out["human_action_size"], out["human_obs_size"]) == (4, 23)
+    assert out["single_agent_env_steps_per_s"] > 0 and out["multi_agent_env_steps_per_s"] > 0
+    assert out["multi_over_single"] == pytest.approx(out["multi_agent_env_steps_per_s"] / out["single_agent_env_steps_per_s"], rel=1e-2)
+
+
+def test_cli_coop_refuses_a_person_with_nothing_to_control(tmp_path, capsys):
+    from assistive_compiler.cli import main
+
+    text = f"extends: {TASKS / 'feeding.yaml'}\nperson:\n  control:\n    policy_joints: []\n"
+    path = tmp_path / "static.yaml"
+    path.write_text(text)
+    assert main(["run", str(path), "--robot", "jaco", "--coop", "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert err.strip().startswith(f"{display(path)}:{at(text, '[]')}: person.control.policy_joints: the person controls no joints")

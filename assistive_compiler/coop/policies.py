@@ -13,10 +13,11 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..policies import HUMAN_POLICIES, POLICIES
+
 __all__ = ["ROBOT_POLICIES", "HUMAN_POLICIES", "agent_policy"]
 
-ROBOT_POLICIES = ("random", "zero", "scripted")
-HUMAN_POLICIES = ("random", "zero", "hold")
+ROBOT_POLICIES = POLICIES
 
 Policy = Callable[[np.ndarray], "np.ndarray | None"]
 
