@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .episode import EpisodeTally
 from .policies import HUMAN_POLICIES, POLICIES
 
 
@@ -33,23 +34,13 @@ def rollout(env, policy, seed: int) -> dict:
     """One episode: return, success, each term's unweighted values summed over the episode (the
     reward is Σ weight × value: see ``term_weights`` in ``run --json``), mean force on the person (N)."""
     obs, info = env.reset(seed=seed)
-    total, terms, forces = 0.0, {}, []
+    tally = EpisodeTally()
     done = False
     while not done:
         obs, reward, terminated, truncated, info = env.step(policy(obs))
-        total += reward
-        for name, value in info["terms"].items():
-            terms[name] = terms.get(name, 0.0) + value
-        forces.append(info["total_force_on_human"])
+        tally.add(reward, info)
         done = terminated or truncated
-    return {
-        "seed": seed,
-        "return": total,
-        "success": bool(info["task_success"]),
-        "success_metric": info["success_metric"],
-        "mean_force_on_human_n": float(np.mean(forces)),
-        "terms": terms,
-    }
+    return tally.summary(seed)
 
 
 def cmd_run(args: argparse.Namespace) -> int:

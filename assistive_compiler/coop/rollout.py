@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from ..episode import EpisodeTally
 from .parallel import AssistiveParallelEnv
 from .policies import agent_policy
 
@@ -22,23 +23,11 @@ def rollout_coop(env: AssistiveParallelEnv, robot_policy: Any, human_policy: Any
     the mean force on the person (N) and the arm-limit reverts of the episode."""
     obs, _ = env.reset(seed=seed)
     act = {"robot": agent_policy(env, "robot", robot_policy, seed), "human": agent_policy(env, "human", human_policy, seed)}
-    total, terms, forces = 0.0, {}, []
+    tally = EpisodeTally()
     while env.agents:
         obs, rewards, _, _, infos = env.step({agent: act[agent](obs[agent]) for agent in env.possible_agents})
-        info = infos["human"]
-        total += rewards["robot"]
-        for name, value in info["terms"].items():
-            terms[name] = terms.get(name, 0.0) + value
-        forces.append(info["total_force_on_human"])
-    return {
-        "seed": seed,
-        "return": total,
-        "success": bool(info["task_success"]),
-        "success_metric": info["success_metric"],
-        "mean_force_on_human_n": float(np.mean(forces)),
-        "arm_limit_reverts": info["arm_limit_reverts"],
-        "terms": terms,
-    }
+        tally.add(rewards["robot"], infos["human"])
+    return {**tally.summary(seed), "arm_limit_reverts": tally.info["arm_limit_reverts"]}
 
 
 def bench_coop(artifact_dir: str | Path, steps: int = 200, repeats: int = 5, seed: int = 0, chunk: int = 10) -> dict:
