@@ -9,7 +9,7 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
-__all__ = ["__version__", "make", "compile_task", "load_spec"]
+__all__ = ["__version__", "make", "compile_task", "load_spec", "parallel_env", "coop"]
 
 
 def load_spec(path):
@@ -31,6 +31,22 @@ def make(spec, robot=None, **kwargs):
     from .runtime.env import AssistiveEnv
 
     return AssistiveEnv.from_spec(spec, robot=robot, **kwargs)
+
+
+def parallel_env(spec, robot=None, render_mode=None, out_dir=None, **kwargs):
+    """A PettingZoo ``ParallelEnv`` (agents ``robot`` and ``human``) for the task spec at ``spec``
+    and ``robot`` (see :func:`assistive_compiler.coop.parallel_env`)."""
+    from .coop.parallel import parallel_env as _parallel_env
+
+    return _parallel_env(spec, robot=robot, render_mode=render_mode, out_dir=out_dir, **kwargs)
+
+
+def __getattr__(name):
+    if name == "coop":  # co-optimisation: imported on first use (it imports pettingzoo and pybullet)
+        import importlib
+
+        return importlib.import_module(".coop", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def _register() -> None:

@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .policies import POLICIES
+from .episode import EpisodeTally
+from .policies import HUMAN_POLICIES, POLICIES
 
 
 def _env(spec: str, robot: str | None, out: str | None = None, **kwargs):
@@ -33,23 +34,13 @@ def rollout(env, policy, seed: int) -> dict:
     """One episode: return, success, each term's unweighted values summed over the episode (the
     reward is Σ weight × value: see ``term_weights`` in ``run --json``), mean force on the person (N)."""
     obs, info = env.reset(seed=seed)
-    total, terms, forces = 0.0, {}, []
+    tally = EpisodeTally()
     done = False
     while not done:
         obs, reward, terminated, truncated, info = env.step(policy(obs))
-        total += reward
-        for name, value in info["terms"].items():
-            terms[name] = terms.get(name, 0.0) + value
-        forces.append(info["total_force_on_human"])
+        tally.add(reward, info)
         done = terminated or truncated
-    return {
-        "seed": seed,
-        "return": total,
-        "success": bool(info["task_success"]),
-        "success_metric": info["success_metric"],
-        "mean_force_on_human_n": float(np.mean(forces)),
-        "terms": terms,
-    }
+    return tally.summary(seed)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
@@ -57,22 +48,35 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     from .policies import make_policy
 
-    env = _env(args.spec, args.robot, args.out)
+    if args.coop:  # both agents act (co-optimisation); the person by --human-policy
+        from .coop import parallel_env, rollout_coop
+
+        coop_env = parallel_env(args.spec, args.robot, out_dir=args.out)
+        env, label = coop_env.env, f"{args.policy}, human {args.human_policy}"
+
+        def play(seed: int) -> dict:
+            return rollout_coop(coop_env, args.policy, args.human_policy, seed)
+    else:
+        env, label = _env(args.spec, args.robot, args.out), args.policy
+        policy = make_policy(args.policy, env, seed=args.seed)
+
+        def play(seed: int) -> dict:
+            return rollout(env, policy, seed)
     weights = {t.name: t.weight for t in env.manifest.reward}
-    policy = make_policy(args.policy, env, seed=args.seed)
     episodes = []
-    bar = tqdm(range(args.episodes), desc=f"{env.manifest.gym_id} {args.policy}", unit="ep", file=sys.stderr, disable=args.quiet)
+    bar = tqdm(range(args.episodes), desc=f"{env.manifest.gym_id} {label}", unit="ep", file=sys.stderr, disable=args.quiet)
     for k in bar:
-        episodes.append(rollout(env, policy, args.seed + k))
+        episodes.append(play(args.seed + k))
         bar.set_postfix(success=f"{sum(e['success'] for e in episodes)}/{len(episodes)}")
     env.close()
     rate = sum(e["success"] for e in episodes) / len(episodes)
     if args.json:
         print(json.dumps({"task": env.manifest.task, "robot": env.manifest.robot_name, "policy": args.policy,
+                          **({"human_policy": args.human_policy} if args.coop else {}),
                           "term_weights": weights, "episodes": episodes, "success_rate": rate,
                           "mean_return": float(np.mean([e["return"] for e in episodes]))}, indent=1))
         return 0
-    print(f"{env.manifest.gym_id}  policy={args.policy}  episodes={len(episodes)}  seed={args.seed}")
+    print(f"{env.manifest.gym_id}  policy={args.policy}{f'  human-policy={args.human_policy}' if args.coop else ''}  episodes={len(episodes)}  seed={args.seed}")
     print(f"{'ep':>3} {'seed':>5} {'return':>9} {'success':>7}  largest weighted terms (episode sums)")
     for k, e in enumerate(episodes):
         top = sorted(e["terms"].items(), key=lambda kv: -abs(weights[kv[0]] * kv[1]))[:3]
@@ -266,11 +270,29 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
     }
 
 
+_BENCH_COOP_TABLE = ("task", "robot", "single_agent_env_steps_per_s", "multi_agent_env_steps_per_s", "multi_over_single")
 _BENCH_TABLE = ("task", "robot", "env_steps_per_s", "raw_physics_steps_per_s", "reset_ms_median", "reference_env_steps_per_s", "vs_reference")
 
 
+def bench_coop_spec(spec: str, robot: str | None, steps: int, repeats: int, seed: int) -> dict:
+    """``bench --coop``: single- and multi-agent env steps/s of the spec's artifact in one run
+    (:func:`assistive_compiler.coop.bench_coop`), compiled into a temporary directory."""
+    import tempfile
+
+    from .compile.compiler import compile_task
+    from .coop import bench_coop, check_coop_spec
+    from .spec.load import load_spec
+
+    check_coop_spec(load_spec(spec))
+    with tempfile.TemporaryDirectory() as tmp:
+        return bench_coop(compile_task(spec, robot, Path(tmp) / "coop").out_dir, steps=steps, repeats=repeats, seed=seed)
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
-    results = [bench(spec, args.robot, args.steps, args.resets, args.repeats, args.seed) for spec in args.specs]
+    if args.coop:
+        results = [bench_coop_spec(spec, args.robot, args.steps, args.repeats, args.seed) for spec in args.specs]
+    else:
+        results = [bench(spec, args.robot, args.steps, args.resets, args.repeats, args.seed) for spec in args.specs]
     if args.json:
         print(json.dumps(results[0] if len(results) == 1 else results, indent=1))
         return 0
@@ -280,8 +302,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
             print(f"{key:<{width}}  {value}")
         return 0
     # Several tasks: one row each (taken one after the other in this run; medians over repeats).
-    rows = [list(_BENCH_TABLE)] + [["-" if r[k] is None else str(r[k]) for k in _BENCH_TABLE] for r in results]
-    widths = [max(len(row[i]) for row in rows) for i in range(len(_BENCH_TABLE))]
+    columns = _BENCH_COOP_TABLE if args.coop else _BENCH_TABLE
+    rows = [list(columns)] + [["-" if r[k] is None else str(r[k]) for k in columns] for r in results]
+    widths = [max(len(row[i]) for row in rows) for i in range(len(columns))]
     for row in rows:
         print("  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip())
     return 0
@@ -448,6 +471,9 @@ def add_commands(sub) -> None:
     p.add_argument("--out", help="artifact directory (default generated/<task>-<robot>)")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--coop", action="store_true", help="co-optimisation: the person acts too (by --human-policy), shared reward")
+    p.add_argument("--human-policy", dest="human_policy", choices=HUMAN_POLICIES, default="random",
+                   help="with --coop: random, zero (keep still by acting) or hold (no human action: the static person); default random")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("render", help="write a GIF (or a PNG strip) of one episode, headless")
@@ -466,6 +492,7 @@ def add_commands(sub) -> None:
     p.add_argument("--steps", type=int, default=400, help="env steps per repeat")
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--resets", type=int, default=100)
+    p.add_argument("--coop", action="store_true", help="multi-agent (PettingZoo, both agents acting) vs single-agent env steps/s, in one run")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_bench)
 

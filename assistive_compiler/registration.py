@@ -57,12 +57,17 @@ def shipped_ids() -> dict[str, tuple[Path, str]]:
     return {env_id: (t.spec, robot) for t in shipped_tasks() for robot, env_id in zip(t.robots, t.ids)}
 
 
+def cached_artifact_dir(spec: str | Path, robot: str) -> Path:
+    """Where an env made by name compiles ``spec`` for ``robot``: ``$ASSISTIVE_COMPILER_CACHE/<task>-<robot>``
+    (shared by the Gymnasium id and the co-optimisation name of the same task and robot)."""
+    return cache_dir() / f"{Path(spec).stem}-{robot}"
+
+
 def make_env(spec: str, robot: str, **kwargs):
     """Entry point of registered ids: compile (cached) into the artifact cache and build the env."""
     from .runtime.env import AssistiveEnv
 
-    name = Path(spec).stem
-    return AssistiveEnv.from_spec(spec, robot=robot, out_dir=cache_dir() / f"{name}-{robot}", **kwargs)
+    return AssistiveEnv.from_spec(spec, robot=robot, out_dir=cached_artifact_dir(spec, robot), **kwargs)
 
 
 def register_all() -> list[str]:

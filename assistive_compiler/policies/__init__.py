@@ -7,6 +7,8 @@ from typing import Callable
 import numpy as np
 
 POLICIES = ("random", "zero", "scripted")
+#: The person's policies in co-optimisation (see :mod:`assistive_compiler.coop.policies`).
+HUMAN_POLICIES = ("random", "zero", "hold")
 
 
 def make_policy(name: str, env, seed: int = 0) -> Callable[[np.ndarray], np.ndarray]:

@@ -210,12 +210,14 @@ class PersonController:
                 self._base = np.array([self.hold[k] for k in self._pol])
             self._acting = False
         else:
-            a = np.clip(np.asarray(action, dtype=np.float64).reshape(-1), -1.0, 1.0)
+            a = np.asarray(action, dtype=np.float64).reshape(-1)
             if a.shape != (len(self.policy_idx),):
                 raise ValueError(f"human action must have shape ({len(self.policy_idx)},), got {a.shape}")
+            # np.minimum/np.maximum: np.clip's result without its call overhead (as the robot's action in env.py).
+            a = np.minimum(np.maximum(a, -1.0), 1.0)
             q = np.array([s[0] for s in pb.getJointStates(self.body_id, self.policy_idx, physicsClientId=c)])
-            base = np.where(self._pol_tremor, self._base, q)
-            target = np.clip(base + self.delta_scale * a, self._pol_lower, self._pol_upper)
+            base = np.where(self._pol_tremor, self._base, q) if self._tremor else q
+            target = np.minimum(np.maximum(base + self.delta_scale * a, self._pol_lower), self._pol_upper)
             self._base = target
             command = target + sign * self._pol_eps
             pb.setJointMotorControlArray(self.body_id, self.policy_idx, pb.POSITION_CONTROL, targetPositions=command.tolist(),

@@ -1,0 +1,50 @@
+"""Policies for one agent of a co-optimisation env, by name or given: ``obs -> action``.
+
+Robot: ``random``, ``zero``, ``scripted`` (the task's IK baseline). Human: ``random``, ``zero``
+(the person keeps its policy joints where they are: a zero delta each step) and ``hold`` (no
+human action at all: the static person of the single-agent task, ``step_agents(·, None)``).
+A callable ``obs -> action`` or an object with Stable-Baselines3's ``predict(obs, deterministic)``
+(a trained model) is used as it is.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+import numpy as np
+
+from ..policies import HUMAN_POLICIES, POLICIES
+
+__all__ = ["ROBOT_POLICIES", "HUMAN_POLICIES", "agent_policy"]
+
+ROBOT_POLICIES = POLICIES
+
+Policy = Callable[[np.ndarray], "np.ndarray | None"]
+
+
+def agent_policy(env, agent: str, policy: Any, seed: int = 0) -> Policy:
+    """``obs -> action`` for ``agent`` ('robot' or 'human') of ``env`` (an
+    :class:`~assistive_compiler.coop.parallel.AssistiveParallelEnv`). ``random`` draws from its own
+    generator seeded with ``seed`` (the env's spaces are left alone)."""
+    if agent not in ("robot", "human"):
+        raise ValueError(f"agent must be 'robot' or 'human', got {agent!r}")
+    if isinstance(policy, str):
+        names = ROBOT_POLICIES if agent == "robot" else HUMAN_POLICIES
+        if policy not in names:
+            raise ValueError(f"unknown {agent} policy '{policy}'; expected one of {', '.join(names)}")
+        shape = env.action_space(agent).shape
+        if policy == "hold":
+            return lambda obs: None
+        if policy == "zero":
+            return lambda obs: np.zeros(shape, dtype=np.float32)
+        if policy == "scripted":
+            from ..policies import make_policy
+
+            return make_policy("scripted", env.env)
+        rng = np.random.default_rng(seed)
+        return lambda obs: rng.uniform(-1.0, 1.0, shape).astype(np.float32)
+    if callable(getattr(policy, "predict", None)):  # a trained model (Stable-Baselines3's interface)
+        return lambda obs: policy.predict(obs, deterministic=True)[0]
+    if callable(policy):
+        return policy
+    raise TypeError(f"a {agent} policy must be a name, a callable obs -> action or a model with predict(), got {type(policy).__name__}")

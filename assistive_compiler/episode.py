@@ -1,0 +1,33 @@
+"""One episode's summary, shared by the single-agent and the co-optimisation rollouts."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class EpisodeTally:
+    """Sums an episode's rewards and each term's unweighted values (the reward is Σ weight ×
+    value), and averages the contact force on the person (N), from each step's reward and info."""
+
+    def __init__(self) -> None:
+        self.total = 0.0
+        self.terms: dict[str, float] = {}
+        self.forces: list[float] = []
+        self.info: dict = {}
+
+    def add(self, reward: float, info: dict) -> None:
+        self.total += reward
+        for name, value in info["terms"].items():
+            self.terms[name] = self.terms.get(name, 0.0) + value
+        self.forces.append(info["total_force_on_human"])
+        self.info = info
+
+    def summary(self, seed: int) -> dict:
+        return {
+            "seed": seed,
+            "return": self.total,
+            "success": bool(self.info["task_success"]),
+            "success_metric": self.info["success_metric"],
+            "mean_force_on_human_n": float(np.mean(self.forces)),
+            "terms": self.terms,
+        }
