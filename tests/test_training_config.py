@@ -97,10 +97,13 @@ def test_unknown_engine_is_refused_with_a_suggestion(capsys):
 def test_coop_on_a_task_without_human_policy_joints_is_refused(capsys, tmp_path):
     code, err = run_cli(["train", str(REACH), "--config", "ppo_quick", "--coop", "--out", str(tmp_path / "run")], capsys)
     assert code == 2 and not (tmp_path / "run").exists()
-    assert err.strip().endswith(
-        "reach.yaml:1:1: --coop: task 'reach' gives the person no policy joints (person.control.policy_joints is empty), "
-        "so there is no human agent to co-optimise; train without --coop"
-    )
+    from assistive_compiler.paths import display
+
+    text, name = REACH.read_text(), display(REACH)
+    lines = err.strip().splitlines()
+    assert lines[0] == (f"{name}:{at(text, 'variants:')}: person.control.policy_joints: the person controls no joints, so it cannot be "
+                        "a co-optimisation agent; list the joint groups a human policy moves, e.g. [person.head] or [person.right_arm]")
+    assert lines[1].startswith(f"{name}:{at(text, 'robot:', 2)}: observations.human: the person observes nothing")
 
 
 def test_evaluate_on_a_directory_that_is_not_a_run(capsys, tmp_path):

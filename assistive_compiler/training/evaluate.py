@@ -49,10 +49,17 @@ def evaluate(run_dir: str | Path, episodes: int | None = None, seed: int = 0, re
     info = run.info()
     steps, checkpoint = latest_checkpoint(run)
     episodes = episodes or info.training_config.eval_episodes
-    env = AssistiveEnv(run.artifact)
-    policy = load_policy(run, info, checkpoint, env)
-    target, act = (env, policy) if not info.coop else _both(env, policy)
-    results = [rollout(target, act, seed + k) for k in range(episodes)]
+    if info.coop:
+        from ..coop.parallel import AssistiveParallelEnv
+        from ..coop.rollout import rollout_coop
+
+        env = AssistiveParallelEnv(run.artifact)
+        policy = load_policy(run, info, checkpoint, env)
+        results = [rollout_coop(env, policy.agent("robot"), policy.agent("human"), seed + k) for k in range(episodes)]
+    else:
+        env = AssistiveEnv(run.artifact)
+        policy = load_policy(run, info, checkpoint, env)
+        results = [rollout(env, policy, seed + k) for k in range(episodes)]
     env.close()
     mean_r, std_r = _stats([e["return"] for e in results])
     mean_f, std_f = _stats([e["mean_force_on_human_n"] for e in results])

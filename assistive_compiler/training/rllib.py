@@ -67,10 +67,11 @@ def init_ray(address: str | None, envs: int) -> None:
     """Attach to ``address``, or start a local Ray instance (unless one is already running)."""
     import ray
 
+    if address:
+        check_address(address)
     if ray.is_initialized():
         return
     if address:
-        check_address(address)
         # Something answers at the address; give Ray a few seconds (not its default 20) to find a
         # cluster there. The variable is read when connecting, by this process only.
         previous = os.environ.get(GCS_WAIT_VAR)
@@ -230,6 +231,10 @@ class RLlibPolicy:
             out = self.modules[name].forward_inference({"obs": torch.as_tensor(obs, dtype=torch.float32)[None]})
         dist = out["action_dist_inputs"][0].numpy()
         return dist[: dist.shape[0] // 2]  # a diagonal Gaussian's inputs: means, then log-stds
+
+    def agent(self, name: str):
+        """One co-optimised agent's policy, ``obs -> action``."""
+        return lambda obs: self._act(name, obs)
 
     def __call__(self, obs: np.ndarray, human_obs: np.ndarray | None = None):
         if self.coop:

@@ -39,14 +39,12 @@ def compile_for_run(spec: str, robot: str | None, coop: bool):
     from ..spec.load import load_spec
 
     loaded = load_spec(spec)
+    if coop:
+        from ..coop.parallel import check_coop_spec
+
+        check_coop_spec(loaded)  # located: the person must control joints and observe something
     robot = robot or loaded.spec.robot.default
     result = compile_task(spec, robot, cache_dir() / f"{loaded.spec.name}-{robot}")
-    if coop and not result.manifest.person.policy_joints:
-        raise SpecError.at(
-            display(Path(spec)),
-            f"--coop: task '{loaded.spec.name}' gives the person no policy joints (person.control.policy_joints is empty), "
-            "so there is no human agent to co-optimise; train without --coop",
-        )
     return result, robot
 
 
