@@ -4,8 +4,7 @@ The driver is :func:`.compiler.compile_task` (cache check, atomic write, hashes)
 stages in order (:func:`.compiler.build`):
 
 1. :mod:`.emit` — render the robot, furniture and tools from their xacro templates, lint
-   (:mod:`.lint`) and write them; the robot's undriven joints welded (:mod:`.robot_welds`,
-   :func:`.merge.weld_joints`).
+   (:mod:`.lint`) and write them; the robot's undriven joints welded (:mod:`.weld`).
 2. :mod:`.placement.settle_person` — a supine person settles limp onto the furniture; its
    settled angles become its posture.
 3. :mod:`.emit` — each person variant, the joints the task never moves baked at the posture.

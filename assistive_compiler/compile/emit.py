@@ -1,7 +1,7 @@
 """Stage 1: emit the scene's URDFs from their templates (render, lint, write).
 
 :func:`emit_props` takes a resolved task, the artifact's ``urdf/`` directory and the library, and
-writes the robot (every joint the task does not drive welded: :mod:`.robot_welds`), the present
+writes the robot (every joint the task does not drive welded: :mod:`.weld`), the present
 furniture and the tools; it returns an :class:`EmittedScene`. :func:`emit_people` then writes one
 person per variant, the joints the task never moves baked into fixed joints at the posture
 (rad) — which, for a supine person, the settle (:mod:`.placement.settle_person`) decides, so it
@@ -21,9 +21,8 @@ from ..paths import display, templates_dir
 from ..person.body import format_fixed_joints
 from ..resolve import ResolvedTask
 from .lint import lint_urdf
-from .merge import weld_joints
+from .weld import robot_welds, weld_joints
 from .render import render_template
-from .robot_welds import robot_welds
 from .task import impairment_joints, mounted_on, observed_person_joints, policy_joints, present_furniture
 
 
