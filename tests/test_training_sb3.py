@@ -19,7 +19,7 @@ import pytest
 from PIL import Image
 
 from assistive_compiler.cli import main
-from assistive_compiler.cli_run import rollout
+from assistive_compiler.cli.run import rollout
 from assistive_compiler.policies import make_policy
 from assistive_compiler.runtime.env import AssistiveEnv
 from assistive_compiler.training.evaluate import evaluate

@@ -42,7 +42,7 @@ def _stats(values: list[float]) -> tuple[float, float]:
 
 def evaluate(run_dir: str | Path, episodes: int | None = None, seed: int = 0, render: str | None = None) -> dict:
     """Evaluate the run's newest checkpoint; optionally write a rollout (``render``: .gif or .png)."""
-    from ..cli_run import rollout
+    from ..cli.run import rollout
     from ..runtime.env import AssistiveEnv
 
     run = RunDir(run_dir)
@@ -101,7 +101,7 @@ def _both(env, policy):
 
 def render_rollout(run: RunDir, info: RunInfo, checkpoint: Path, seed: int, out: Path, every: int = 2) -> str:
     """Write one rollout of the trained policy as a GIF (or a PNG strip); returns a line saying so."""
-    from ..cli_run import record, write_picture
+    from ..cli.render import record, write_picture
     from ..runtime.env import AssistiveEnv
 
     env = AssistiveEnv(run.artifact, render_mode="rgb_array")

@@ -101,19 +101,3 @@ class Progress:
         self.bar.close()
         self.writer.close()
         self._csv.close()
-
-
-class EpisodeSums:
-    """Per-env running sums of each term's unweighted value, for envs that run side by side."""
-
-    def __init__(self, n_envs: int):
-        self.sums: list[dict[str, float]] = [{} for _ in range(n_envs)]
-
-    def add(self, i: int, terms: dict[str, float]) -> None:
-        acc = self.sums[i]
-        for name, value in terms.items():
-            acc[name] = acc.get(name, 0.0) + value
-
-    def pop(self, i: int) -> dict[str, float]:
-        out, self.sums[i] = self.sums[i], {}
-        return out

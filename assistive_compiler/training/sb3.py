@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from .config import TrainingConfig
-from .progress import EpisodeSums, Progress
+from ..episode import EpisodeTally
+from .progress import Progress
 from .run_dir import RunDir
 
 ACTIVATIONS = {"tanh": "Tanh", "relu": "ReLU"}
@@ -93,7 +94,7 @@ def _callback(run: RunDir, progress: Progress, config: TrainingConfig, n_envs: i
 
         def __init__(self) -> None:
             super().__init__()
-            self.sums = EpisodeSums(n_envs)
+            self.tallies = [EpisodeTally() for _ in range(n_envs)]
             self.next_checkpoint = 0
 
         def _on_training_start(self) -> None:
@@ -102,9 +103,11 @@ def _callback(run: RunDir, progress: Progress, config: TrainingConfig, n_envs: i
 
         def _on_step(self) -> bool:
             for i, (info, done) in enumerate(zip(self.locals["infos"], self.locals["dones"])):
-                self.sums.add(i, info["terms"])
+                # The rewards SB3 sees may be normalised: the episode's return is the Monitor's.
+                self.tallies[i].add(0.0, info)
                 if done:
-                    progress.episode(info["episode"]["r"], info["task_success"], self.sums.pop(i))
+                    tally, self.tallies[i] = self.tallies[i], EpisodeTally()
+                    progress.episode(info["episode"]["r"], info["task_success"], tally.terms)
             return True
 
         def _on_rollout_end(self) -> None:
