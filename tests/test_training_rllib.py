@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from PIL import Image
 
 from assistive_compiler.cli import main
 from assistive_compiler.training.evaluate import evaluate
@@ -58,8 +59,10 @@ def test_multi_agent_ppo_iteration_checkpoint_resume_evaluate(local_ray, tmp_pat
     rows = (out / "curve.csv").read_text().splitlines()
     assert [int(r.split(",")[0]) for r in rows[1:]] == [200, 400]
 
-    result = evaluate(out, episodes=1, seed=0)
+    strip = tmp_path / "coop.png"
+    result = evaluate(out, episodes=1, seed=0, render=str(strip))
     assert result["engine"] == "rllib" and result["coop"] and result["trained_steps"] == 400
+    assert Image.open(strip).size == (4 * 480, 360)  # a rollout of both trained policies, as a strip of 4 frames
     assert np.isfinite(result["mean_return"]) and result["per_episode"][0]["seed"] == 0
     assert evaluate(out, episodes=1, seed=0)["mean_return"] == result["mean_return"]  # deterministic for a seed
     summary = json.loads((out / "summary.json").read_text())
