@@ -4,9 +4,6 @@ by the package or the CLI parser."""
 
 from __future__ import annotations
 
-import json
-import subprocess
-import sys
 from pathlib import Path
 
 import jsonschema
@@ -110,17 +107,6 @@ def test_evaluate_on_a_directory_that_is_not_a_run(capsys, tmp_path):
     code, err = run_cli(["evaluate", str(tmp_path)], capsys)
     assert code == 2
     assert err.strip() == f"error: {tmp_path}: not a run directory (no run.json); `assistive-compiler train` writes one"
-
-
-def test_the_cli_parser_and_package_import_nothing_heavy():
-    code = (
-        "import sys\n"
-        "from assistive_compiler.cli import build_parser\n"
-        "build_parser().parse_args(['train', 'x.yaml', '--config', 'ppo_quick'])\n"
-        "print(sorted(m for m in ('torch', 'ray', 'stable_baselines3', 'matplotlib', 'tensorboard') if m in sys.modules))\n"
-    )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert json.loads(out.strip().replace("'", '"')) == []
 
 
 def test_the_reach_example_is_not_a_registered_id():
