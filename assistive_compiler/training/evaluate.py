@@ -25,12 +25,12 @@ def latest_checkpoint(run: RunDir) -> tuple[int, Path]:
     return found
 
 
-def load_policy(run: RunDir, info: RunInfo, checkpoint: Path, env):
+def load_policy(info: RunInfo, checkpoint: Path):
     """The run's policy as ``obs -> action`` (co-optimised runs: ``(robot_obs, human_obs) -> (a_r, a_h)``)."""
     if info.engine == "sb3":
         from .sb3 import SB3Policy
 
-        return SB3Policy(checkpoint, env)
+        return SB3Policy(checkpoint)
     from .rllib import RLlibPolicy
 
     return RLlibPolicy(checkpoint, coop=info.coop)
@@ -49,16 +49,15 @@ def evaluate(run_dir: str | Path, episodes: int | None = None, seed: int = 0, re
     info = run.info()
     steps, checkpoint = latest_checkpoint(run)
     episodes = episodes or info.training_config.eval_episodes
+    policy = load_policy(info, checkpoint)
     if info.coop:
         from ..coop.parallel import AssistiveParallelEnv
         from ..coop.rollout import rollout_coop
 
         env = AssistiveParallelEnv(run.artifact)
-        policy = load_policy(run, info, checkpoint, env)
         results = [rollout_coop(env, policy.agent("robot"), policy.agent("human"), seed + k) for k in range(episodes)]
     else:
         env = AssistiveEnv(run.artifact)
-        policy = load_policy(run, info, checkpoint, env)
         results = [rollout(env, policy, seed + k) for k in range(episodes)]
     env.close()
     mean_r, std_r = _stats([e["return"] for e in results])
@@ -105,7 +104,7 @@ def render_rollout(run: RunDir, info: RunInfo, checkpoint: Path, seed: int, out:
     from ..runtime.env import AssistiveEnv
 
     env = AssistiveEnv(run.artifact, render_mode="rgb_array")
-    policy = load_policy(run, info, checkpoint, env)
+    policy = load_policy(info, checkpoint)
     target, act = (env, policy) if not info.coop else _both(env, policy)
     frames, summary = record(target, act, seed, every)
     env.close()

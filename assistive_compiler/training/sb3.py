@@ -165,7 +165,7 @@ def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, res
 class SB3Policy:
     """A trained SB3 policy as a function of raw observations (normalised as during training)."""
 
-    def __init__(self, checkpoint: Path, env):
+    def __init__(self, checkpoint: Path):
         from stable_baselines3 import PPO
 
         self.model = PPO.load(str(checkpoint / "model.zip"), device="cpu")
