@@ -72,7 +72,11 @@ def train(spec: str, *, robot: str | None, config_path: str, coop: bool = False,
     run = RunDir(out or default_run_dir(manifest.task, robot, coop, config.seed))
     if resume:
         info = check_resumable(run, manifest.content_hash, robot, coop, engine)
-        config = info.training_config.with_overrides(steps=steps)
+        resumed = info.training_config
+        for flag, given, kept in (("--seed", seed, resumed.seed), ("--envs", envs, resumed.envs)):
+            if given is not None and given != kept:
+                raise UsageError(f"{flag} {given}: --resume continues the run with its own config ({flag} {kept}); only --steps may change")
+        config = resumed.with_overrides(steps=steps)
     elif run.exists():
         raise UsageError(f"{display(run.path)}: the run directory already holds a run; pass --resume to continue it, or choose another --out")
     else:
