@@ -129,7 +129,8 @@ def test_resume_refuses_a_run_of_another_spec(reach_run, tmp_path, capsys):
     assert f"{copy / 'run.json'}:1:1: --resume: this run trained a different compiled task" in err
 
 
-def test_ctrl_c_leaves_a_resumable_checkpoint(tmp_path):
+@pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
+def test_ctrl_c_or_sigterm_leaves_a_resumable_checkpoint(tmp_path, stop):
     out = tmp_path / "interrupted"
     proc = subprocess.Popen([sys.executable, "-m", "assistive_compiler.cli", "train", str(REACH), "--config", "ppo_quick",
                              "--envs", "1", "--steps", "1000000", "--out", str(out), "--quiet"],
@@ -137,7 +138,7 @@ def test_ctrl_c_leaves_a_resumable_checkpoint(tmp_path):
     deadline = time.time() + 120
     while time.time() < deadline and not ((out / "curve.csv").is_file() and len((out / "curve.csv").read_text().splitlines()) > 1):
         time.sleep(0.5)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(stop)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
     assert "interrupted: checkpoint written; continue with the same command and --resume" in err

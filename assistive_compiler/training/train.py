@@ -7,7 +7,10 @@ co-optimisation with policies ``robot`` and ``human``, or any run on a Ray clust
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import sys
+import threading
 from pathlib import Path
 
 from ..errors import SpecError, UsageError
@@ -88,15 +91,34 @@ def train(spec: str, *, robot: str | None, config_path: str, coop: bool = False,
         print(f"{manifest.gym_id}{' + human (co-optimisation)' if coop else ''}: {engine} PPO, {config.envs} envs, "
               f"{config.total_steps:,} steps -> {display(run.path)}", file=sys.stderr)
         print_reward_table(weights, manifest.task)
-    if engine == "sb3":
-        from . import sb3
+    with sigterm_as_interrupt():
+        if engine == "sb3":
+            from . import sb3
 
-        figures = sb3.train(run, config, weights, resume=resume, quiet=quiet)
-    else:
-        from . import rllib
+            figures = sb3.train(run, config, weights, resume=resume, quiet=quiet)
+        else:
+            from . import rllib
 
-        figures = rllib.train(run, config, weights, coop=coop, resume=resume, address=address, quiet=quiet)
+            figures = rllib.train(run, config, weights, coop=coop, resume=resume, address=address, quiet=quiet)
     return finish(run, manifest, engine, config, figures)
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt():
+    """While training, SIGTERM (a scheduler's or ``kill``'s stop) acts like Ctrl-C: the engine
+    writes a checkpoint and returns. Only the main thread can install signal handlers."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def finish(run: RunDir, manifest, engine: str, config: TrainingConfig, figures: dict) -> dict:
