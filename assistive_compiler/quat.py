@@ -4,6 +4,8 @@ the simulator."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -39,6 +41,29 @@ def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         aw * bz + ax * by - ay * bx + az * bw,
         aw * bw - ax * bx - ay * by - az * bz,
     ])
+
+
+def quat_from_rpy(rpy: tuple[float, float, float]) -> tuple[float, float, float, float]:
+    """Quaternion (x, y, z, w) of fixed-axis roll, pitch, yaw (rad; URDF convention R = Rz·Ry·Rx)."""
+    r, p, y = (a / 2 for a in rpy)
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return (
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+        cr * cp * cy + sr * sp * sy,
+    )
+
+
+def quat_from_rpy_deg(rpy_deg) -> tuple[float, float, float, float]:
+    """:func:`quat_from_rpy` of angles in degrees (a spec's ``rpy_deg``)."""
+    return quat_from_rpy(tuple(math.radians(a) for a in rpy_deg))
+
+
+def quat_yaw(orn) -> float:
+    """Yaw (rad, about world z) of a quaternion (x, y, z, w)."""
+    x, y, z, w = orn
+    return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
 
 def capsule_axes(start, end) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:

@@ -18,7 +18,8 @@ import numpy as np
 import pybullet as pb
 import pytest
 
-from assistive_compiler.compile.compiler import compile_task, person_self_collision
+from assistive_compiler.compile.compiler import compile_task
+from assistive_compiler.compile.self_collision import person_self_collision
 from assistive_compiler.person.body import SELF_COLLISION_GROUPS, self_collision_pairs
 from assistive_compiler.runtime.env import AssistiveEnv
 

@@ -13,7 +13,7 @@ import pybullet as pb
 import pytest
 
 from assistive_compiler.compile.compiler import compile_task
-from assistive_compiler.compile.merge import weld_joints
+from assistive_compiler.compile.weld import weld_joints
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -29,9 +29,8 @@ were computed from: the 6e-17 that 1 - 1 leaves) are written as 0, and every flo
 with ``repr``. Elements that are not touched keep their text. The output
 is deterministic: same input, same bytes.
 
-`weld_joints` turns moving joints into ``fixed`` ones at given values (a robot's fingers at the
-task's grip): the joint's origin becomes ``T_J * motion(axis, value)`` and its motion elements
-(``<axis>``, ``<limit>``, ``<dynamics>``, ...) are dropped. Same number rules and output.
+Its frame arithmetic (:class:`Pose`, :func:`origin_pose`, :func:`write_origin`) also serves
+:mod:`.weld`.
 
 Pure Python + numpy + ``xml.etree``; no pybullet.
 """
@@ -41,12 +40,12 @@ from __future__ import annotations
 import copy
 import math
 import xml.etree.ElementTree as ET
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["MergedFrame", "merge_fixed_links", "weld_joints"]
+__all__ = ["MergedFrame", "Pose", "merge_fixed_links", "origin_pose", "parse_vector", "reindent", "write_origin"]
 
 _SIGNIFICANT_DIGITS = 12
 _RELATIVE_ZERO = 1e-12
@@ -128,7 +127,7 @@ def _matrix_quat(rot: np.ndarray) -> tuple[float, float, float, float]:
     return tuple(float(v) + 0.0 for v in q)  # type: ignore[return-value]
 
 
-class _Pose:
+class Pose:
     """A rigid transform (rotation ``rot``, translation ``pos``). ``scale`` bounds the size of
     the translations it was computed from, so that rounding noise left by cancellation (1 - 1 =
     6e-17) can be told from a real offset."""
@@ -141,17 +140,17 @@ class _Pose:
         self.scale = float(np.abs(pos).max()) if scale is None else scale
 
     @staticmethod
-    def identity() -> _Pose:
-        return _Pose(np.eye(3), np.zeros(3))
+    def identity() -> Pose:
+        return Pose(np.eye(3), np.zeros(3))
 
-    def __mul__(self, other: _Pose) -> _Pose:
-        return _Pose(self.rot @ other.rot, self.rot @ other.pos + self.pos, self.scale + other.scale)
+    def __mul__(self, other: Pose) -> Pose:
+        return Pose(self.rot @ other.rot, self.rot @ other.pos + self.pos, self.scale + other.scale)
 
 
 # --------------------------------------------------------------------------- number I/O
 
 
-def _parse_vector(text: str | None, what: str) -> np.ndarray:
+def parse_vector(text: str | None, what: str) -> np.ndarray:
     if text is None:
         return np.zeros(3)
     parts = text.split()
@@ -175,13 +174,13 @@ def _parse_scalar(elem: ET.Element, attr: str, what: str) -> float:
     return value
 
 
-def _origin_pose(parent: ET.Element, what: str) -> _Pose:
+def origin_pose(parent: ET.Element, what: str) -> Pose:
     origin = parent.find("origin")
     if origin is None:
-        return _Pose.identity()
-    xyz = _parse_vector(origin.get("xyz"), f"{what} <origin xyz>")
-    rpy = _parse_vector(origin.get("rpy"), f"{what} <origin rpy>")
-    return _Pose(_rpy_matrix(rpy), xyz)
+        return Pose.identity()
+    xyz = parse_vector(origin.get("xyz"), f"{what} <origin xyz>")
+    rpy = parse_vector(origin.get("rpy"), f"{what} <origin rpy>")
+    return Pose(_rpy_matrix(rpy), xyz)
 
 
 def _round(value: float) -> float:
@@ -200,7 +199,7 @@ def _fmt(values: Sequence[float]) -> str:
     return " ".join(repr(v) for v in values)
 
 
-def _write_origin(parent: ET.Element, pose: _Pose, *, index: int = 0) -> None:
+def write_origin(parent: ET.Element, pose: Pose, *, index: int = 0) -> None:
     """Replace (or insert at ``index``) ``parent``'s ``<origin>`` with ``pose``."""
     origin = parent.find("origin")
     if origin is None:
@@ -221,7 +220,7 @@ def _read_inertial(link: ET.Element, name: str) -> tuple[float, np.ndarray, np.n
     if inertial is None:
         return None
     what = f"link {name!r} <inertial>"
-    pose = _origin_pose(inertial, what)
+    pose = origin_pose(inertial, what)
     mass_elem = inertial.find("mass")
     mass = 0.0 if mass_elem is None else _parse_scalar(mass_elem, "value", f"{what} <mass>")
     inertia_elem = inertial.find("inertia")
@@ -266,7 +265,7 @@ def _combined_inertial(parts: list[tuple[float, np.ndarray, np.ndarray]]) -> ET.
 # --------------------------------------------------------------------------- formatting
 
 
-def _reindent(elem: ET.Element, level: int = 0) -> None:
+def reindent(elem: ET.Element, level: int = 0) -> None:
     """Two-space indentation, whitespace-only text dropped (moved elements carry odd tails)."""
     pad = "\n" + "  " * (level + 1)
     children = list(elem)
@@ -276,7 +275,7 @@ def _reindent(elem: ET.Element, level: int = 0) -> None:
         if elem.text is None:
             elem.text = pad
         for child in children:
-            _reindent(child, level + 1)
+            reindent(child, level + 1)
             if child.tail is None or not child.tail.strip():
                 child.tail = pad
         children[-1].tail = "\n" + "  " * level
@@ -285,6 +284,25 @@ def _reindent(elem: ET.Element, level: int = 0) -> None:
 
 
 # --------------------------------------------------------------------------- the merge
+
+
+@dataclass
+class _Tree:
+    """A URDF document's tree: links by name, joints in document order, each link's parent joint
+    and child joints, the root link, and the links the merge must keep."""
+
+    root: ET.Element
+    links: dict[str, ET.Element]
+    joints: list[ET.Element]
+    parent_joint: dict[str, ET.Element]  # child link -> its joint
+    child_joints: dict[str, list[ET.Element]]
+    root_link: str
+    keep: set[str]
+
+    def merged(self, name: str) -> bool:
+        """Whether link ``name`` is merged into its parent: its joint is fixed and it is not kept."""
+        joint = self.parent_joint.get(name)
+        return joint is not None and joint.get("type") == "fixed" and name not in self.keep
 
 
 def merge_fixed_links(
@@ -302,6 +320,24 @@ def merge_fixed_links(
     one root link), when a number it needs is not finite, or when ``keep`` names a link the
     document lacks.
     """
+    tree = _parse_tree(urdf_xml, set(keep))
+    survivor, in_survivor = _survivors(tree)
+    for name, absorbed in _merged_order(tree).items():
+        _absorb(tree, name, absorbed, in_survivor)
+    _drop_merged(tree, survivor, in_survivor)
+    frames = {}
+    for name in tree.links:
+        if tree.merged(name):
+            pose = in_survivor[name]
+            xyz = tuple(float(v) + 0.0 for v in pose.pos)
+            frames[name] = MergedFrame(survivor[name], xyz, _matrix_quat(pose.rot))  # type: ignore[arg-type]
+    reindent(tree.root)
+    text = '<?xml version="1.0"?>\n' + ET.tostring(tree.root, encoding="unicode") + "\n"
+    return text, frames
+
+
+def _parse_tree(urdf_xml: str, keep_set: set[str]) -> _Tree:
+    """The document's tree; ValueError when it is not one (see :func:`merge_fixed_links`)."""
     try:
         root = ET.fromstring(urdf_xml)
     except ET.ParseError as exc:
@@ -317,7 +353,6 @@ def merge_fixed_links(
         if name in links:
             raise ValueError(f"link name {name!r} is used twice")
         links[name] = link
-    keep_set = set(keep)
     unknown = sorted(keep_set - set(links))
     if unknown:
         raise ValueError(f"keep names links the document lacks: {', '.join(unknown)}")
@@ -346,161 +381,103 @@ def merge_fixed_links(
     roots = [name for name in links if name not in parent_joint]
     if len(roots) != 1:
         raise ValueError(f"expected exactly one root link, found {len(roots)}: {roots}")
-    root_link = roots[0]
+    return _Tree(root, links, joints, parent_joint, child_joints, roots[0], keep_set)
 
-    # Walk the tree from the root (joint document order): depth-first order for each surviving
-    # link's merged descendants, and the pose of each merged link in its surviving link.
-    def merged(name: str) -> bool:
-        joint = parent_joint.get(name)
-        return joint is not None and joint.get("type") == "fixed" and name not in keep_set
 
+def _survivors(tree: _Tree) -> tuple[dict[str, str], dict[str, Pose]]:
+    """Walk the tree from the root (joint document order): each link's surviving link and its
+    pose there (identity for a survivor). ValueError for links not reachable from the root."""
+    root_link = tree.root_link
     survivor: dict[str, str] = {root_link: root_link}
-    in_survivor: dict[str, _Pose] = {root_link: _Pose.identity()}
-    merged_order: dict[str, list[str]] = {}  # surviving link -> merged links, depth-first
+    in_survivor: dict[str, Pose] = {root_link: Pose.identity()}
     visited = {root_link}
     stack = [root_link]
     while stack:
         name = stack.pop()
-        for joint in reversed(child_joints[name]):
+        for joint in reversed(tree.child_joints[name]):
             child = joint.find("child").get("link")  # type: ignore[union-attr]
             visited.add(child)
-            if merged(child):
+            if tree.merged(child):
                 jname = joint.get("name")
                 survivor[child] = survivor[name]
-                in_survivor[child] = in_survivor[name] * _origin_pose(joint, f"joint {jname!r}")
+                in_survivor[child] = in_survivor[name] * origin_pose(joint, f"joint {jname!r}")
             else:
                 survivor[child] = child
-                in_survivor[child] = _Pose.identity()
+                in_survivor[child] = Pose.identity()
             stack.append(child)
-    if len(visited) != len(links):
-        missing = [n for n in links if n not in visited]
+    if len(visited) != len(tree.links):
+        missing = [n for n in tree.links if n not in visited]
         raise ValueError(f"links on a cycle, not reachable from root {root_link!r}: {missing}")
+    return survivor, in_survivor
 
-    # Depth-first (pre-order) list of merged links per survivor, children in joint order.
+
+def _merged_order(tree: _Tree) -> dict[str, list[str]]:
+    """Surviving link -> the links merged into it, depth-first (pre-order), children in joint order."""
+
     def collect(name: str, into: list[str]) -> None:
-        for joint in child_joints[name]:
+        for joint in tree.child_joints[name]:
             child = joint.find("child").get("link")  # type: ignore[union-attr]
-            if merged(child):
+            if tree.merged(child):
                 into.append(child)
                 collect(child, into)
 
-    for name in links:
-        if not merged(name):
+    merged_order: dict[str, list[str]] = {}
+    for name in tree.links:
+        if not tree.merged(name):
             order: list[str] = []
             collect(name, order)
             if order:
                 merged_order[name] = order
+    return merged_order
 
-    # Rewrite each surviving link that absorbs others.
-    for name, absorbed in merged_order.items():
-        link = links[name]
-        parts = []
-        own = _read_inertial(link, name)
-        if own is not None:
-            parts.append(own)
-        moved: list[ET.Element] = []
-        for child in absorbed:
-            pose = in_survivor[child]
-            child_link = links[child]
-            part = _read_inertial(child_link, child)
-            if part is not None:
-                mass, com, tensor = part
-                parts.append((mass, pose.rot @ com + pose.pos, pose.rot @ tensor @ pose.rot.T))
-            for elem in child_link:
-                if elem.tag in _GEOMETRY_TAGS:
-                    new = copy.deepcopy(elem)
-                    elem_pose = _origin_pose(elem, f"link {child!r} <{elem.tag}>")
-                    _write_origin(new, pose * elem_pose)
-                    moved.append(new)
-        if len(parts) > (1 if own is not None else 0):
-            combined = _combined_inertial(parts)
-            old = link.find("inertial")
-            if old is not None:
-                index = list(link).index(old)
-                link.remove(old)
-                link.insert(index, combined)
-            else:
-                link.insert(0, combined)
-        link.extend(moved)
 
-    # Re-parent the joints of merged links; drop merged links and their joints.
-    for joint in joints:
+def _absorb(tree: _Tree, name: str, absorbed: list[str], in_survivor: dict[str, Pose]) -> None:
+    """Rewrite surviving link ``name``: one inertial for it and the ``absorbed`` links, and their
+    visuals and collisions moved into its frame."""
+    link = tree.links[name]
+    parts = []
+    own = _read_inertial(link, name)
+    if own is not None:
+        parts.append(own)
+    moved: list[ET.Element] = []
+    for child in absorbed:
+        pose = in_survivor[child]
+        child_link = tree.links[child]
+        part = _read_inertial(child_link, child)
+        if part is not None:
+            mass, com, tensor = part
+            parts.append((mass, pose.rot @ com + pose.pos, pose.rot @ tensor @ pose.rot.T))
+        for elem in child_link:
+            if elem.tag in _GEOMETRY_TAGS:
+                new = copy.deepcopy(elem)
+                elem_pose = origin_pose(elem, f"link {child!r} <{elem.tag}>")
+                write_origin(new, pose * elem_pose)
+                moved.append(new)
+    if len(parts) > (1 if own is not None else 0):
+        combined = _combined_inertial(parts)
+        old = link.find("inertial")
+        if old is not None:
+            index = list(link).index(old)
+            link.remove(old)
+            link.insert(index, combined)
+        else:
+            link.insert(0, combined)
+    link.extend(moved)
+
+
+def _drop_merged(tree: _Tree, survivor: dict[str, str], in_survivor: dict[str, Pose]) -> None:
+    """Re-parent the joints of merged links onto their survivors; drop merged links and their joints."""
+    for joint in tree.joints:
         child = joint.find("child").get("link")  # type: ignore[union-attr]
-        if merged(child):
-            root.remove(joint)
+        if tree.merged(child):
+            tree.root.remove(joint)
             continue
         parent_elem = joint.find("parent")
         parent = parent_elem.get("link")  # type: ignore[union-attr]
-        if merged(parent):
+        if tree.merged(parent):
             parent_elem.set("link", survivor[parent])  # type: ignore[union-attr]
-            jpose = _origin_pose(joint, f"joint {joint.get('name')!r}")
-            _write_origin(joint, in_survivor[parent] * jpose, index=0)
-    for name, link in links.items():
-        if merged(name):
-            root.remove(link)
-
-    frames = {}
-    for name in links:
-        if merged(name):
-            pose = in_survivor[name]
-            xyz = tuple(float(v) + 0.0 for v in pose.pos)
-            frames[name] = MergedFrame(survivor[name], xyz, _matrix_quat(pose.rot))  # type: ignore[arg-type]
-
-    _reindent(root)
-    text = '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
-    return text, frames
-
-
-# --------------------------------------------------------------------------- welding
-
-_MOTION_TAGS = ("axis", "limit", "dynamics", "calibration", "safety_controller", "mimic")
-
-
-def _axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
-    """Rotation by ``angle`` (rad) about the unit vector ``axis`` (Rodrigues)."""
-    x, y, z = axis
-    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-    return np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
-
-
-def weld_joints(urdf_xml: str, values: Mapping[str, float]) -> str:
-    """Make each joint named in ``values`` ``fixed`` at that value: rad for ``revolute`` and
-    ``continuous`` joints (a rotation about the joint's axis), m for ``prismatic`` ones (a shift
-    along it). The child link then sits exactly where it sat with the joint at that value.
-
-    Raises ValueError when the document is not well-formed, a name is not a joint of the
-    document, a joint is of another type (fixed, floating, planar) or a number is not finite.
-    """
-    try:
-        root = ET.fromstring(urdf_xml)
-    except ET.ParseError as exc:
-        raise ValueError(f"not well-formed XML: {exc}") from None
-    joints = {joint.get("name"): joint for joint in root.findall("joint")}
-    unknown = sorted(set(values) - set(joints))
-    if unknown:
-        raise ValueError(f"no joint named {', '.join(repr(n) for n in unknown)} in the document")
-    for name, value in values.items():
-        joint = joints[name]
-        kind = joint.get("type")
-        if kind not in ("revolute", "continuous", "prismatic"):
-            raise ValueError(f"joint {name!r} is {kind!r}; only revolute, continuous and prismatic joints can be welded")
-        if not math.isfinite(value):
-            raise ValueError(f"joint {name!r}: value {value!r} is not a finite number")
-        axis_elem = joint.find("axis")
-        axis = _parse_vector(axis_elem.get("xyz"), f"joint {name!r} <axis xyz>") if axis_elem is not None else np.array([1.0, 0.0, 0.0])
-        norm = float(np.linalg.norm(axis))
-        if norm == 0.0:
-            raise ValueError(f"joint {name!r} has a zero axis")
-        axis = axis / norm
-        if kind == "prismatic":
-            motion = _Pose(np.eye(3), axis * float(value))
-        else:
-            motion = _Pose(_axis_rotation(axis, float(value)), np.zeros(3))
-        origin = _origin_pose(joint, f"joint {name!r}")
-        _write_origin(joint, origin * motion, index=0)
-        joint.set("type", "fixed")
-        for tag in _MOTION_TAGS:
-            for elem in joint.findall(tag):
-                joint.remove(elem)
-    _reindent(root)
-    return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+            jpose = origin_pose(joint, f"joint {joint.get('name')!r}")
+            write_origin(joint, in_survivor[parent] * jpose, index=0)
+    for name, link in tree.links.items():
+        if tree.merged(name):
+            tree.root.remove(link)

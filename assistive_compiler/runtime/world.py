@@ -196,7 +196,7 @@ class World:
         The compiler lists only pairs between links that move relative to each other, of the
         reference's groups (an arm or leg against the rest), for the groups that move in the task,
         and leaves out pairs already touching at the rest pose; see
-        :func:`assistive_compiler.compile.compiler.person_self_collision`. Pybullet never collides
+        :func:`assistive_compiler.compile.self_collision.person_self_collision`. Pybullet never collides
         a link with its direct parent (the ``URDF_USE_SELF_COLLISION`` default), nor does the list.
         """
         c, bid = self.client, handle.id

@@ -1,44 +1,20 @@
-"""The compiler's own check of every URDF it writes (design decision 2, "Standard URDF").
-
-`lint_urdf` reads a rendered URDF document and returns a list of `LintProblem`s, one per
-fault, each naming the template, the link or joint, what is wrong (with the offending numbers)
-and what was expected. An empty list means the document is standard URDF that PyBullet,
-yourdfpy and urdfdom's ``check_urdf`` all accept and that simulates sensibly:
-
-a. every link has an ``<inertial>`` with a positive ``<mass value>``; every number in the
-   document is finite;
-b. every inertia tensor is positive-definite and its principal moments satisfy the triangle
-   inequality;
-c. revolute and prismatic joints have ``<limit>`` with finite lower < upper, effort > 0 and
-   velocity > 0; continuous joints have effort > 0 and velocity > 0; no floating or planar
-   joints;
-d. the axis of every movable joint is a non-zero unit vector;
-e. geometry is only box, cylinder, sphere or mesh, with positive sizes;
-f. links that need collision geometry have at least one ``<collision>``;
-g. mesh files exist (no ``package://``);
-h. the links and joints form one tree: unique names, exactly one root link, every joint's
-   parent and child exist, no link has two parent joints.
-
-Only the standard library and numpy are used; the module imports nothing heavy.
-"""
+"""The lint's element checks (rules a–g of :mod:`assistive_compiler.compile.lint`): finite
+numbers, inertials, shapes and meshes of every link; type, limits and axis of every joint. The
+tree (rule h) is :mod:`.tree`. :class:`Linter` collects :class:`~.problems.LintProblem`s in
+document order."""
 
 from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-__all__ = [
-    "LintError",
-    "LintProblem",
-    "check_urdf_or_raise",
-    "lint_urdf",
-    "pybullet_crash_risks",
-]
+from .numbers import fmt, fmt_derived, number, parse_numbers, vec
+from .problems import LintProblem
+from .tree import lint_tree
 
 #: Joint types a generated scene may use.
 MOVABLE_LIMITED = ("revolute", "prismatic")
@@ -79,79 +55,7 @@ _NUMERIC_ATTRIBUTES: dict[str, dict[str, int]] = {
 }
 
 
-@dataclass(frozen=True)
-class LintProblem:
-    """One fault in a rendered URDF.
-
-    ``template`` names the template (or file) the document came from, ``element`` the thing at
-    fault (``"link 'forearm'"``, ``"joint 'elbow'"``, ``"robot 'jaco'"``, ``"document"``) and
-    ``message`` says what is wrong and what was expected.
-    """
-
-    template: str
-    element: str
-    message: str
-
-    def __str__(self) -> str:
-        return f"{self.template}: {self.element}: {self.message}"
-
-
-class LintError(Exception):
-    """Raised by `check_urdf_or_raise` when a document has problems; one problem per line."""
-
-    def __init__(self, problems: list[LintProblem]) -> None:
-        self.problems: list[LintProblem] = list(problems)
-        super().__init__("\n".join(str(problem) for problem in self.problems))
-
-
-# --------------------------------------------------------------------------- number helpers
-
-
-def _fmt(value: float) -> str:
-    """A number the user wrote, shown exactly (``-1.0``, ``0.3``, ``1e-05``)."""
-    return repr(float(value))
-
-
-def _fmt_derived(value: float) -> str:
-    """A number the linter computed (eigenvalues, lengths), shown to 6 significant digits."""
-    text = f"{float(value):.6g}"
-    return "0" if text == "-0" else text
-
-
-def _vec(values: tuple[float, ...] | list[float], derived: bool = False) -> str:
-    fmt = _fmt_derived if derived else _fmt
-    return "(" + ", ".join(fmt(v) for v in values) + ")"
-
-
-def _parse_numbers(text: str | None, count: int) -> tuple[float, ...] | None:
-    """``count`` finite floats from a whitespace-separated attribute, else None."""
-    if text is None:
-        return None
-    parts = text.split()
-    if len(parts) != count:
-        return None
-    try:
-        values = tuple(float(part) for part in parts)
-    except ValueError:
-        return None
-    if not all(math.isfinite(v) for v in values):
-        return None
-    return values
-
-
-def _number(elem: ET.Element, attr: str) -> float | None:
-    values = _parse_numbers(elem.get(attr), 1)
-    return None if values is None else values[0]
-
-
-def _plural(count: int, word: str) -> str:
-    return f"{count} {word}" if count == 1 else f"{count} {word}s"
-
-
-# --------------------------------------------------------------------------- the linter
-
-
-class _Linter:
+class Linter:
     def __init__(
         self,
         template: str,
@@ -195,7 +99,7 @@ class _Linter:
             self.lint_joint(joint, self.label("joint", joint, index))
         for index, material in enumerate(root.findall("material"), start=1):
             self.check_finite(material, self.label("material", material, index))
-        self.lint_structure(root, links, joints)
+        lint_tree(self, root, links, joints)
         return self.problems
 
     @staticmethod
@@ -210,7 +114,7 @@ class _Linter:
         finite numbers. ``where`` prefixes messages for elements inside visual/collision."""
         for attr, count in _NUMERIC_ATTRIBUTES.get(elem.tag, {}).items():
             text = elem.get(attr)
-            if text is not None and _parse_numbers(text, count) is None:
+            if text is not None and parse_numbers(text, count) is None:
                 expected = "a finite number" if count == 1 else f"{count} finite numbers"
                 self.add(owner, f"{where}<{elem.tag} {attr}> is {text!r}; expected {expected}")
         for child in elem:
@@ -264,9 +168,9 @@ class _Linter:
         if mass_elem is None or mass_elem.get("value") is None:
             self.add(owner, "<inertial> has no <mass value>; expected a positive mass in kg")
         else:
-            mass = _number(mass_elem, "value")
+            mass = number(mass_elem, "value")
             if mass is not None and mass <= 0:
-                self.add(owner, f"mass is {_fmt(mass)} kg; expected a positive mass")
+                self.add(owner, f"mass is {fmt(mass)} kg; expected a positive mass")
 
         inertia_elem = inertial.find("inertia")
         if inertia_elem is None:
@@ -283,7 +187,7 @@ class _Linter:
                 f"{', '.join(INERTIA_KEYS)}",
             )
             return
-        values = {key: _number(inertia_elem, key) for key in INERTIA_KEYS}
+        values = {key: number(inertia_elem, key) for key in INERTIA_KEYS}
         if any(v is None for v in values.values()):
             return  # reported as a non-finite number already
         tensor = np.array(
@@ -299,16 +203,16 @@ class _Linter:
             self.add(
                 owner,
                 f"inertia is not positive-definite: principal moments are "
-                f"{_vec(moments, derived=True)} kg*m^2; expected all principal moments > 0",
+                f"{vec(moments, derived=True)} kg*m^2; expected all principal moments > 0",
             )
             return
         small, middle, large = moments
         if large > (small + middle) + TRIANGLE_TOLERANCE * (small + middle + large):
             self.add(
                 owner,
-                f"principal moments {_vec(moments, derived=True)} kg*m^2 break the triangle "
-                f"inequality: {_fmt_derived(large)} > {_fmt_derived(small)} + "
-                f"{_fmt_derived(middle)}; expected each moment <= the sum of the other two",
+                f"principal moments {vec(moments, derived=True)} kg*m^2 break the triangle "
+                f"inequality: {fmt_derived(large)} > {fmt_derived(small)} + "
+                f"{fmt_derived(middle)}; expected each moment <= the sum of the other two",
             )
 
     def lint_shape(self, shape: ET.Element, owner: str, where: str) -> None:
@@ -345,11 +249,11 @@ class _Linter:
             if text is None:
                 self.add(owner, f"{where}box has no size; expected three positive sizes in metres")
             else:
-                size = _parse_numbers(text, 3)
+                size = parse_numbers(text, 3)
                 if size is not None and min(size) <= 0:
                     self.add(
                         owner,
-                        f"{where}box size is {_vec(size)}; expected three positive sizes",
+                        f"{where}box size is {vec(size)}; expected three positive sizes",
                     )
         elif geom.tag in ("cylinder", "sphere"):
             attrs = ("radius", "length") if geom.tag == "cylinder" else ("radius",)
@@ -360,11 +264,11 @@ class _Linter:
                         f"{where}{geom.tag} has no {attr}; expected a positive {attr} in metres",
                     )
                     continue
-                value = _number(geom, attr)
+                value = number(geom, attr)
                 if value is not None and value <= 0:
                     self.add(
                         owner,
-                        f"{where}{geom.tag} {attr} is {_fmt(value)}; expected a positive {attr}",
+                        f"{where}{geom.tag} {attr} is {fmt(value)}; expected a positive {attr}",
                     )
         else:  # mesh
             self.lint_mesh(geom, owner, where)
@@ -372,11 +276,11 @@ class _Linter:
     def lint_mesh(self, mesh: ET.Element, owner: str, where: str) -> None:
         scale_text = mesh.get("scale")
         if scale_text is not None:
-            scale = _parse_numbers(scale_text, 3)
+            scale = parse_numbers(scale_text, 3)
             if scale is not None and any(s == 0 for s in scale):
                 self.add(
                     owner,
-                    f"{where}mesh scale is {_vec(scale)}; expected three non-zero factors",
+                    f"{where}mesh scale is {vec(scale)}; expected three non-zero factors",
                 )
         filename = mesh.get("filename")
         if not filename:
@@ -452,21 +356,21 @@ class _Linter:
                         f"{joint_type} joint",
                     )
                 else:
-                    bounds[attr] = _number(limit, attr)
+                    bounds[attr] = number(limit, attr)
             lower, upper = bounds.get("lower"), bounds.get("upper")
             if lower is not None and upper is not None and not lower < upper:
                 self.add(
                     owner,
-                    f"lower limit {_fmt(lower)} is not below upper limit {_fmt(upper)}; "
+                    f"lower limit {fmt(lower)} is not below upper limit {fmt(upper)}; "
                     f"expected lower < upper",
                 )
         for attr in ("effort", "velocity"):
             if limit.get(attr) is None:
                 self.add(owner, f"<limit> has no {attr}; expected {attr} > 0")
                 continue
-            value = _number(limit, attr)
+            value = number(limit, attr)
             if value is not None and value <= 0:
-                self.add(owner, f"<limit> {attr} is {_fmt(value)}; expected {attr} > 0")
+                self.add(owner, f"<limit> {attr} is {fmt(value)}; expected {attr} > 0")
 
     def lint_axis(self, joint: ET.Element, owner: str) -> None:
         axis_elem = joint.find("axis")
@@ -476,177 +380,15 @@ class _Linter:
         if text is None:
             self.add(owner, "<axis> has no xyz; expected a unit vector such as '0 0 1'")
             return
-        axis = _parse_numbers(text, 3)
+        axis = parse_numbers(text, 3)
         if axis is None:
             return  # reported as a non-finite number already
         length = math.sqrt(sum(a * a for a in axis))
         if length == 0:
-            self.add(owner, f"axis is {_vec(axis)}; expected a non-zero unit vector")
+            self.add(owner, f"axis is {vec(axis)}; expected a non-zero unit vector")
         elif abs(length - 1.0) >= AXIS_TOLERANCE:
             self.add(
                 owner,
-                f"axis {_vec(axis)} has length {_fmt_derived(length)}; expected a unit vector "
+                f"axis {vec(axis)} has length {fmt_derived(length)}; expected a unit vector "
                 "(length 1 within 1e-6)",
             )
-
-    # -- rule h: structure --------------------------------------------------------------
-
-    def lint_structure(
-        self, root: ET.Element, links: list[ET.Element], joints: list[ET.Element]
-    ) -> None:
-        robot = f"robot '{root.get('name')}'" if root.get("name") else "robot (unnamed)"
-        if not links:
-            self.add(robot, "has no <link>; expected at least one link")
-            return
-
-        link_names: list[str] = []
-        for index, link in enumerate(links, start=1):
-            name = link.get("name")
-            if not name:
-                self.add(self.label("link", link, index), "has no name; expected a unique name")
-            else:
-                link_names.append(name)
-        self.report_duplicates("link", link_names)
-        joint_names = [j.get("name") for j in joints if j.get("name")]
-        for index, joint in enumerate(joints, start=1):
-            if not joint.get("name"):
-                self.add(self.label("joint", joint, index), "has no name; expected a unique name")
-        self.report_duplicates("joint", joint_names)
-
-        known = set(link_names)
-        parents_of: dict[str, list[str]] = {}
-        children_of: dict[str, list[str]] = {}
-        for index, joint in enumerate(joints, start=1):
-            owner = self.label("joint", joint, index)
-            ends = {}
-            for role in ("parent", "child"):
-                elem = joint.find(role)
-                name = elem.get("link") if elem is not None else None
-                if not name:
-                    self.add(
-                        owner,
-                        f"has no <{role} link>; expected the name of a link in this document",
-                    )
-                elif name not in known:
-                    self.add(
-                        owner,
-                        f"{role} link {name!r} does not exist; expected the name of a link "
-                        f"in this document",
-                    )
-                else:
-                    ends[role] = name
-            if "child" in ends:
-                parents_of.setdefault(ends["child"], []).append(joint.get("name") or owner)
-            if "parent" in ends and "child" in ends:
-                children_of.setdefault(ends["parent"], []).append(ends["child"])
-
-        for name in dict.fromkeys(link_names):
-            joints_in = parents_of.get(name, [])
-            if len(joints_in) > 1:
-                listed = ", ".join(repr(j) for j in joints_in)
-                self.add(
-                    f"link '{name}'",
-                    f"is the child of {len(joints_in)} joints ({listed}); expected at most one "
-                    f"parent joint",
-                    crash_prone=True,
-                )
-
-        roots = [name for name in dict.fromkeys(link_names) if name not in parents_of]
-        if not roots:
-            self.add(
-                robot,
-                "has no root link (every link is the child of a joint, so the joints form a "
-                "cycle); expected exactly one root link",
-            )
-            return
-        if len(roots) > 1:
-            listed = ", ".join(repr(r) for r in roots)
-            self.add(
-                robot,
-                f"has {len(roots)} root links ({listed}); expected exactly one root link "
-                f"(connect the others with joints)",
-                crash_prone=True,
-            )
-            return
-        # One root: every link must hang from it (anything else sits on a cycle).
-        reached = {roots[0]}
-        frontier = [roots[0]]
-        while frontier:
-            for child in children_of.get(frontier.pop(), []):
-                if child not in reached:
-                    reached.add(child)
-                    frontier.append(child)
-        for name in dict.fromkeys(link_names):
-            if name not in reached:
-                self.add(
-                    f"link '{name}'",
-                    f"is not reachable from the root link {roots[0]!r} (its joints form a "
-                    f"cycle); expected the links and joints to form a tree",
-                    crash_prone=True,
-                )
-
-    def report_duplicates(self, kind: str, names: list[str]) -> None:
-        counts: dict[str, int] = {}
-        for name in names:
-            counts[name] = counts.get(name, 0) + 1
-        for name, count in counts.items():
-            if count > 1:
-                self.add(
-                    f"{kind} '{name}'",
-                    f"name is used by {_plural(count, kind)}; expected unique {kind} names",
-                )
-
-
-def lint_urdf(
-    urdf_xml: str,
-    *,
-    template: str,
-    base_dir: Path | None = None,
-    require_collision: Callable[[str], bool] | None = None,
-    static_root: bool = False,
-) -> list[LintProblem]:
-    """Check a rendered URDF document; return its problems in document order (empty = clean).
-
-    ``template`` names where the document came from (it prefixes every problem).
-    ``base_dir`` is the folder relative mesh filenames resolve against (the folder the URDF is
-    written to; the current directory when None). ``require_collision(link_name)`` says which
-    links must have a ``<collision>``; by default every link with a ``<visual>`` must.
-    A malformed document is reported as one problem. ``static_root``: the document will be loaded
-    with a fixed base, so its root link may be massless (a common convention in robot URDFs such as
-    pybullet_data's KUKA iiwa; a fixed base never moves, so its mass plays no part). Our own
-    templates are linted without it.
-    """
-    return _Linter(template, base_dir, require_collision, static_root).run(urdf_xml)
-
-
-def pybullet_crash_risks(urdf_xml: str, *, template: str = "") -> list[LintProblem]:
-    """The structure problems (several root links, a link with two parent joints, links on a
-    cycle) on which PyBullet 3.2.7's ``loadURDF`` crashes the process instead of failing."""
-    linter = _Linter(template, None, None)
-    try:
-        root = ET.fromstring(urdf_xml)
-    except (ET.ParseError, ValueError):
-        return []
-    if root.tag != "robot":
-        return []
-    linter.lint_structure(root, root.findall("link"), root.findall("joint"))
-    if len(linter.problems) > len(linter.crash_prone):
-        # Unknown or duplicate link names: PyBullet rejects the file cleanly before it gets
-        # to building the tree.
-        return []
-    return linter.crash_prone
-
-
-def check_urdf_or_raise(
-    urdf_xml: str,
-    *,
-    template: str,
-    base_dir: Path | None = None,
-    require_collision: Callable[[str], bool] | None = None,
-) -> None:
-    """`lint_urdf`, raising `LintError` (one problem per line) when anything is found."""
-    problems = lint_urdf(
-        urdf_xml, template=template, base_dir=base_dir, require_collision=require_collision
-    )
-    if problems:
-        raise LintError(problems)

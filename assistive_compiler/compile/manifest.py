@@ -1,0 +1,169 @@
+"""Building the manifest: what the runtime needs to know of the artifact besides its URDFs.
+
+:func:`build_manifest` takes the resolved task and what placement produced (the bodies' entries,
+the person variants, tool attachments, particle sets, garments, the arm's joints and limits,
+the base placements and the welded joints) and returns a :class:`Manifest` without hashes (the
+driver adds them). :func:`person_variant` builds one variant's entry (initial angles and
+randomisation ranges in rad; target offsets, limb surfaces and marker points in the limb's link
+frame, m). Every float that a solver produced is rounded (:func:`~.task.rounded`), so the bytes
+are deterministic."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..artifact import Capsule, Manifest, MarkerPoint, MarkerSet, Person, PersonVariant, Robot, Sim, StartState, Success, Target, TermUse
+from ..paths import display
+from ..quat import capsule_axes
+from ..resolve import ResolvedTask
+from ..spec.models import scalar_bounds
+from ..terms.registry import SizeContext, terms
+from .render import urdf_info
+from .weld import gripper
+from .task import impairment_joints, policy_joints, rounded
+
+
+def gym_id(task_title: str, robot_title: str) -> str:
+    """``assistive_compiler/<Task><Robot>-v1`` (e.g. FeedingJaco-v1)."""
+    return f"assistive_compiler/{task_title.replace(' ', '')}{robot_title}-v1"
+
+
+def build_manifest(rt: ResolvedTask, *, bodies, variants, tools, particles, garments, arm_joints, lower, upper,
+                   placements, welded) -> Manifest:
+    """The artifact's manifest (``input_hash`` and ``content_hash`` left empty)."""
+    spec = rt.spec
+    robot_part = rt.robot.part
+    return Manifest(
+        task=spec.name, title=spec.title, robot_name=rt.robot_name, gym_id=gym_id(spec.title, robot_part.title), input_hash="",
+        sources=[display(f) for f in rt.loaded.files],
+        sim=Sim(time_step=spec.sim.time_step_s, frame_skip=spec.sim.frame_skip, episode_steps=spec.sim.episode_steps,
+                gravity=spec.sim.gravity_mps2, sub_steps=spec.sim.solver.sub_steps, solver_iterations=spec.sim.solver.iterations,
+                contact_breaking_threshold=spec.sim.solver.contact_breaking_threshold_m,
+                ground_friction=scalar_bounds(spec.sim.ground.friction)),
+        bodies=bodies,
+        person=_person(rt, variants),
+        robot=_robot(rt, arm_joints, lower, upper, placements, welded),
+        tools=tools, targets=_targets(rt), particles=particles,
+        markers=[MarkerSet(name=name, tool=ms["tool"]["body"], tool_link=ms["tool"]["link"], radius=ms["radius_m"],
+                           show_rgba=ms["show_rgba"]) for name, ms in rt.markers.items()],
+        joint_groups=rt.joint_groups | {"person.policy": {"body": "person", "group": "policy", "joints": policy_joints(rt)}},
+        observations={agent: [_observation_use(rt, t) for t in ts] for agent, ts in rt.observations.items()},
+        reward=[TermUse(name=t.name, term=t.term, category=t.category, weight=t.weight, params=t.params) for t in rt.reward],
+        success=Success(term=spec.success.term, aggregate=spec.success.aggregate, threshold=rt.success_threshold,
+                        fraction_of=spec.success.relative_to if spec.success.relative_to in rt.markers else None),
+        garments=list(garments),
+        scripted=rt.scripted,
+    )
+
+
+def _person(rt: ResolvedTask, variants: list[PersonVariant]) -> Person:
+    gains = rt.spec.person.control
+    compliant = gains.compliant
+    compliant_joints = []
+    if compliant:
+        for ref in compliant.joints:
+            compliant_joints += rt.joint_groups[ref]["joints"]
+    return Person(variants=variants, policy_joints=policy_joints(rt), position_gain=gains.position_gain, max_force=gains.max_force_nm,
+                  hold_gain=0.1, hold_force=1000.0, compliant_joints=compliant_joints,
+                  compliant_gain=compliant.position_gain if compliant else 0.0, compliant_force=compliant.max_force_nm if compliant else 0.0,
+                  impairments=[impairment_json(rt, ch) for ch in rt.spec.person.impairments.choices],
+                  action_scale=gains.action_scale_rad, arm_limits=gains.arm_limits)
+
+
+def _robot(rt: ResolvedTask, arm_joints, lower, upper, placements, welded) -> Robot:
+    robot_part = rt.robot.part
+    control = rt.spec.robot.control
+    chosen = {field: getattr(control, field) for field in ("position_gain", "max_force_nm")}
+    for field in chosen:  # the task's explicit value, else the robot's default, else the spec default
+        own = getattr(robot_part.control, field)
+        if field not in control.model_fields_set and own is not None:
+            chosen[field] = own
+    finger_joints, grip_pos = gripper(rt)
+    return Robot(name=rt.robot_name, title=robot_part.title, arm_joints=arm_joints, joint_lower=rounded(lower), joint_upper=rounded(upper),
+                 links=rt.robot_links, action_scale=control.action_scale_rad, position_gain=chosen["position_gain"],
+                 max_force=chosen["max_force_nm"], gripper_joints=finger_joints, gripper_position=grip_pos,
+                 welded_joints=welded, placement=placements)
+
+
+def _targets(rt: ResolvedTask) -> dict[str, Target]:
+    targets = {}
+    for name, t in rt.spec.targets.items():
+        ref = rt.points[name]
+        targets[name] = Target(body=ref["body"], link=ref["link"], offset=rounded(tuple(t.offset_m)), show_rgba=t.show_rgba,
+                               surface="surface_links" in ref)
+    return targets
+
+
+def _observation_use(rt: ResolvedTask, t) -> TermUse:
+    """An observation term with its size (a joint group's size from the task's joint groups)."""
+    sizes = {name: len(g["joints"]) for name, g in rt.joint_groups.items()} | {"person.policy": len(policy_joints(rt))}
+    tdef = terms("observation")[t.term]
+    raw = {k: (v["group"] if isinstance(v, dict) and "group" in v and "joints" in v else v) for k, v in t.params.items()}
+    size_params = tdef.params.model_construct(**{k: (f"{t.params[k]['body']}.{t.params[k]['group']}" if isinstance(t.params[k], dict) and "joints" in t.params[k] else v) for k, v in raw.items()})
+    return TermUse(name=t.name, term=t.term, category="observation", weight=1.0, params=t.params, size=tdef.size(size_params, SizeContext(sizes)))
+
+
+def person_variant(rt: ResolvedTask, variant: str, urdf: Path, measurements, posture: dict[str, float], movable: list[str],
+                   starts: list[StartState]) -> PersonVariant:
+    """One person variant's entry: body, movable joints at ``posture`` (rad), randomisation, target
+    offsets, limb surfaces and marker points (from the variant's ``urdf`` capsules) and the robot's starts."""
+    person_spec = rt.spec.person
+    offsets = {}
+    for tname, target in rt.spec.targets.items():
+        if rt.points.get(tname, {}).get("body") == "person":
+            offsets[tname] = rounded(tuple(target.offset_by_variant.get(variant, target.offset_m)))
+    limbs = urdf_info(urdf.read_text()).capsules
+    surfaces = {t: [_capsule(limbs, link) for link in ref["surface_links"]] for t, ref in rt.points.items() if "surface_links" in ref}
+    marker_points = {name: _marker_points(limbs, ms["links"], ms["spacing_m"]) for name, ms in rt.markers.items()}
+    initial = {j: rounded(posture[j]) for j in movable}
+    randomize = {j: rounded(tuple(math.radians(a) for a in person_spec.randomize_deg[j].uniform)) for j in movable if j in person_spec.randomize_deg}
+    m = measurements
+    return PersonVariant(name=variant, body=f"person_{variant}", sex=m.sex, mass_kg=rounded(m.mass_kg),
+                         standing_height_m=rounded(m.standing_height_m), movable_joints=movable,
+                         initial_angles=initial, randomize=randomize, target_offsets=offsets, starts=starts,
+                         surfaces=surfaces, markers=marker_points)
+
+
+def _capsule(limbs: dict, link: str) -> Capsule:
+    cap = limbs[link]
+    return Capsule(link=link, start=rounded(cap.start), end=rounded(cap.end), radius=rounded(cap.radius))
+
+
+def _marker_points(limbs: dict, links: list[str], spacing: float) -> list[MarkerPoint]:
+    """The reference's capsule_points: on each limb, int(L/spacing) rings at L·(i+1)/(n+1) from the
+    joint end, each with int(2πr/spacing) points spacing/r radians apart (male arm: 81 + 48)."""
+    out: list[MarkerPoint] = []
+    for link in links:
+        cap = limbs[link]
+        start, r = np.asarray(cap.start), cap.radius
+        length, axis, u, v = capsule_axes(cap.start, cap.end)
+        rings, per_ring = int(length / spacing), int(2 * math.pi * r / spacing)
+        for i in range(rings):
+            centre = start + axis * length * (i + 1) / (rings + 1)
+            for k in range(per_ring):
+                a = k * spacing / r
+                out.append(MarkerPoint(link=link, offset=rounded(tuple(centre + r * (math.cos(a) * u + math.sin(a) * v)))))
+    return out
+
+
+def impairment_json(rt: ResolvedTask, choice) -> dict[str, Any]:
+    """An impairment choice for the runtime: ranges as [low, high] (angles in radians), joints by
+    URDF name, and each joint's pose-independent limits (for limited range of motion)."""
+    out: dict[str, Any] = {"kind": choice.kind}
+    for key in ("amplitude_deg", "strength", "scale"):
+        if hasattr(choice, key):
+            lo, hi = scalar_bounds(getattr(choice, key))
+            if key.endswith("_deg"):
+                out[key.replace("_deg", "_rad")] = [math.radians(lo), math.radians(hi)]
+            else:
+                out[key] = [lo, hi]
+    joints = impairment_joints(rt, choice)
+    if joints:
+        movable = rt.person_urdf.movable_joints
+        out["joints"] = joints
+        out["limits"] = {j: [movable[j].lower, movable[j].upper] for j in joints}
+    return out

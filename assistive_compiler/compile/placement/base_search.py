@@ -1,0 +1,119 @@
+"""The robot's base-pose search (paper §III: sampling + IK + joint-limit-weighted kinematic
+isotropy), and furniture carried under a searched base.
+
+:func:`reach_goals` takes the task, the client, the loaded scene, the arm chains and a person
+variant and returns the goals a base pose is scored on: the arms' start poses, then the task's
+``base_goals`` (world positions m, orientations x, y, z, w or None). :func:`search_base` returns
+the ``keep`` best sampled base poses ((position, orientation), goals reached, Σ JLWKI)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...quat import quat_from_rpy
+from ...resolve import ResolvedTask
+from ..task import fail
+
+
+class Carried:
+    """Furniture carried under a robot whose base is searched (robot.mount_base: search): its
+    mount link (pose ``mount_pos``/``mount_orn`` in the furniture frame, m) lies on the base frame."""
+
+    def __init__(self, pc, body: int, mount_pos, mount_orn):
+        self.pc, self.body, self.height = pc, body, float(mount_pos[2])
+        self.inv_pos, self.inv_orn = pc.p.invertTransform(mount_pos, mount_orn)  # furniture frame in the base frame
+
+    def place(self, base_pos, base_orn) -> tuple[tuple, tuple]:
+        """Put the furniture under a base pose (world); returns its frame's world pose."""
+        pos, orn = self.pc.p.multiplyTransforms(base_pos, base_orn, self.inv_pos, self.inv_orn)
+        self.pc.place(self.body, pos, orn)
+        return tuple(pos), tuple(orn)
+
+
+def reach_goals(rt: ResolvedTask, pc, scene, arms: list, variant: str) -> list[tuple]:
+    """(position, orientation or None, required, description, the arm's kinematics, is a start pose)
+    for each arm's start pose and each of the task's base goals, with ``variant`` in the scene."""
+    goals = []
+    for side, (kin, side_start, side_orn) in zip(rt.sides, arms):
+        kin.person = scene.people[variant]
+        what = "the start pose" if len(arms) == 1 else f"the {side} arm's start pose"
+        goals.append((tuple(side_start.tool_position_m), side_orn, True, what, kin, True))
+    for g in rt.base_goals:
+        where = np.asarray(_point_world(pc, rt, g["point"], scene, variant)) + g["offset_m"]
+        k = rt.sides.index(g["arm"]) if g["arm"] in rt.sides else 0
+        kin, _, side_orn = arms[k]
+        goals.append((tuple(where), side_orn if g["oriented"] else None, g["required"], _describe_point(g["point"]), kin, False))
+    return goals
+
+
+def _describe_point(ref: dict) -> str:
+    return f"target '{ref['target']}'" if "target" in ref else f"{ref['body']}.{ref['link']}"
+
+
+def _point_world(pc, rt: ResolvedTask, ref, scene, variant: str) -> tuple[float, float, float]:
+    """World position of a normalised point reference in the compile-time scene."""
+    if "target" in ref:
+        target = rt.spec.targets[ref["target"]]
+        base = rt.points[ref["target"]]
+        offset = target.offset_by_variant.get(variant, target.offset_m)
+    else:
+        base, offset = ref, (0.0, 0.0, 0.0)
+    body = {"person": scene.people[variant]} | scene.furniture | scene.tools
+    pos, orn = pc.named_link_pose(body[base["body"]], base["link"])
+    return tuple(pc.p.multiplyTransforms(pos, orn, tuple(offset), (0, 0, 0, 1))[0])
+
+
+def search_base(rt: ResolvedTask, arms: list, goals, offset, rng, carry: Carried | None = None):
+    """The paper's base-pose search, bounded: exactly ``attempts`` samples; the ``keep`` best by
+    (goals reached, Σ JLWKI), each reaching every required goal. ``goals`` are (position,
+    orientation or None, required, description, the arm's kinematics, is a start pose); each arm
+    starts from its rest pose. Raises with the goal that no sampled pose reached. With ``carry``
+    the base sits at the carried furniture's mount height and the furniture moves under every
+    sampled base; a pose where it touches the person or other furniture is rejected."""
+    search = rt.spec.robot.base_search
+    anchor = np.asarray(search.origin_m[:2]) + np.asarray(offset[:2])
+    z = (carry.height if carry is not None else rt.robot.part.base_height_m) + (offset[2] if len(offset) > 2 else 0.0)
+    found = []
+    required_misses = np.zeros(len(goals), dtype=int)
+    for _ in range(search.attempts):
+        xy = anchor + [rng.uniform(*search.x_range_m), rng.uniform(*search.y_range_m)]
+        yaw = math.radians(search.yaw_deg + rng.uniform(-search.yaw_noise_deg, search.yaw_noise_deg))
+        pos, orn = (float(xy[0]), float(xy[1]), float(z)), quat_from_rpy((0.0, 0.0, yaw))
+        if not _base_clear(arms, pos, orn, carry):
+            continue
+        reached, score, ok = 0, 0.0, True
+        for k, (gpos, gorn, required, _name, kin, is_start) in enumerate(goals):
+            q = kin.reach(gpos, gorn, rng, tries=2, tool_may_touch=not is_start)
+            if q is None:
+                if required:
+                    required_misses[k] += 1
+                    ok = False
+                    break
+                continue
+            reached += 1
+            score += kin.jlwki(q)
+        if ok:
+            found.append(((pos, orn), reached, score))
+    if not found:
+        worst = int(np.argmax(required_misses))
+        raise fail(rt, ("robot", "base_search"), f"robot '{rt.robot_name}' reaches {goals[worst][3]} from none of {search.attempts} sampled base poses (set robot.per_robot.{rt.robot_name}.base_offset_m or widen base_search)")
+    found.sort(key=lambda f: (-f[1], -f[2]))
+    return found[: search.keep]
+
+
+def _base_clear(arms: list, pos, orn, carry: Carried | None) -> bool:
+    """Place the base (and any carried furniture) at (pos, orn), the arms at rest; whether the
+    robot and the carried furniture clear the person and the other furniture there."""
+    arm = arms[0]
+    arm.place(pos, orn)
+    for a in arms:
+        a.set_arm(a.rest)
+    if carry is not None:
+        carry.place(pos, orn)
+        if any(arm.pc.touching(carry.body, o) for o in arm.obstacles if o != carry.body) or arm.pc.touching(carry.body, arm.person):
+            return False
+    # The base must clear the scene at the arm's rest pose; its own carried mount is checked per IK solution
+    # only (a folded arm may rest against the mount's top, which says nothing about the base pose).
+    return not (any(arm.pc.touching(arm.robot, o) for o in arm.obstacles if carry is None or o != carry.body) or arm.pc.touching(arm.robot, arm.person))

@@ -1,0 +1,127 @@
+"""Arm inverse kinematics in the placement client: one :class:`ArmKinematics` per acting arm.
+
+:func:`arm_chains` takes the resolved task, the client and the loaded scene and returns, per
+acting side (action order), the arm's kinematics, its start pose (spec part) and the tool's
+start orientation (quaternion x, y, z, w). :meth:`ArmKinematics.reach` solves IK for a tool
+pose (world frame, m) with collision checks against person and furniture;
+:meth:`ArmKinematics.jlwki` scores a configuration (facts §5)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...quat import quat_from_rpy_deg
+from ...resolve import ResolvedTask
+from ..task import start_for
+from .client import PlacementClient
+
+
+class ArmKinematics:
+    """IK, collision checks and JLWKI for one arm in the compile-time world."""
+
+    def __init__(self, pc, robot, ee_link, arm_idx, lower, upper, tool_from_ee, tool_ids, obstacles, rest):
+        p, c = pc.p, pc.client
+        self.pc, self.robot, self.ee_link, self.arm_idx = pc, robot, ee_link, arm_idx
+        self.lower, self.upper = lower, upper
+        self.tool_inv = tool_from_ee  # inverse grip: tool frame -> end-effector frame
+        self.tool_ids, self.obstacles = tool_ids, obstacles
+        self.person: int | None = None
+        self.rest = rest or [0.0] * len(arm_idx)
+        self.movable = [j for j in range(p.getNumJoints(robot, physicsClientId=c)) if p.getJointInfo(robot, j, physicsClientId=c)[2] != p.JOINT_FIXED]
+        self.lo_all = [p.getJointInfo(robot, j, physicsClientId=c)[8] for j in self.movable]
+        self.hi_all = [p.getJointInfo(robot, j, physicsClientId=c)[9] for j in self.movable]
+        self.ranges = [max(h - l, 1e-3) for l, h in zip(self.lo_all, self.hi_all)]
+        self.cols = [self.movable.index(i) for i in arm_idx]
+
+    def place(self, pos, orn) -> None:
+        self.pc.place(self.robot, pos, orn)
+
+    def set_arm(self, q) -> None:
+        for i, v in zip(self.arm_idx, q):
+            self.pc.p.resetJointState(self.robot, i, v, physicsClientId=self.pc.client)
+
+    def reach(self, tool_pos, tool_orn, rng, tries: int = 2, tool_may_touch: bool = False):
+        """Arm configuration putting the tool at ``tool_pos`` (with ``tool_orn`` unless None) within
+        1 cm (and 3°), the arm free of collisions with person and furniture, and the tool too unless
+        ``tool_may_touch`` (a goal at the mouth puts the spoon against the face); None if none found."""
+        p, c = self.pc.p, self.pc.client
+        orn = tool_orn if tool_orn is not None else (0, 0, 0, 1)
+        ee_pos, ee_orn = p.multiplyTransforms(tool_pos, orn, *self.tool_inv)
+        for attempt in range(tries):
+            arm_rest = list(self.rest) if attempt == 0 else list(rng.uniform(self.lower, self.upper))
+            rest = [p.getJointState(self.robot, j, physicsClientId=c)[0] for j in self.movable]
+            for col, q in zip(self.cols, arm_rest):
+                rest[col] = q
+            self.set_arm(arm_rest)
+            q = arm_rest
+            for _ in range(4):  # refine from the last solution
+                kwargs = dict(lowerLimits=self.lo_all, upperLimits=self.hi_all, jointRanges=self.ranges, restPoses=rest,
+                              maxNumIterations=100, residualThreshold=1e-6, physicsClientId=c)
+                sol = (p.calculateInverseKinematics(self.robot, self.ee_link, ee_pos, ee_orn, **kwargs) if tool_orn is not None
+                       else p.calculateInverseKinematics(self.robot, self.ee_link, ee_pos, **kwargs))
+                q = [min(max(sol[k], l), u) for k, l, u in zip(self.cols, self.lower, self.upper)]
+                self.set_arm(q)
+            got_pos, got_orn = self.pc.link_pose(self.robot, self.ee_link)
+            if np.linalg.norm(np.subtract(got_pos, ee_pos)) >= 0.01:
+                continue
+            if tool_orn is not None and 2 * math.acos(min(1.0, abs(float(np.dot(got_orn, ee_orn))))) >= math.radians(3):
+                continue
+            if self.collides(tool_pos, orn, check_tool=not tool_may_touch):
+                continue
+            return q
+        return None
+
+    def collides(self, tool_pos, tool_orn, check_tool: bool = True) -> bool:
+        touching = self.pc.touching
+        if any(touching(self.robot, o) for o in self.obstacles) or (self.person is not None and touching(self.robot, self.person)):
+            return True
+        for tid in self.tool_ids.values() if check_tool else ():
+            self.pc.place(tid, tool_pos, tool_orn)
+            if self.person is not None and touching(tid, self.person):
+                return True
+        return False
+
+    def jlwki(self, q) -> float:
+        """Joint-limit-weighted kinematic isotropy at ``q`` (facts §5: φ = 0.5, λ = 0.05)."""
+        p, c = self.pc.p, self.pc.client
+        all_q = [p.getJointState(self.robot, j, physicsClientId=c)[0] for j in self.movable]
+        zeros = [0.0] * len(self.movable)
+        lin, ang = p.calculateJacobian(self.robot, self.ee_link, [0, 0, 0], all_q, zeros, zeros, physicsClientId=c)
+        J = np.vstack([np.asarray(lin)[:, self.cols], np.asarray(ang)[:, self.cols]])
+        w = []
+        for qi, l, u in zip(q, self.lower, self.upper):
+            qr = (u - l) / 2
+            w.append(max(0.001, 1 - 0.5 ** ((qr - abs(qr - qi + l)) / (0.05 * qr) + 1)))
+        M = J @ np.diag(w) @ J.T
+        return float(max(np.linalg.det(M), 0.0) ** (1 / 6) / (np.trace(M) / 6))
+
+
+def arm_chains(rt: ResolvedTask, pc: PlacementClient, scene) -> list[tuple[ArmKinematics, object, tuple]]:
+    """One kinematic chain per acting side (a two-arm robot in a task with arm 'both' has two), each
+    with its start pose and the tool (or garment) in its hand: (kinematics, start, tool orientation)."""
+    robot_part = rt.robot.part
+    arms: list[tuple[ArmKinematics, object, tuple]] = []
+    offset_in_action = 0
+    for side in rt.sides:
+        real_side, arm = robot_part.arm_for(side)
+        n = len(arm.joints)
+        side_start = start_for(rt, side)
+        side_orn = quat_from_rpy_deg(side_start.tool_rpy_deg)
+        held = [k for k, (name, use) in enumerate(rt.tool_uses.items()) if robot_part.arm_for(use.hand)[0] == real_side]
+        held_garments = [scene.garment_grips[gname][1:] for gname, g in rt.spec.garments.items() if robot_part.arm_for(g.held.hand)[0] == real_side]
+        if held:
+            att = scene.attachments[held[0]]
+            inv = pc.p.invertTransform(att.position, att.orientation)
+            side_tools = {att.body: scene.tools[att.body]}
+        elif held_garments:  # the start pose is the garment's held frame
+            inv, side_tools = pc.p.invertTransform(*held_garments[0]), {}
+        else:
+            inv, side_tools = ((0, 0, 0), (0, 0, 0, 1)), {}
+        kin = ArmKinematics(pc, scene.robot, pc.link_index(scene.robot, arm.tool_mount), [scene.robot_joints[j] for j in arm.joints],
+                            scene.lower[offset_in_action:offset_in_action + n], scene.upper[offset_in_action:offset_in_action + n],
+                            inv, side_tools, list(scene.furniture.values()), arm.rest_rad)
+        arms.append((kin, side_start, side_orn))
+        offset_in_action += n
+    return arms
