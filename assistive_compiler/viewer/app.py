@@ -10,6 +10,7 @@ steps the physics. Ctrl-C (SIGINT) stops the server and returns.
 
 from __future__ import annotations
 
+import signal
 import tempfile
 import threading
 import time
@@ -156,6 +157,8 @@ def serve(artifact_dir: str | Path, recording: Recording, player: EpisodePlayer 
 
     from ..runtime.camera import DEFAULT_VIEW
 
+    if threading.current_thread() is threading.main_thread():  # Ctrl-C stops the server even if the shell ignored SIGINT (a background job)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     server = viser.ViserServer(host=host, port=port, label="assistive-compiler", verbose=False)
     try:
         server.scene.set_up_direction("+z")
