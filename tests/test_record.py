@@ -129,3 +129,25 @@ def test_record_a_callable_without_policy_name(tmp_path, artifact):
     rec = record_episode(env, lambda obs: np.zeros(7), 2, tmp_path)
     env.close()
     assert rec.header["policy"] is None and rec.header["seed"] == 2 and (tmp_path / "episode-0000.npz").is_file()
+
+
+def test_run_record_writes_the_episodes_it_reports(artifact, tmp_path):
+    """``run --record DIR``: one file per episode, each with the return and success ``run --json`` reports."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from conftest import FEEDING
+
+    out = subprocess.run([sys.executable, "-m", "assistive_compiler.cli", "run", str(FEEDING), "--robot", "jaco", "--episodes", "2", "--seed", "3",
+                          "--out", str(artifact), "--record", str(tmp_path / "rec"), "--json", "--quiet"],
+                         cwd=Path(__file__).resolve().parents[1], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    report = json.loads(out.stdout)
+    files = episode_files(tmp_path / "rec")
+    assert [f.name for f in files] == ["episode-0000.npz", "episode-0001.npz"]
+    for f, e in zip(files, report["episodes"]):
+        rec = load_recording(f)
+        assert (rec.header["seed"], rec.header["success"], rec.header["policy"]) == (e["seed"], e["success"], "scripted")
+        assert rec.header["return"] == pytest.approx(e["return"], abs=1e-9)
+        assert dict(zip(rec.header["terms"], rec.arrays["terms"].sum(axis=0))) == pytest.approx(e["terms"], abs=1e-9)
