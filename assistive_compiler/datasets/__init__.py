@@ -1,7 +1,7 @@
 """Demonstration datasets in Minari, the Farama standard for offline RL (the ``datasets`` extra).
 
-:func:`collect` plays a policy for N episodes from consecutive seeds through ``minari.DataCollector``
-and writes a dataset loadable with ``minari.load_dataset(dataset_id)``:
+:func:`collect` plays a policy for N episodes from consecutive seeds and writes them with
+``minari.create_dataset_from_buffers``, loadable with ``minari.load_dataset(dataset_id)``:
 
 * per episode: observations (T+1, O) float32, actions (T, A), rewards (T,), terminations and
   truncations (T,), the reset seed, and infos ``task_success`` (T+1,) int (0 after reset),
@@ -94,9 +94,3 @@ def collect(spec: str, robot: str | None, dataset_id: str, policy: str = "script
         "content_hash": m.content_hash, "task": m.task, "robot": m.robot_name, "gym_id": m.gym_id, "policy": policy,
         "seeds": [seed + k for k in range(episodes)], "successes": successes, "term_weights": {t.name: t.weight for t in m.reward}}})
     return minari.load_dataset(dataset_id)
-
-
-def success_rate(dataset) -> float:
-    """Fraction of a collected dataset's episodes that succeeded (from its metadata)."""
-    flags = dataset.storage.metadata["assistive_compiler"]["successes"]
-    return float(np.mean(flags)) if flags else 0.0
