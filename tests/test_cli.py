@@ -105,5 +105,5 @@ def test_every_command_group_registers_its_commands():
     from assistive_compiler.cli import COMMAND_MODULES, build_parser
 
     sub = next(a for a in build_parser()._actions if a.dest == "command")
-    assert set(sub.choices) == {"validate", "compile", "list", "schema", "run", "demo", "render", "render-person", "bench", "compare"}
+    assert set(sub.choices) == {"validate", "compile", "list", "schema", "run", "demo", "render", "render-person", "bench", "compare", "view", "collect"}
     assert all(callable(m.add_commands) for m in COMMAND_MODULES)

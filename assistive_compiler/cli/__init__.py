@@ -18,6 +18,8 @@ imports.
 * :mod:`.render` — render, render-person
 * :mod:`.bench` — bench
 * :mod:`.compare` — compare
+* :mod:`.view` — view (browser or pybullet GUI)
+* :mod:`.collect` — collect (Minari datasets)
 """
 
 from __future__ import annotations
@@ -28,10 +30,10 @@ import sys
 from typing import Callable, Sequence
 
 from ..errors import SpecError
-from . import bench, compare, render, run, spec_commands
+from . import bench, collect, compare, render, run, spec_commands, view
 from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, print_problems
 
-COMMAND_MODULES = (spec_commands, run, render, bench, compare)
+COMMAND_MODULES = (spec_commands, run, render, bench, compare, view, collect)
 
 __all__ = ["COMMAND_MODULES", "EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_OK", "build_parser", "main"]
 

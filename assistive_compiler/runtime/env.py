@@ -158,8 +158,15 @@ class AssistiveEnv(gym.Env):
         self._used = True
         m, w, c = self.manifest, self.world, self.world.client
         w.restore()
-        # Person variant: the drawn one in place, the others parked.
+        # Person variant: the drawn one in place, the others parked. ``options["person_variant"]``
+        # (a variant name) chooses it instead; the draw is still made, so every other draw is the seed's.
         variant = m.person.variants[int(rng.integers(len(m.person.variants)))]
+        chosen = (options or {}).get("person_variant")
+        if chosen is not None:
+            names = [v.name for v in m.person.variants]
+            if chosen not in names:
+                raise ValueError(f"unknown person variant {chosen!r}; this task has {', '.join(names)}")
+            variant = m.person.variants[names.index(chosen)]
         w.active_variant = variant
         self.snap.begin_episode()
         for i, v in enumerate(m.person.variants):
