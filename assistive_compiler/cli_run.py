@@ -251,7 +251,7 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
     reset_med, reset_p95 = _median_p95(reset_ms)
     return {
         "task": m.task, "robot": m.robot_name, "gym_id": m.gym_id,
-        "obs_size": sum(t.size for t in m.observations["robot"]), "action_size": len(m.robot.arm_joints),
+        "obs_size": sum(t.size for t in m.observations["robot"]), "action_size": m.robot.action_size,
         "env_steps_per_s": round(env_med, 1),
         "reference_env_steps_per_s": REFERENCE_STEPS_PER_S.get((m.task, m.robot_name)),
         "vs_reference": round(env_med / REFERENCE_STEPS_PER_S[(m.task, m.robot_name)], 2) if (m.task, m.robot_name) in REFERENCE_STEPS_PER_S else None,

@@ -79,10 +79,13 @@ def search_base(rt: ResolvedTask, arms: list, goals, offset, rng, carry: Carried
     required_misses = np.zeros(len(goals), dtype=int)
     for _ in range(search.attempts):
         xy = anchor + [rng.uniform(*search.x_range_m), rng.uniform(*search.y_range_m)]
-        yaw = math.radians(search.yaw_deg + rng.uniform(-search.yaw_noise_deg, search.yaw_noise_deg))
+        yaw = math.radians(search.yaw_deg + rt.robot.part.facing_yaw_deg + rng.uniform(-search.yaw_noise_deg, search.yaw_noise_deg))
         pos, orn = (float(xy[0]), float(xy[1]), float(z)), quat_from_rpy((0.0, 0.0, yaw))
         if not _base_clear(arms, pos, orn, carry):
             continue
+        first = goals[0][4]
+        if first.frozen:  # a mobile base drives from the sample to where its arm reaches the start pose
+            pos, orn = first.drive_to(pos, orn, goals[0][0], goals[0][1])
         reached, score, ok = 0, 0.0, True
         for k, (gpos, gorn, required, _name, kin, is_start) in enumerate(goals):
             q = kin.reach(gpos, gorn, rng, tries=2, tool_may_touch=not is_start)
