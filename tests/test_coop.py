@@ -208,7 +208,7 @@ def test_fixed_robot_partner_exposes_the_human(feeding):
 
 
 def test_rollout_coop_with_a_holding_person_is_the_single_agent_rollout(feeding, artifact):
-    from assistive_compiler.cli_run import rollout
+    from assistive_compiler.cli.run import rollout
     from assistive_compiler.policies import make_policy
 
     single = AssistiveEnv(artifact)

@@ -113,7 +113,7 @@ def deformable_client():
 
 
 def _load(cid, obj_path, pos=(0.0, 0.0, 1.0), orn=(0.0, 0.0, 0.0, 1.0)):
-    # The parameters experiments/dressing_report.md found stable at a 0.02 s step with 4 sub-steps.
+    # The parameters docs/dressing-study.md found stable at a 0.02 s step with 4 sub-steps.
     return p.loadSoftBody(
         str(obj_path), basePosition=list(pos), baseOrientation=list(orn), scale=1.0, mass=0.1,
         collisionMargin=0.01, useMassSpring=1, useBendingSprings=1, useNeoHookean=0,

@@ -85,7 +85,7 @@ class Snapshot:
         self._closest_hint: dict[tuple, float] = {}  # last closest_distance per (body, bodies): where the next query starts
         self._garment_nodes: dict[int, np.ndarray] = {}
         # pybullet reports a soft body's contact forces of its last solver sub-step only: scale them
-        # back to the physics step (experiments/dressing_report.md: then Σ|f_n| ≈ the weight it rests on).
+        # back to the physics step (docs/dressing-study.md: then Σ|f_n| ≈ the weight it rests on).
         sub_steps = max(1, world.m.sim.sub_steps)
         self.force_scale: dict[int, float] = {g.soft_id: float(sub_steps) for g in world.garments}
 

@@ -599,7 +599,7 @@ class SleeveShape(Strict):
 
 class SoftBodyPhysics(Strict):
     """Mass-spring settings of pybullet's deformable world (``loadSoftBody``). The defaults are the
-    tested values of experiments/dressing_report.md: stable with 4 solver sub-steps at a 0.02 s
+    tested values of docs/dressing-study.md: stable with 4 solver sub-steps at a 0.02 s
     step for about 100 nodes (the springs are integrated explicitly: a stiffer, lighter or finer
     cloth needs more sub-steps)."""
 

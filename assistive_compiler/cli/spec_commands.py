@@ -1,35 +1,23 @@
-"""``assistive-compiler`` — validate, compile, inspect and run task specs.
+"""The spec commands: ``validate``, ``compile``, ``schema`` and ``list``.
 
-Exit status: 0 success, 2 bad input (problems printed one per line as ``PATH:LINE:COL: message``),
-1 a run that failed for another stated reason. Heavy modules are imported by the command that
-needs them, so ``validate`` and ``schema`` start fast.
+They read and compile specs and print what they found; none of them runs physics (``compile``
+only to precompute). Heavy modules are imported by the command that needs them, so ``validate``
+and ``schema`` start fast.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
-from typing import Callable, Sequence
 
-from .errors import SpecError
-
-EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
-
-
-def _print_problems(error: SpecError) -> None:
-    for problem in error.problems:
-        print(problem, file=sys.stderr)
-
-
-# --------------------------------------------------------------------------------------------
-# validate / compile / schema
+from ..errors import SpecError
+from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, print_problems
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    from .resolve import validate_all_robots
-    from .spec.load import load_spec
+    from ..resolve import validate_all_robots
+    from ..spec.load import load_spec
 
     status = EXIT_OK
     for path in args.paths:
@@ -37,7 +25,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
             loaded = load_spec(path)
             resolved = validate_all_robots(loaded)
         except SpecError as exc:
-            _print_problems(exc)
+            print_problems(exc)
             status = EXIT_BAD_INPUT
             continue
         robots = ", ".join(r.robot_name for r in resolved)
@@ -46,12 +34,12 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_compile(args: argparse.Namespace) -> int:
-    from .compile.compiler import compile_task
+    from ..compile.compiler import compile_task
 
     result = compile_task(args.spec, args.robot, args.out, force=args.force)
     m = result.manifest
     if args.strict:
-        from .compile.external_checks import check_with_urdfdom, check_with_yourdfpy, pybullet_load_warnings
+        from ..compile.external_checks import check_with_urdfdom, check_with_yourdfpy, pybullet_load_warnings
 
         failures = []
         for body in m.bodies:
@@ -71,8 +59,8 @@ def cmd_compile(args: argparse.Namespace) -> int:
 
 def task_schema() -> dict:
     """JSON Schema of a task spec, with the registered term and preference names as enums."""
-    from .spec.models import PREFERENCE_NAMES, TaskSpec
-    from .terms.registry import terms
+    from ..spec.models import PREFERENCE_NAMES, TaskSpec
+    from ..terms.registry import terms
 
     schema = TaskSpec.model_json_schema()
     defs = schema.get("$defs", {})
@@ -89,42 +77,40 @@ def task_schema() -> dict:
 
 def cmd_schema(args: argparse.Namespace) -> int:
     if args.terms:
-        from .terms.registry import terms
+        from ..terms.registry import terms
+        from .output import print_table
 
         for category in ("observation", "reward", "preference"):
-            print(f"{category} terms:")
-            for name, tdef in sorted(terms(category).items()):
-                fields = ", ".join(tdef.params.model_fields) or "-"
-                print(f"  {name:20s} ({fields}) {tdef.summary()}")
+            rows = [[name, ", ".join(tdef.params.model_fields) or "-", tdef.summary()] for name, tdef in sorted(terms(category).items())]
+            print_table(["term", "parameters", "what it is"], rows, left=["term", "parameters", "what it is"], title=f"{category} terms")
         return EXIT_OK
     print(json.dumps(task_schema(), indent=2, sort_keys=True))
     return EXIT_OK
 
 
 def cmd_list(args: argparse.Namespace) -> int:
-    from .paths import display
-    from .registration import shipped_tasks
+    from ..paths import display
+    from ..registration import shipped_tasks
 
     tasks = shipped_tasks()
     if args.json:
         print(json.dumps([{"task": t.name, "title": t.title, "spec": display(t.spec), "robots": t.robots, "ids": t.ids} for t in tasks], indent=2))
         return EXIT_OK
+    from .output import print_table
+
     robots = sorted({r for t in tasks for r in t.robots})
     print(f"{len(tasks)} tasks x {len(robots)} robots ({', '.join(robots)}); Gymnasium ids (gymnasium.make after import assistive_compiler):")
+    rows, ends = [], []
     for t in tasks:
-        print(f"  {t.title} ({t.name}, {display(t.spec)})")
-        for robot, env_id in zip(t.robots, t.ids):
-            print(f"    {robot:8s} {env_id}")
+        for k, (robot, env_id) in enumerate(zip(t.robots, t.ids)):
+            rows.append([f"{t.title} ({t.name})" if k == 0 else "", display(t.spec) if k == 0 else "", robot, env_id])
+        ends.append(len(rows) - 1)
+    columns = ["task", "spec", "robot", "Gymnasium id"]
+    print_table(columns, rows, left=columns, section_after=ends[:-1])
     return EXIT_OK
 
 
-# --------------------------------------------------------------------------------------------
-
-
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="assistive-compiler", description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-
+def add_commands(sub) -> None:
     p = sub.add_parser("validate", help="check task specs; print PATH:LINE:COL: problem for each mistake")
     p.add_argument("paths", nargs="+", help="task spec files")
     p.set_defaults(func=cmd_validate)
@@ -144,37 +130,3 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("schema", help="print the JSON Schema of a task spec (or --terms: the term library)")
     p.add_argument("--terms", action="store_true", help="list registered terms and their parameters instead")
     p.set_defaults(func=cmd_schema)
-
-    _add_runtime_commands(sub)
-    return parser
-
-
-def _add_runtime_commands(sub) -> None:
-    try:
-        from . import cli_run
-    except ImportError:  # pragma: no cover - the runtime commands ship with the package
-        return
-    cli_run.add_commands(sub)
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    func: Callable[[argparse.Namespace], int] = args.func
-    try:
-        return func(args)
-    except SpecError as exc:
-        _print_problems(exc)
-        return EXIT_BAD_INPUT
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
-        return 130
-    except BrokenPipeError:
-        # The reader went away (e.g. `| head`): not an error. Point stdout at /dev/null so the
-        # interpreter's final flush does not raise again.
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return EXIT_OK
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

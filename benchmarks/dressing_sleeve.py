@@ -1,6 +1,6 @@
 """Feasibility experiment: a gown sleeve pulled along a seated person's left arm on STOCK pybullet.
 
-Two methods (see experiments/dressing_report.md for the findings):
+Two methods (see docs/dressing-study.md for the findings):
 
 * ``--method softbody`` — a pybullet deformable (``loadSoftBody`` of a tube OBJ made by
   ``assistive_compiler.garment``, mass-spring model) in a ``RESET_USE_DEFORMABLE_WORLD`` world.
@@ -20,8 +20,8 @@ of the sleeve on the arm, and timing (physics steps/s, env steps/s = physics/5).
 
 Run e.g.::
 
-    .venv/bin/python experiments/dressing_sleeve.py --method softbody --pose bent --print
-    .venv/bin/python experiments/dressing_sleeve.py --method rings --pose straight --repeat 3
+    .venv/bin/python benchmarks/dressing_sleeve.py --method softbody --pose bent --print
+    .venv/bin/python benchmarks/dressing_sleeve.py --method rings --pose straight --repeat 3
 """
 
 from __future__ import annotations

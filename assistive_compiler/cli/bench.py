@@ -1,0 +1,238 @@
+"""``bench``: speed figures of (task, robot) pairs, all taken in one run.
+
+Env steps/s against raw physics (the same episodes, physics timed inside ``env.step``) and
+against the reference implementation's measured rate, both agents acting (co-optimisation),
+resets, compile times, import time and memory. Each figure comes from a plain ``measure_*``
+function (medians over repeats) that other commands may reuse; :func:`bench` takes them all.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from .common import EXIT_OK
+
+_CHILD = r"""
+import json, resource, sys, time, numpy as np
+t = time.perf_counter()
+import assistive_compiler
+import_s = time.perf_counter() - t
+heavy = sorted(m for m in ("torch", "tensorflow", "jax", "ray", "stable_baselines3", "pybullet") if m in sys.modules)
+from assistive_compiler.runtime.env import AssistiveEnv
+env = AssistiveEnv(sys.argv[1])
+env.reset(seed=0)
+for _ in range(200):
+    env.step(env.action_space.sample())
+print(json.dumps({"import_s": import_s, "heavy_modules_on_import": heavy,
+                  "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+"""
+
+
+#: Env steps/s of the reference implementation (Assistive Gym v1.0 on stock pybullet, random actions,
+#: 200-step episodes, one process, a 2-core shared machine like ours), per (task, robot) it was
+#: measured for: shared/reference/performance-anchors.md. Dressing does not run on stock pybullet.
+REFERENCE_STEPS_PER_S = {
+    ("scratch_itch", "jaco"): 423, ("scratch_itch", "pr2"): 188, ("scratch_itch", "sawyer"): 428, ("scratch_itch", "baxter"): 312,
+    ("bed_bathing", "jaco"): 156,
+    ("feeding", "jaco"): 248, ("feeding", "pr2"): 135, ("feeding", "sawyer"): 237, ("feeding", "baxter"): 199,
+    ("drinking", "jaco"): 37,
+    ("arm_manipulation", "jaco"): 216,
+}
+
+
+def _median_p95(values: list[float]) -> tuple[float, float]:
+    s = sorted(values)
+    return statistics.median(s), s[min(len(s) - 1, int(round(0.95 * (len(s) - 1))))]
+
+
+def measure_steps(env, steps: int, repeats: int, seed: int) -> tuple[list[float], list[float], list[float]]:
+    """Per repeat (one seeded episode of ``steps`` random actions): env steps/s, the same steps' physics
+    alone in steps/s (stepSimulation + gravity compensation, timed inside ``env.step``), and the env's
+    overhead per step (µs)."""
+    physics = [0.0]
+    world = env.world
+    original = world.step_physics
+
+    def timed() -> None:
+        t0 = time.perf_counter()
+        original()
+        physics[0] += time.perf_counter() - t0
+
+    world.step_physics = timed  # type: ignore[method-assign]
+    env.action_space.seed(seed)
+    env_rates, raw_rates, overhead = [], [], []
+    try:
+        for r in range(repeats):
+            env.reset(seed=seed + r)
+            physics[0] = 0.0
+            t0 = time.perf_counter()
+            for _ in range(steps):
+                env.step(env.action_space.sample())
+            total = time.perf_counter() - t0
+            env_rates.append(steps / total)
+            raw_rates.append(steps / physics[0])
+            overhead.append((total - physics[0]) / steps * 1e6)
+    finally:
+        world.step_physics = original  # type: ignore[method-assign]
+    return env_rates, raw_rates, overhead
+
+
+def measure_coop_steps(env, steps: int, repeats: int, seed: int) -> list[float]:
+    """Env steps/s with both agents acting (``step_agents``); empty when the person has no policy joints."""
+    if env.human_action_space is None:
+        return []
+    env.human_action_space.seed(seed)
+    rates = []
+    for r in range(repeats):
+        env.reset(seed=seed + r)
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            env.step_agents(env.action_space.sample(), env.human_action_space.sample())
+        rates.append(steps / (time.perf_counter() - t0))
+    return rates
+
+
+def measure_raw_loop(env, steps: int) -> float:
+    """Env steps/s of a bare ``stepSimulation`` loop (frame_skip physics steps each) with the scene at rest."""
+    import pybullet as pb
+
+    env.reset(seed=0)
+    t0 = time.perf_counter()
+    for _ in range(steps * env.manifest.sim.frame_skip):
+        pb.stepSimulation(physicsClientId=env.world.client)
+    return steps / (time.perf_counter() - t0)
+
+
+def measure_resets(env, resets: int) -> tuple[list[float], list[float]]:
+    """Reset times (ms) after a step: unseeded (restore the saved state: the training path) and
+    seeded (rebuild for a bit-exact replay; at most 20)."""
+    reset_ms, seeded_ms = [], []
+    for k in range(resets):
+        env.step(env.action_space.sample())
+        t0 = time.perf_counter()
+        env.reset()
+        reset_ms.append((time.perf_counter() - t0) * 1e3)
+    for k in range(min(resets, 20)):
+        env.step(env.action_space.sample())
+        t0 = time.perf_counter()
+        env.reset(seed=1000 + k)
+        seeded_ms.append((time.perf_counter() - t0) * 1e3)
+    return reset_ms, seeded_ms
+
+
+def measure_process(artifact_dir: Path) -> dict:
+    """In a fresh interpreter: ``import assistive_compiler`` time (s), heavy modules it imported, and
+    peak RSS (MB) of one env stepped 200 times."""
+    child = subprocess.run([sys.executable, "-c", _CHILD, str(artifact_dir)], capture_output=True, text=True, check=True,
+                           env=os.environ | {"PYTHONWARNINGS": "ignore"})
+    return json.loads(child.stdout.strip().splitlines()[-1])
+
+
+def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, seed: int = 0) -> dict:
+    """Speed figures of one (task, robot), all taken in this one run (medians over repeats)."""
+    from ..compile.compiler import compile_task
+    from ..runtime.env import AssistiveEnv
+
+    with tempfile.TemporaryDirectory() as tmp:
+        cold = compile_task(spec, robot, Path(tmp) / "cold", force=True)
+        cached = compile_task(spec, robot, Path(tmp) / "cold")
+        assert cached.cache_hit
+        env = AssistiveEnv(cold.out_dir)
+        env_rates, raw_rates, overhead = measure_steps(env, steps, repeats, seed)
+        coop_rates = measure_coop_steps(env, steps, repeats, seed)
+        raw_loop = measure_raw_loop(env, steps)
+        reset_ms, seeded_ms = measure_resets(env, resets)
+        m = env.manifest
+        env.close()
+        proc = measure_process(cold.out_dir)
+    env_med = statistics.median(env_rates)
+    raw_med = statistics.median(raw_rates)
+    reset_med, reset_p95 = _median_p95(reset_ms)
+    reference = REFERENCE_STEPS_PER_S.get((m.task, m.robot_name))
+    return {
+        "task": m.task, "robot": m.robot_name, "gym_id": m.gym_id,
+        "obs_size": sum(t.size for t in m.observations["robot"]), "action_size": m.robot.action_size,
+        "env_steps_per_s": round(env_med, 1),
+        "reference_env_steps_per_s": reference,
+        "vs_reference": round(env_med / reference, 2) if reference is not None else None,
+        "raw_physics_steps_per_s": round(raw_med, 1),
+        "env_over_raw": round(env_med / raw_med, 3),
+        "env_overhead_us_per_step": round(statistics.median(overhead), 1),
+        "coop_env_steps_per_s": round(statistics.median(coop_rates), 1) if coop_rates else None,
+        "raw_loop_steps_per_s_at_rest": round(raw_loop, 1),
+        "reset_ms_median": round(reset_med, 3), "reset_ms_p95": round(reset_p95, 3), "resets": resets,
+        "seeded_reset_ms_median": round(statistics.median(seeded_ms), 2),
+        "compile_s_cold": round(cold.seconds, 3), "compile_s_cached": round(cached.seconds, 3),
+        "import_s": round(proc["import_s"], 4), "heavy_modules_on_import": proc["heavy_modules_on_import"],
+        "peak_rss_mb_one_env": round(proc["peak_rss_mb"], 1),
+        "steps_per_repeat": steps, "repeats": repeats,
+        "notes": "env/raw: the same episodes, physics timed inside env.step (stepSimulation + gravity compensation) vs the whole step; random actions; coop: step_agents with both agents acting (None: the person has no policy joints); medians over repeats",
+    }
+
+
+BENCH_TABLE = ("task", "robot", "env_steps_per_s", "raw_physics_steps_per_s", "reset_ms_median", "reference_env_steps_per_s", "vs_reference")
+"""The columns of ``bench``'s table for several specs."""
+
+BENCH_COOP_TABLE = ("task", "robot", "single_agent_env_steps_per_s", "multi_agent_env_steps_per_s", "multi_over_single")
+"""The columns of ``bench --coop``'s table for several specs."""
+
+
+def bench_coop_spec(spec: str, robot: str | None, steps: int, repeats: int, seed: int) -> dict:
+    """``bench --coop``: single- and multi-agent env steps/s of the spec's artifact in one run
+    (:func:`assistive_compiler.coop.bench_coop`), compiled into a temporary directory."""
+    from ..compile.compiler import compile_task
+    from ..coop import bench_coop, check_coop_spec
+    from ..spec.load import load_spec
+
+    check_coop_spec(load_spec(spec))
+    with tempfile.TemporaryDirectory() as tmp:
+        return bench_coop(compile_task(spec, robot, Path(tmp) / "coop").out_dir, steps=steps, repeats=repeats, seed=seed)
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from .output import cell, print_table, progress
+
+    results = []
+    with progress("bench", len(args.specs)) as tracker:
+        for spec in args.specs:
+            if args.coop:
+                r = bench_coop_spec(spec, args.robot, args.steps, args.repeats, args.seed)
+                tracker.done(f"{r['name']}: {r['multi_agent_env_steps_per_s']} multi-agent env steps/s, "
+                             f"{r['multi_over_single']} x single-agent ({spec})")
+            else:
+                r = bench(spec, args.robot, args.steps, args.resets, args.repeats, args.seed)
+                tracker.done(f"{r['gym_id']}: {r['env_steps_per_s']} env steps/s ({spec})")
+            results.append(r)
+    if args.json:
+        print(json.dumps(results[0] if len(results) == 1 else results, indent=1))
+        return EXIT_OK
+    if len(results) == 1:
+        figures = {k: v for k, v in results[0].items() if k != "notes"}
+        print_table(["figure", "value"], [[key, cell(value)] for key, value in figures.items()], left=["figure", "value"],
+                    caption=f"notes: {results[0]['notes']}")
+        return EXIT_OK
+    # Several tasks: one row each (taken one after the other in this run; medians over repeats).
+    columns = BENCH_COOP_TABLE if args.coop else BENCH_TABLE
+    print_table(columns, [[cell(r[k]) for k in columns] for r in results], left=("task", "robot"))
+    return EXIT_OK
+
+
+def add_commands(sub) -> None:
+    p = sub.add_parser("bench", help="speed figures taken in one run: steps/s vs raw physics and the reference, resets, compile, import, RSS")
+    p.add_argument("specs", nargs="+", metavar="spec", help="task spec file(s); several print one row each")
+    p.add_argument("--robot", help="robot (default: each spec's default)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the first repeat's episode and of the random actions")
+    p.add_argument("--steps", type=int, default=400, help="env steps per repeat")
+    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--resets", type=int, default=100)
+    p.add_argument("--coop", action="store_true", help="multi-agent (PettingZoo, both agents acting) vs single-agent env steps/s, in one run")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_bench)

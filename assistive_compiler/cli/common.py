@@ -1,0 +1,37 @@
+"""What every command shares: exit statuses, printing located problems, common arguments.
+
+Exit status: 0 success, 2 bad input (problems printed one per line as ``PATH:LINE:COL: message``),
+1 a run that failed for another stated reason.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..errors import SpecError
+
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+
+
+def print_problems(error: SpecError) -> None:
+    for problem in error.problems:
+        print(problem, file=sys.stderr)
+
+
+def add_spec_arguments(p: argparse.ArgumentParser, policy: bool = True) -> None:
+    """``spec``, ``--robot``, ``--policy`` (optional) and ``--seed``: what a rollout command needs."""
+    from ..policies import POLICIES
+
+    p.add_argument("spec", help="task spec file")
+    p.add_argument("--robot", help="robot (default: the spec's default)")
+    if policy:
+        p.add_argument("--policy", choices=POLICIES, default="scripted", help="policy to roll out (default scripted)")
+    p.add_argument("--seed", type=int, default=0, help="first episode seed")
+
+
+def make_env(spec: str, robot: str | None, out: str | None = None, **kwargs):
+    """The env of ``spec`` for ``robot``, compiled into ``out`` first (a cache hit when unchanged)."""
+    from ..runtime.env import AssistiveEnv
+
+    return AssistiveEnv.from_spec(spec, robot=robot, out_dir=out, **kwargs)

@@ -1,0 +1,141 @@
+"""The rollout commands: ``run`` (a policy over episodes: returns, success, largest terms) and
+``demo`` (the README's main job: Feeding on Jaco, scripted, with a picture).
+
+:func:`rollout` is the one episode loop both use; it is a plain function so that other commands
+(training, evaluation, co-optimisation) reuse it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..episode import EpisodeTally
+from .common import EXIT_OK, add_spec_arguments, make_env
+
+
+def rollout(env, policy, seed: int) -> dict:
+    """One episode: return, success, each term's unweighted values summed over the episode (the
+    reward is Σ weight × value: see ``term_weights`` in ``run --json``), mean force on the person (N)."""
+    obs, info = env.reset(seed=seed)
+    tally = EpisodeTally()
+    done = False
+    while not done:
+        obs, reward, terminated, truncated, info = env.step(policy(obs))
+        tally.add(reward, info)
+        done = terminated or truncated
+    return tally.summary(seed)
+
+
+def _yes_no(flag: bool) -> str:
+    return "yes" if flag else "no"
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from ..policies import make_policy
+    from .output import print_table, progress
+
+    if args.coop:  # both agents act (co-optimisation); the person by --human-policy
+        from ..coop import parallel_env, rollout_coop
+
+        coop_env = parallel_env(args.spec, args.robot, out_dir=args.out)
+        env, label = coop_env.env, f"{args.policy}, human {args.human_policy}"
+
+        def play(seed: int) -> dict:
+            return rollout_coop(coop_env, args.policy, args.human_policy, seed)
+    else:
+        env, label = make_env(args.spec, args.robot, args.out), args.policy
+        policy = make_policy(args.policy, env, seed=args.seed)
+
+        def play(seed: int) -> dict:
+            return rollout(env, policy, seed)
+    weights = {t.name: t.weight for t in env.manifest.reward}
+    episodes = []
+    with progress(f"{env.manifest.gym_id} {label}", args.episodes, enabled=not args.quiet) as tracker:
+        for k in range(args.episodes):
+            e = play(args.seed + k)
+            episodes.append(e)
+            tracker.done(f"episode {k} (seed {e['seed']}): return {e['return']:.1f}, success {_yes_no(e['success'])}; "
+                         f"{sum(x['success'] for x in episodes)}/{len(episodes)} successful so far")
+    env.close()
+    rate = sum(e["success"] for e in episodes) / len(episodes)
+    if args.json:
+        print(json.dumps({"task": env.manifest.task, "robot": env.manifest.robot_name, "policy": args.policy,
+                          **({"human_policy": args.human_policy} if args.coop else {}),
+                          "term_weights": weights, "episodes": episodes, "success_rate": rate,
+                          "mean_return": float(np.mean([e["return"] for e in episodes]))}, indent=1))
+        return EXIT_OK
+    human = f"  human-policy={args.human_policy}" if args.coop else ""
+    print(f"{env.manifest.gym_id}  policy={args.policy}{human}  episodes={len(episodes)}  seed={args.seed}")
+    rows = []
+    for k, e in enumerate(episodes):
+        top = sorted(e["terms"].items(), key=lambda kv: -abs(weights[kv[0]] * kv[1]))[:3]
+        shown = ", ".join(f"{name} {weights[name] * value:+.1f}" for name, value in top)
+        rows.append([str(k), str(e["seed"]), f"{e['return']:.1f}", _yes_no(e["success"]), shown])
+    largest = "largest weighted terms (episode sums)"
+    print_table(["ep", "seed", "return", "success", largest], rows, left=["success", largest])
+    print(f"success rate {rate:.2f}   mean return {np.mean([e['return'] for e in episodes]):.1f}")
+    return EXIT_OK
+
+
+def cmd_demo(args: argparse.Namespace) -> int:
+    from ..compile.compiler import compile_task
+    from ..policies import make_policy
+    from ..runtime.env import AssistiveEnv
+    from .render import record, write_picture
+
+    spec = str(Path(args.spec))
+    result = compile_task(spec, args.robot)
+    m = result.manifest
+    print(f"{'cache hit' if result.cache_hit else 'compiled'}: {m.task} for {m.robot_name} -> {result.out_dir}/ ({result.seconds:.2f} s)")
+    env = AssistiveEnv(result.out_dir, render_mode="rgb_array")
+    policy = make_policy("scripted", env)
+    outcomes = []
+    for k in range(args.episodes):
+        frames = None
+        if k == 0:
+            frames, _ = record(env, policy, args.seed, every=10)
+            env.reset(seed=args.seed)
+        e = rollout(env, policy, args.seed + k)
+        outcomes.append(e)
+        eaten = e["success_metric"]
+        print(f"episode {k}: return {e['return']:7.1f}  success {'yes' if e['success'] else 'no '}  "
+              f"{m.success.term} {eaten:g} (need {m.success.threshold:g})  mean force on person {e['mean_force_on_human_n']:.2f} N")
+        if frames is not None:
+            write_picture(frames, Path(args.picture), fps=1)
+    env.close()
+    rate = sum(o["success"] for o in outcomes) / len(outcomes)
+    print(f"scripted success {rate:.0%} over {len(outcomes)} episodes; picture: {args.picture}")
+    return EXIT_OK
+
+
+def _default_feeding() -> Path:
+    from ..paths import display, specs_dir
+
+    return Path(display(specs_dir() / "tasks" / "feeding.yaml"))
+
+
+def add_commands(sub) -> None:
+    from ..policies import HUMAN_POLICIES
+
+    p = sub.add_parser("run", help="roll out a policy and report returns, success and the largest terms")
+    add_spec_arguments(p)
+    p.add_argument("--episodes", type=int, default=5)
+    p.add_argument("--out", help="artifact directory (default generated/<task>-<robot>)")
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.add_argument("--coop", action="store_true", help="co-optimisation: the person acts too (by --human-policy), shared reward")
+    p.add_argument("--human-policy", dest="human_policy", choices=HUMAN_POLICIES, default="random",
+                   help="with --coop: random, zero (keep still by acting) or hold (no human action: the static person); default random")
+    p.set_defaults(func=cmd_run)
+
+    p = sub.add_parser("demo", help="the main job: compile Feeding for Jaco, run the scripted policy, write a picture")
+    p.add_argument("--spec", default=str(_default_feeding()), help="task spec (default: the shipped feeding.yaml)")
+    p.add_argument("--robot", default="jaco")
+    p.add_argument("--episodes", type=int, default=3)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--picture", default="feeding.png", help="picture of the first episode (.png strip or .gif)")
+    p.set_defaults(func=cmd_demo)

@@ -1,0 +1,115 @@
+"""The body sections: body names, ``targets``, ``markers``, ``particles`` and ``garments``.
+
+Checks that every furniture, tool, particle set and garment has a name of its own (not ``robot``
+or ``person``), that targets sit on known links (``surface_of``: person limbs with a capsule) and
+their per-variant offsets name the task's person variants, that marker sets are cleared by a tool
+link, that particle sets attach to, rest in and are lost beyond known bodies (containers are
+tools whose part declares one), and that a garment's grip, held node set and colliders exist.
+Produces the body-name table (``Scope.body_names``), the resolved target points and the marker
+sets.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..errors import did_you_mean, one_of
+from .located import expected
+from .scope import RESERVED_BODIES, Scope
+
+
+def name_bodies(s: Scope) -> None:
+    """Fill ``Scope.body_names``: each declared body name -> the section that declares it."""
+    spec = s.spec
+    s.body_names = {"robot": "robot", "person": "person"}
+    for section, names in (("scene.furniture", spec.scene.furniture), ("tools", spec.tools), ("particles", spec.particles),
+                           ("garments", spec.garments)):
+        for name in names:
+            path = tuple(section.split(".")) + (name,)
+            if name in s.body_names:
+                other = s.body_names[name]
+                why = "is reserved" if name in RESERVED_BODIES else f"is already used in {other}"
+                s.problem(path, f"body name '{name}' {why}; every furniture, tool and particle set needs its own name", key=True)
+            else:
+                s.body_names[name] = section
+
+
+def targets(s: Scope) -> dict[str, dict[str, Any]]:
+    """Target name -> a point (``surface_of`` targets: the first limb, plus ``surface_links``)."""
+    spec = s.spec
+    out: dict[str, dict[str, Any]] = {}
+    for name, target in spec.targets.items():
+        if target.surface_of:
+            links = s.limbs(target.surface_of, ("targets", name, "surface_of"))
+            if links:
+                out[name] = {"body": "person", "link": links[0], "surface_links": links}
+            continue
+        p = s.point(target.link, ("targets", name, "link"), allow_target=False)
+        for variant in target.offset_by_variant:
+            if variant not in spec.person.variants:
+                s.problem(("targets", name, "offset_by_variant", variant), f"'{variant}' is not a person variant of this task; variants are {one_of(spec.person.variants)}{did_you_mean(variant, spec.person.variants)}", key=True)
+        if p:
+            out[name] = p
+    return out
+
+
+def markers(s: Scope) -> dict[str, dict[str, Any]]:
+    """Marker set name -> the limbs it is drawn on, the clearing tool link, radius and spacing (m)."""
+    spec = s.spec
+    out: dict[str, dict[str, Any]] = {}
+    for name, ms in spec.markers.items():
+        base = ("markers", name)
+        if name in s.body_names or name in spec.targets:
+            s.problem(base, f"marker set name '{name}' is already used by a body or target", key=True)
+        links = s.limbs(ms.surface_of, base + ("surface_of",))
+        tool = s.point(ms.cleared_by.tool, base + ("cleared_by", "tool"), allow_target=False)
+        if tool is not None and tool["body"] not in spec.tools:
+            s.problem(base + ("cleared_by", "tool"), f"markers are cleared by a tool link; '{ms.cleared_by.tool}' is not on a tool (tools: {one_of(spec.tools)})")
+            tool = None
+        if links and tool:
+            out[name] = {"links": links, "tool": tool, "radius_m": ms.cleared_by.radius_m, "spacing_m": ms.spacing_m,
+                         "show_rgba": ms.show_rgba}
+    return out
+
+
+def check_particles(s: Scope) -> None:
+    for name, ps in s.spec.particles.items():
+        base = ("particles", name)
+        s.body(ps.attach, base + ("attach",), allow_particles=False)
+        if ps.consumed_at:
+            s.point(ps.consumed_at.target, base + ("consumed_at", "target"))
+            if ps.consumed_at.outside_of is not None:
+                _check_container(s, ps.consumed_at.outside_of, base + ("consumed_at", "outside_of"))
+        if ps.rest is not None:
+            _check_container(s, ps.rest.container, base + ("rest", "container"))
+        if ps.lost_beyond:
+            s.body(ps.lost_beyond.body, base + ("lost_beyond", "body"), allow_particles=False)
+        if ps.hit_body:
+            s.body(ps.hit_body, base + ("hit_body",), allow_particles=False)
+
+
+def _check_container(s: Scope, holder: str, path: tuple) -> None:
+    """``holder`` must be a tool whose part declares a container."""
+    if s.body(holder, path, allow_particles=False):
+        if holder not in s.tools or s.tools[holder].part.container is None:
+            with_container = [t for t, part in s.tools.items() if part.part.container is not None]
+            s.problem(path, f"'{holder}' is not a tool with a container; tools with one: {one_of(with_container) or 'none'}")
+
+
+def check_garments(s: Scope) -> None:
+    from ..garment import sleeve_node_sets
+
+    spec = s.spec
+    for name, g in spec.garments.items():
+        base = ("garments", name, "held")
+        if g.held.grip not in s.robot.part.grips:
+            grips = list(s.robot.part.grips)
+            s.problem(base + ("grip",), f"robot '{s.robot_name}' has no grip '{g.held.grip}' to hold garment '{name}' (add it under grips: in {s.robot.shown}); its grips are {one_of(grips)}{did_you_mean(g.held.grip, grips)}")
+        for i, body in enumerate(g.collides_with or []):
+            if s.body(body, ("garments", name, "collides_with", i), allow_particles=False) == name:
+                s.problem(("garments", name, "collides_with", i), f"garment '{name}' cannot collide with itself (self-collision is off)")
+        sets = sleeve_node_sets(g.shape.rings, g.shape.segments)
+        if g.held.nodes not in sets:
+            s.problem(base + ("nodes",), f"unknown node set '{g.held.nodes}' of garment '{name}'; {expected(sets, g.held.nodes)}")
+    if spec.garments and spec.tools:
+        s.problem(("garments",), "a task with a garment holds no tool (the garment is what the hand holds); remove tools: or garments:", key=True)
