@@ -72,7 +72,7 @@ def search_base(rt: ResolvedTask, arms: list, goals, offset, rng, carry: Carried
     starts from its rest pose. Raises with the goal that no sampled pose reached. With ``carry``
     the base sits at the carried furniture's mount height and the furniture moves under every
     sampled base; a pose where it touches the person or other furniture is rejected."""
-    search = rt.spec.robot.base_search
+    search = rt.spec.robot.search_for(rt.robot_name)
     anchor = np.asarray(search.origin_m[:2]) + np.asarray(offset[:2])
     z = (carry.height if carry is not None else rt.robot.part.base_height_m) + (offset[2] if len(offset) > 2 else 0.0)
     found = []
