@@ -149,3 +149,11 @@ def test_one_action_extends_all_four_tubes(scratch_env):
         env.step(np.array([0.0, 0.0, 0.0, 1.0, 0.0]))
     tubes = [pb.getJointState(w.robot.id, w.robot.joints[t], physicsClientId=w.client)[0] for t in TUBES]
     assert min(tubes) > 0.01
+
+
+def test_base_search_ranks_poses_by_isotropy_for_a_three_joint_arm(scratch_env):
+    # JLWKI over the directions the arm can move in: Stretch's 3 arm joints give a rank-3 Jacobian,
+    # whose 6-D determinant is 0, so every pose used to score 0 and the search could not rank them.
+    placement = scratch_env.manifest.robot.placement
+    poses = [p for variant in placement.values() for p in variant["base_poses"]] if isinstance(placement, dict) else []
+    assert poses and all(0.0 < p["jlwki"] <= p["goals_reached"] + 1e-9 for p in poses)

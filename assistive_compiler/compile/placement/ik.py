@@ -125,7 +125,12 @@ class ArmKinematics:
             qr = (u - l) / 2
             w.append(max(0.001, 1 - 0.5 ** ((qr - abs(qr - qi + l)) / (0.05 * qr) + 1)))
         M = J @ np.diag(w) @ J.T
-        return float(max(np.linalg.det(M), 0.0) ** (1 / 6) / (np.trace(M) / 6))
+        # Isotropy over the directions the arm can move in: with n = min(6, joints) it is the
+        # geometric over the arithmetic mean of M's n largest eigenvalues (det^(1/6) / (trace/6) for
+        # six or more joints; a 3-joint arm such as Stretch's has rank 3 and would always score 0).
+        n = min(6, J.shape[1])
+        eig = np.clip(np.sort(np.linalg.eigvalsh(M))[::-1][:n], 0.0, None)
+        return float(np.prod(eig) ** (1 / n) / (eig.sum() / n)) if eig.sum() > 0 else 0.0
 
 
 def arm_chains(rt: ResolvedTask, pc: PlacementClient, scene) -> list[tuple[ArmKinematics, object, tuple]]:
