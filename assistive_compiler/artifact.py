@@ -21,7 +21,7 @@ import json
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_serializer
 
 FORMAT_VERSION = 1
 
@@ -123,8 +123,24 @@ class Person(_Model):
     )
 
 
+class Drive(_Model):
+    """A differential-drive base on a planar chain (see :class:`assistive_compiler.spec.parts.BaseDrive`)."""
+
+    joints: tuple[str, str, str] = Field(description="The x, y (prismatic, m) and yaw (revolute, rad) joints.")
+    base_link: str = Field(description="The moving base link (robot_base observations are in its frame).")
+    wheel_radius: float = Field(description="Wheel radius, m.")
+    wheel_separation: float = Field(description="Distance between the wheels, m.")
+    action_scale: float = Field(description="Wheel turn per unit action per physics step, rad.")
+    position_gain: float = Field(description="Position gain of the drive joints.")
+    max_force: tuple[float, float, float] = Field(description="Force limits of x, y (N) and yaw (N·m).")
+
+
 class Robot(_Model):
-    """The robot: which joints act, links by role, control, gripper."""
+    """The robot: which joints act, links by role, control, gripper.
+
+    The action is the drive's two wheel dimensions (when ``drive`` is set), then one per arm joint.
+    ``drive``, ``followers`` and ``action_multipliers`` are left out of the JSON when unset, so a
+    fixed-base robot's manifest has the same bytes as before they existed."""
 
     name: str = Field(description="Library robot name.")
     title: str = Field(description="Display name.")
@@ -140,6 +156,22 @@ class Robot(_Model):
     gripper_position: list[float] = Field(description="The task's grip: each finger joint's value (rad or m).")
     welded_joints: dict[str, float] = Field(default_factory=dict, description="Moving joints of the robot's URDF that the task never drives, made fixed in the artifact's robot.urdf at these values (rad or m): fingers at the grip, the rest at 0 (both within the joint's limits).")
     placement: dict[str, Any] = Field(default_factory=dict, description="How the base was placed: mount, or the search's kept poses with goals reached and JLWKI.")
+    action_multipliers: list[float] | None = Field(None, description="Per arm joint, a factor on action_scale (None: 1 each).")
+    followers: dict[str, str] | None = Field(None, description="Joints moved with an arm joint (follower -> leader): the same target change every step, the leader's value at start.")
+    drive: Drive | None = Field(None, description="The mobile base's drive (None: a fixed base).")
+
+    @model_serializer(mode="wrap")
+    def _drop_unset_mobility(self, handler):
+        data = handler(self)
+        for key in ("action_multipliers", "followers", "drive"):
+            if data.get(key) is None:
+                data.pop(key, None)
+        return data
+
+    @property
+    def action_size(self) -> int:
+        """Length of the robot's action: two wheel dimensions with a drive, then one per arm joint."""
+        return len(self.arm_joints) + (2 if self.drive is not None else 0)
 
 
 class ToolAttachment(_Model):

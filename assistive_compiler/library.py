@@ -159,8 +159,14 @@ class Library:
             for side, arm in part.arms.items():
                 for i, j in enumerate(arm.joints):
                     need(j, joints, "joint", ("arms", side, "joints", i))
+                for follower in arm.follow:
+                    need(follower, joints, "joint", ("arms", side, "follow", follower))
                 need(arm.end_effector, links, "link", ("arms", side, "end_effector"))
                 need(arm.tool_mount, links, "link", ("arms", side, "tool_mount"))
+            if part.base_drive is not None:
+                for i, j in enumerate(part.base_drive.joints):
+                    need(j, joints, "joint", ("base_drive", "joints", i))
+                need(part.base_drive.base_link, links, "link", ("base_drive", "base_link"))
             for side, grip in part.gripper.items():
                 for i, j in enumerate(grip.joints):
                     need(j, joints, "joint", ("gripper", side, "joints", i))

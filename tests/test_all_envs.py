@@ -15,9 +15,10 @@ IDS = sorted(shipped_ids())
 
 def test_shipped_task_robot_pairs_are_registered():
     tasks = {i.split("/")[1].removesuffix("-v1") for i in IDS}
-    expected = {f"{task}{robot}" for task in ("Feeding", "ScratchItch") for robot in ("PR2", "Jaco", "Baxter", "Sawyer", "Panda")}
-    expected |= {f"{task}{robot}" for task in ("BedBathing", "Drinking", "Dressing", "ArmManipulation") for robot in ("PR2", "Jaco", "Baxter", "Sawyer", "Panda")}
-    assert tasks == expected
+    robots = ("PR2", "Jaco", "Baxter", "Sawyer", "Panda", "Stretch")
+    expected = {f"{task}{robot}" for task in ("Feeding", "ScratchItch", "BedBathing", "Drinking", "Dressing", "ArmManipulation")
+                for robot in robots}
+    assert tasks == expected and len(IDS) == 36
 
 
 @pytest.mark.slow

@@ -48,7 +48,7 @@ def feeding(artifact):
 
 
 def test_names_follow_the_reference():
-    assert len(NAMES) == 30 == len(shipped_ids())
+    assert len(NAMES) == 36 == len(shipped_ids())
     assert "FeedingJacoHuman-v1" in NAMES and "ScratchItchPR2Human-v1" in NAMES and "ArmManipulationPandaHuman-v1" in NAMES
     assert coop.coop_name("assistive_compiler/BedBathingSawyer-v1") == "BedBathingSawyerHuman-v1"
     assert coop.spec_of("assistive_compiler/DressingBaxterHuman-v1") == (TASKS / "dressing.yaml", "baxter")

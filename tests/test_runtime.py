@@ -501,7 +501,7 @@ def test_package_import_is_light(tmp_path):
     code = (
         "import json, sys\n"
         "import assistive_compiler\n"
-        "heavy = ['torch', 'tensorflow', 'ray', 'stable_baselines3', 'pybullet']\n"
+        "heavy = ['torch', 'tensorflow', 'ray', 'stable_baselines3', 'pybullet', 'viser', 'minari', 'h5py', 'trimesh', 'websockets']\n"
         "print(json.dumps(sorted(m for m in heavy if m in sys.modules)))\n"
     )
     env = dict(os.environ, ASSISTIVE_COMPILER_CACHE=str(tmp_path / "cache"))

@@ -19,6 +19,8 @@ imports.
 * :mod:`.bench` — bench
 * :mod:`.compare` — compare
 * :mod:`.train`, :mod:`.evaluate`, :mod:`.table` — learning (the optional ``train`` extra)
+* :mod:`.view` — view (browser or pybullet GUI)
+* :mod:`.collect` — collect (Minari datasets)
 """
 
 from __future__ import annotations
@@ -29,10 +31,10 @@ import sys
 from typing import Callable, Sequence
 
 from ..errors import SpecError, UsageError
-from . import bench, compare, evaluate, render, run, spec_commands, table, train
+from . import bench, collect, compare, evaluate, render, run, spec_commands, table, train, view
 from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, print_problems
 
-COMMAND_MODULES = (spec_commands, run, render, bench, compare, train, evaluate, table)
+COMMAND_MODULES = (spec_commands, run, render, bench, compare, view, collect, train, evaluate, table)
 
 __all__ = ["COMMAND_MODULES", "EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_OK", "build_parser", "main"]
 

@@ -159,7 +159,7 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
     reference = REFERENCE_STEPS_PER_S.get((m.task, m.robot_name))
     return {
         "task": m.task, "robot": m.robot_name, "gym_id": m.gym_id,
-        "obs_size": sum(t.size for t in m.observations["robot"]), "action_size": len(m.robot.arm_joints),
+        "obs_size": sum(t.size for t in m.observations["robot"]), "action_size": m.robot.action_size,
         "env_steps_per_s": round(env_med, 1),
         "reference_env_steps_per_s": reference,
         "vs_reference": round(env_med / reference, 2) if reference is not None else None,

@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from ..episode import EpisodeTally
-from .common import EXIT_OK, add_spec_arguments, make_env
+from .common import EXIT_BAD_INPUT, EXIT_OK, add_spec_arguments, make_env
 
 
 def rollout(env, policy, seed: int) -> dict:
@@ -38,6 +39,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     from ..policies import make_policy
     from .output import print_table, progress
 
+    if args.coop and args.record:
+        print("run: --record writes single-agent episodes; it cannot be combined with --coop", file=sys.stderr)
+        return EXIT_BAD_INPUT
     if args.coop:  # both agents act (co-optimisation); the person by --human-policy
         from ..coop import parallel_env, rollout_coop
 
@@ -49,9 +53,14 @@ def cmd_run(args: argparse.Namespace) -> int:
     else:
         env, label = make_env(args.spec, args.robot, args.out), args.policy
         policy = make_policy(args.policy, env, seed=args.seed)
+        player = env
+        if args.record:  # every episode also written as DIR/episode-NNNN.npz (reads only: same episodes)
+            from ..record import RecordEpisodes
+
+            player = RecordEpisodes(env, args.record, policy=args.policy)
 
         def play(seed: int) -> dict:
-            return rollout(env, policy, seed)
+            return rollout(player, policy, seed)
     weights = {t.name: t.weight for t in env.manifest.reward}
     episodes = []
     with progress(f"{env.manifest.gym_id} {label}", args.episodes, enabled=not args.quiet) as tracker:
@@ -130,6 +139,8 @@ def add_commands(sub) -> None:
     p.add_argument("--coop", action="store_true", help="co-optimisation: the person acts too (by --human-policy), shared reward")
     p.add_argument("--human-policy", dest="human_policy", choices=HUMAN_POLICIES, default="random",
                    help="with --coop: random, zero (keep still by acting) or hold (no human action: the static person); default random")
+    p.add_argument("--record", metavar="DIR", help="also write each episode to DIR/episode-NNNN.npz (poses, actions, per-term "
+                   "rewards, success; see assistive_compiler.record.format); view one with: view SPEC --replay FILE")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("demo", help="the main job: compile Feeding for Jaco, run the scripted policy, write a picture")

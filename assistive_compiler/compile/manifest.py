@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ..artifact import Capsule, Manifest, MarkerPoint, MarkerSet, Person, PersonVariant, Robot, Sim, StartState, Success, Target, TermUse
+from ..artifact import Capsule, Drive, Manifest, MarkerPoint, MarkerSet, Person, PersonVariant, Robot, Sim, StartState, Success, Target, TermUse
 from ..paths import display
 from ..quat import capsule_axes
 from ..resolve import ResolvedTask
@@ -83,10 +83,19 @@ def _robot(rt: ResolvedTask, arm_joints, lower, upper, placements, welded) -> Ro
         if field not in control.model_fields_set and own is not None:
             chosen[field] = own
     finger_joints, grip_pos = gripper(rt)
+    arms = [robot_part.arm_for(side)[1] for side in rt.sides]
+    multipliers = [m for arm in arms for m in (arm.action_multipliers or [1.0] * len(arm.joints))]
+    followers = {f: leader for arm in arms for f, leader in arm.follow.items()}
+    d = robot_part.base_drive
+    drive = None if d is None else Drive(joints=d.joints, base_link=d.base_link, wheel_radius=d.wheel_radius_m,
+                                         wheel_separation=d.wheel_separation_m, action_scale=control.action_scale_rad * d.action_multiplier,
+                                         position_gain=d.position_gain, max_force=(d.max_force_n, d.max_force_n, d.max_torque_nm))
     return Robot(name=rt.robot_name, title=robot_part.title, arm_joints=arm_joints, joint_lower=rounded(lower), joint_upper=rounded(upper),
                  links=rt.robot_links, action_scale=control.action_scale_rad, position_gain=chosen["position_gain"],
                  max_force=chosen["max_force_nm"], gripper_joints=finger_joints, gripper_position=grip_pos,
-                 welded_joints=welded, placement=placements)
+                 welded_joints=welded, placement=placements,
+                 action_multipliers=multipliers if any(m != 1.0 for m in multipliers) else None,
+                 followers=followers or None, drive=drive)
 
 
 def _targets(rt: ResolvedTask) -> dict[str, Target]:

@@ -81,6 +81,11 @@ def robot_welds(rt: ResolvedTask, urdf_xml: str) -> dict[str, float]:
     joint every physics step, and each row costs in proportion to the robot's joint count, so a
     Jaco's six finger joints cost about a seventh of a Scratch Itch step while holding still."""
     driven = set(rt.joint_groups["robot.arm"]["joints"])
+    part = rt.robot.part
+    for side in rt.sides:  # joints moved with an arm joint (Stretch's telescoping tubes)
+        driven |= set(part.arm_for(side)[1].follow)
+    if part.base_drive is not None:  # the mobile base's planar chain
+        driven |= set(part.base_drive.joints)
     finger_joints, grip = gripper(rt)
     held = dict(zip(finger_joints, grip))
     welds: dict[str, float] = {}

@@ -22,6 +22,7 @@ import math
 import numpy as np
 import pybullet as pb
 
+from ..ik_options import ik_damping, ik_limits
 from ..quat import quat_conj, quat_mul, quat_rotate
 
 
@@ -46,7 +47,7 @@ class _Track:
         self.ee_link = robot.links[mount_link]
         self.ee_point = snap.point({"body": "robot", "link": mount_link})
         order = list(m.robot.arm_joints)
-        self.action_cols = [order.index(j) for j in joints]
+        self.action_cols = [order.index(j) for j in joints]  # columns among the arm joints (env.arm_idx, env.delta_scale)
 
 
 class ScriptedPolicy:
@@ -70,11 +71,17 @@ class ScriptedPolicy:
         c = env.world.client
         movable = [j for j in range(pb.getNumJoints(robot.id, physicsClientId=c)) if pb.getJointInfo(robot.id, j, physicsClientId=c)[2] != pb.JOINT_FIXED]
         self.movable = movable
+        # Each arm joint with its followers: IK spreads a move over the group, the action is their mean.
+        followers = m.robot.followers or {}
         for track in self.tracks:
-            track.cols = [movable.index(env.arm_idx[k]) for k in track.action_cols]
-        self.lo = [pb.getJointInfo(robot.id, j, physicsClientId=c)[8] for j in movable]
-        self.hi = [pb.getJointInfo(robot.id, j, physicsClientId=c)[9] for j in movable]
-        self.ranges = [max(h - l, 1e-3) for l, h in zip(self.lo, self.hi)]
+            track.cols = [[movable.index(env.arm_idx[k])] + [movable.index(robot.joints[f]) for f, lead in followers.items()
+                                                             if lead == m.robot.arm_joints[k]] for k in track.action_cols]
+        self.lo_all = [pb.getJointInfo(robot.id, j, physicsClientId=c)[8] for j in movable]
+        self.hi_all = [pb.getJointInfo(robot.id, j, physicsClientId=c)[9] for j in movable]
+        self.ranges = [max(h - l, 1e-3) for l, h in zip(self.lo_all, self.hi_all)]
+        # A mobile base stays put: the script reaches with the arm (its wheel actions are 0).
+        self.damping = ik_damping(movable, env.drive.idx if env.drive else [])
+        self.arm_offset = 2 if env.drive else 0
 
     def _goal(self, track: _Track) -> tuple[np.ndarray, float]:
         """The track's current waypoint position (world, m) and tolerance."""
@@ -124,7 +131,7 @@ class ScriptedPolicy:
         c = env.world.client
         robot = env.world.robot.id
         rest = [pb.getJointState(robot, j, physicsClientId=c)[0] for j in self.movable]
-        action = np.zeros(len(env.arm_idx), dtype=np.float32)
+        action = np.zeros(env.action_space.shape, dtype=np.float32)
         for track in self.tracks:
             goal, tol = self._goal(track)
             error = float(np.linalg.norm(env.snap.position(track.move) - goal))
@@ -150,9 +157,9 @@ class ScriptedPolicy:
             if track.face_normal[track.index] is not None:
                 orn = self._facing(track, orn, -env.snap.normal(track.waypoints[track.index][0]), track.face_normal[track.index])
             ee_pos, ee_orn = pb.multiplyTransforms(goal.tolist(), orn, inv_pos, inv_orn)
-            sol = pb.calculateInverseKinematics(robot, track.ee_link, ee_pos, ee_orn, lowerLimits=self.lo, upperLimits=self.hi,
-                                                jointRanges=self.ranges, restPoses=rest, maxNumIterations=50, physicsClientId=c)
-            q_goal = np.array([sol[k] for k in track.cols])
-            q = np.array([rest[k] for k in track.cols])
-            action[track.action_cols] = np.clip((q_goal - q) / env.delta_scale, -1.0, 1.0)
+            sol = pb.calculateInverseKinematics(robot, track.ee_link, ee_pos, ee_orn, maxNumIterations=50, physicsClientId=c,
+                                                **ik_limits(self, rest))
+            step = np.array([np.mean([sol[k] - rest[k] for k in group]) for group in track.cols])
+            cols = track.action_cols
+            action[[self.arm_offset + k for k in cols]] = np.clip(step / env.delta_scale[cols], -1.0, 1.0)
         return action

@@ -155,12 +155,15 @@ def _check_searched_mount(s: Scope, mount: str | None) -> None:
 def base_goals(s: Scope) -> list[dict[str, Any]]:
     """The base search's goals: a resolved point, an offset (m) and the arm that should reach it."""
     spec = s.spec
+    own = spec.robot.per_robot.get(s.robot_name)
+    where = ("robot", "per_robot", s.robot_name, "base_search") if own is not None and own.base_search is not None else ("robot", "base_search")
+    search = spec.robot.search_for(s.robot_name)
     goals = [
-        {"point": s.point(g.point, ("robot", "base_search", "goals", i, "point")), "offset_m": list(g.offset_m),
+        {"point": s.point(g.point, where + ("goals", i, "point")), "offset_m": list(g.offset_m),
          "oriented": g.oriented, "required": g.required, "arm": (g.arm or "right") if len(s.sides) > 1 else s.sides[0]}
-        for i, g in enumerate(spec.robot.base_search.goals)
+        for i, g in enumerate(search.goals)
     ]
-    for i, g in enumerate(spec.robot.base_search.goals):
+    for i, g in enumerate(search.goals):
         if g.arm is not None and spec.robot.arm != "both":
-            s.problem(("robot", "base_search", "goals", i, "arm"), f"a goal names an arm only in a task acting with both arms (robot.arm: both); this task's arm is '{spec.robot.arm}'")
+            s.problem(where + ("goals", i, "arm"), f"a goal names an arm only in a task acting with both arms (robot.arm: both); this task's arm is '{spec.robot.arm}'")
     return goals

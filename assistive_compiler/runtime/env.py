@@ -1,8 +1,10 @@
 """The Gymnasium face of a compiled task: one generic environment for every task and robot.
 
 * **Action** (robot): joint-position deltas of the arm in [−1, 1]; each env step the target is
-  ``q_measured + frame_skip · action_scale · clip(a)`` clamped to the joint limits, sent as one
-  position-control command, then ``frame_skip`` physics steps run (the paper's 10 Hz control).
+  ``q_measured + frame_skip · action_scale · multiplier · clip(a)`` clamped to the joint limits,
+  sent as one position-control command, then ``frame_skip`` physics steps run (the paper's 10 Hz
+  control). A mobile robot's action starts with two wheel dimensions (:mod:`.drive`), and joints
+  that follow an arm joint get its target change.
 * **Observation**: the spec's features concatenated (float32).
 * **Reward**: Σ weight·value over the reward terms (preference costs included);
   ``info["terms"]`` holds every term's unweighted value, ``info["total_force_on_human"]`` the
@@ -41,6 +43,7 @@ from ..artifact import Manifest, TermUse
 from ..quat import capsule_axes
 from ..terms.registry import ref_fields, terms
 from .markers import MarkerSystem
+from .drive import BaseDriveControl, FollowerControl
 from .human import PersonController, draw_impairment  # noqa: F401  (draw_impairment: re-exported)
 from .particles import ParticleSystem
 from .snapshot import Snapshot
@@ -116,9 +119,17 @@ class AssistiveEnv(gym.Env):
         self.arm_idx = [robot.joints[j] for j in m.robot.arm_joints]
         self.lower = np.array(m.robot.joint_lower)
         self.upper = np.array(m.robot.joint_upper)
-        self.delta_scale = m.robot.action_scale * m.sim.frame_skip
+        #: Per arm joint: target change per unit action per env step (rad or m).
+        self.delta_scale = m.robot.action_scale * m.sim.frame_skip * np.asarray(m.robot.action_multipliers or [1.0] * len(self.arm_idx))
         self._gains = [m.robot.position_gain] * len(self.arm_idx)
         self._forces = [m.robot.max_force] * len(self.arm_idx)
+        # Followers (moved with an arm joint) and a mobile base's drive, both commanded with the arm.
+        self.drive = BaseDriveControl(self.world, m.robot.drive, m.sim.frame_skip) if m.robot.drive else None
+        self.follow = FollowerControl(self.world, m.robot.followers or {}, list(m.robot.arm_joints), self.delta_scale)
+        self._arm_slice = slice(2, None) if self.drive else slice(None)
+        self._command_idx = self.arm_idx + self.follow.idx + (self.drive.idx if self.drive else [])
+        self._command_gains = self._gains + [m.robot.position_gain] * len(self.follow.idx) + (self.drive.gains if self.drive else [])
+        self._command_forces = self._forces + [m.robot.max_force] * len(self.follow.idx) + (self.drive.forces if self.drive else [])
 
         self.robot_features = Features(m.observations["robot"], self.snap)
         self.reward_fns = [(t.name, t.weight, bind_term(t, self.snap)) for t in m.reward]
@@ -128,7 +139,7 @@ class AssistiveEnv(gym.Env):
         self.tool_point = self.snap.point({"body": "robot", "link": m.robot.links["tool_mount"]})
         self._force_on_person = ([b.name for b in m.bodies if b.kind in ("robot", "tool")] + [g.name for g in m.garments], ["person"])
         self.observation_space = self.robot_features.space
-        self.action_space = gym.spaces.Box(-1.0, 1.0, (len(self.arm_idx),), np.float32)
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (m.robot.action_size,), np.float32)
         self.steps = 0
         self.success_metric: float | None = None
         #: Whether the world has seen anything since it was built (a reset runs collision
@@ -158,8 +169,15 @@ class AssistiveEnv(gym.Env):
         self._used = True
         m, w, c = self.manifest, self.world, self.world.client
         w.restore()
-        # Person variant: the drawn one in place, the others parked.
+        # Person variant: the drawn one in place, the others parked. ``options["person_variant"]``
+        # (a variant name) chooses it instead; the draw is still made, so every other draw is the seed's.
         variant = m.person.variants[int(rng.integers(len(m.person.variants)))]
+        chosen = (options or {}).get("person_variant")
+        if chosen is not None:
+            names = [v.name for v in m.person.variants]
+            if chosen not in names:
+                raise ValueError(f"unknown person variant {chosen!r}; this task has {', '.join(names)}")
+            variant = m.person.variants[names.index(chosen)]
         w.active_variant = variant
         self.snap.begin_episode()
         for i, v in enumerate(m.person.variants):
@@ -185,11 +203,11 @@ class AssistiveEnv(gym.Env):
         k = int(rng.integers(len(variant.starts)))
         start = variant.starts[k]
         w.set_base_frame(w.robot, start.base_position, start.base_orientation)
-        q0 = start.joints
-        for i, q in zip(self.arm_idx, q0):
+        q0 = list(start.joints) + self.follow.start(start.joints) + ([0.0, 0.0, 0.0] if self.drive else [])
+        for i, q in zip(self._command_idx, q0):
             pb.resetJointState(w.robot.id, i, q, physicsClientId=c)
-        pb.setJointMotorControlArray(w.robot.id, self.arm_idx, pb.POSITION_CONTROL, targetPositions=q0,
-                                     positionGains=self._gains, forces=self._forces, physicsClientId=c)
+        pb.setJointMotorControlArray(w.robot.id, self._command_idx, pb.POSITION_CONTROL, targetPositions=q0,
+                                     positionGains=self._command_gains, forces=self._command_forces, physicsClientId=c)
         # Tools follow the hand exactly.
         for att in m.tools:
             link_pos, link_orn = w.link_frame(w.robot, w.robot.links[att.parent_link])
@@ -211,8 +229,8 @@ class AssistiveEnv(gym.Env):
 
         self.steps = 0
         self.success_metric = None
-        self.snap.actions = {"robot": np.zeros(len(self.arm_idx)), "human": np.zeros(0)}
-        self.snap.set_frame("robot_base", *w.base_frame(w.robot))
+        self.snap.actions = {"robot": np.zeros(m.robot.action_size), "human": np.zeros(0)}
+        self._set_robot_base_frame()
         self.snap.set_frame("person_base", *w.base_frame(person))
         self.snap.refresh()
         return self._observe(), {"person_variant": variant.name, "start": k, "impairment": impairment}
@@ -235,13 +253,17 @@ class AssistiveEnv(gym.Env):
     def _step(self, action, human_action):
         m, w, c = self.manifest, self.world, self.world.client
         raw = np.asarray(action, dtype=np.float64).reshape(-1)
-        if raw.shape != (len(self.arm_idx),):
-            raise ValueError(f"action must have shape ({len(self.arm_idx)},), got {raw.shape}")
+        if raw.shape != self.action_space.shape:
+            raise ValueError(f"action must have shape {self.action_space.shape}, got {raw.shape}")
         q = np.array([s[0] for s in pb.getJointStates(w.robot.id, self.arm_idx, physicsClientId=c)])
         # np.minimum/np.maximum: np.clip's result, without its ~6 µs of call overhead.
-        target = np.minimum(np.maximum(q + self.delta_scale * np.minimum(np.maximum(raw, -1.0), 1.0), self.lower), self.upper)
-        pb.setJointMotorControlArray(w.robot.id, self.arm_idx, pb.POSITION_CONTROL, targetPositions=target.tolist(),
-                                     positionGains=self._gains, forces=self._forces, physicsClientId=c)
+        clipped = np.minimum(np.maximum(raw, -1.0), 1.0)
+        arm_action = clipped[self._arm_slice]
+        target = np.minimum(np.maximum(q + self.delta_scale * arm_action, self.lower), self.upper).tolist()
+        if len(self._command_idx) > len(self.arm_idx):  # followers and a drive, in one command with the arm
+            target += self.follow.targets(arm_action) + (self.drive.targets(clipped[:2]) if self.drive else [])
+        pb.setJointMotorControlArray(w.robot.id, self._command_idx, pb.POSITION_CONTROL, targetPositions=target,
+                                     positionGains=self._command_gains, forces=self._command_forces, physicsClientId=c)
         # The person: held / tremoring without a human action, else its policy joints act (runtime/human.py).
         human = None if human_action is None else np.asarray(human_action, dtype=np.float64).reshape(-1)
         self.human.apply(human, self.steps)
@@ -250,6 +272,8 @@ class AssistiveEnv(gym.Env):
         w.step_physics()
         self.steps += 1
         self.snap.actions["robot"] = raw
+        if self.drive:  # robot_base observations are in the moving base's frame
+            self._set_robot_base_frame()
         self.snap.refresh()
         self.particles.update()
         self.markers.update()
@@ -277,6 +301,12 @@ class AssistiveEnv(gym.Env):
         self.world.close()
 
     # -- helpers -------------------------------------------------------------------------------
+    def _set_robot_base_frame(self) -> None:
+        """The robot_base frame: the moving base link of a mobile robot, else the body's base frame."""
+        w = self.world
+        frame = w.link_frame(w.robot, self.drive.base_link) if self.drive else w.base_frame(w.robot)
+        self.snap.set_frame("robot_base", *frame)
+
     def _observe(self) -> np.ndarray:
         return self.robot_features(self.snap)
 

@@ -257,6 +257,17 @@ class ParticleSystem:
             if ps.rest is not None:
                 self._maybe_carry(ps, ids)
 
+    def shown_positions(self, name: str) -> np.ndarray:
+        """Where each particle of set ``name`` appears, (n, 3) world m: a carried one where its
+        container carries it, any other where its body is (removed ones: parked far away)."""
+        ps, ids, _ = next(s for s in self.sets if s[0].name == name)
+        out = self._positions(ids)
+        carried = self.carried[name] & self.active[name] if name in self.carried else np.zeros(len(ids), dtype=bool)
+        if carried.any():
+            pos, rot = self._container_state(ps.rest.container)[:2]
+            out[carried] = pos + self.carried_at[name][carried] @ rot.T
+        return out
+
     def place_visuals(self) -> None:
         """Put the render ghosts of carried particles where they are carried (the others' ghosts far away)."""
         w, c = self.world, self.world.client
@@ -265,9 +276,9 @@ class ParticleSystem:
             if not ghosts:
                 continue
             carried = self.carried[ps.name] & self.active[ps.name]
-            pos, rot = (self._container_state(ps.rest.container)[:2]) if carried.any() else (None, None)
+            shown = self.shown_positions(ps.name) if carried.any() else None
             for k, ghost in enumerate(ghosts):
-                p = (pos + rot @ self.carried_at[ps.name][k]).tolist() if carried[k] else [PARK[0] - 5.0 - 0.1 * k, PARK[1] + 2.0, PARK[2]]
+                p = shown[k].tolist() if carried[k] else [PARK[0] - 5.0 - 0.1 * k, PARK[1] + 2.0, PARK[2]]
                 pb.resetBasePositionAndOrientation(ghost, p, (0, 0, 0, 1), physicsClientId=c)
 
     def remaining(self, name: str) -> int:

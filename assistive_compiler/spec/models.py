@@ -403,6 +403,10 @@ class PerRobot(Strict):
 
     base_offset_m: Vec3 | None = Field(None, description="Base position offset from the mount or the search anchor, m (the reference's toc_base_pos_offset).")
     start: StartGoal | None = Field(None, description="This robot's start pose, replacing robot.start (e.g. a one-arm robot's single start in a two-arm task).")
+    base_search: BaseSearch | None = Field(
+        None, description="This robot's base search, replacing robot.base_search (e.g. a robot that reaches a goal only "
+        "part of the time, where the task requires it of the others)."
+    )
 
 
 class RobotRole(Strict):
@@ -430,6 +434,11 @@ class RobotRole(Strict):
     )
     base_search: BaseSearch = Field(default_factory=BaseSearch, description="Base placement of robots that are not mounted.")
     per_robot: dict[Name, PerRobot] = Field(default_factory=dict, description="Per-robot settings by robot name.")
+
+    def search_for(self, robot: str) -> BaseSearch:
+        """The base search ``robot`` uses: its per_robot one if it has one, else the task's."""
+        own = self.per_robot.get(robot)
+        return own.base_search if own is not None and own.base_search is not None else self.base_search
 
     @model_validator(mode="after")
     def _default_supported(self) -> "RobotRole":

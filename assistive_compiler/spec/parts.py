@@ -31,6 +31,27 @@ class Arm(Strict):
     end_effector: str = Field(description="URDF link whose pose is the end effector.")
     tool_mount: str = Field(description="URDF link tools are attached to.")
     rest_rad: list[float] | None = Field(None, description="Rest (tucked) configuration, radians; default zeros.")
+    follow: dict[str, str] = Field(
+        default_factory=dict,
+        description="Joints (URDF names) moved with one of this arm's joints: follower -> leader. A follower gets its leader's "
+        "target change every step and its value at start (the reference's action duplication: Stretch's four telescoping "
+        "tubes, one action). Followers are not in the action or in joint-angle observations.",
+    )
+    action_multipliers: list[float] | None = Field(
+        None, description="Per arm joint, a factor on the task's action scale (the reference's per-robot action multipliers, "
+        "e.g. Stretch's lift 2, telescoping 1, wrist 2); default 1 for every joint."
+    )
+
+    @model_validator(mode="after")
+    def _followers_and_multipliers(self) -> "Arm":
+        for follower, leader in self.follow.items():
+            if leader not in self.joints:
+                raise ValueError(f"@follow: follower '{follower}' follows '{leader}', which is not one of this arm's joints {self.joints}")
+            if follower in self.joints:
+                raise ValueError(f"@follow: '{follower}' is one of the arm's joints; a follower is a joint moved with them, not one of them")
+        if self.action_multipliers is not None and len(self.action_multipliers) != len(self.joints):
+            raise ValueError(f"@action_multipliers: {len(self.action_multipliers)} multipliers for {len(self.joints)} arm joints; give one per joint")
+        return self
 
 
 class Gripper(Strict):
@@ -49,6 +70,24 @@ class ToolGrip(Strict):
 
     position_m: Vec3 = Field((0.0, 0.0, 0.0), description="Tool frame origin in the tool-mount frame, metres.")
     rpy_rad: Vec3 = Field((0.0, 0.0, 0.0), description="Tool frame orientation in the tool-mount frame, radians.")
+
+
+class BaseDrive(Strict):
+    """A mobile base driven by two wheel actions (a differential drive), modelled as a planar chain:
+    prismatic x, prismatic y and revolute yaw joints between the placed root frame and the base.
+    The first two action dimensions are the right and left wheel's turn (rad per unit action per
+    physics step: the task's action scale times ``action_multiplier``); each step the runtime moves
+    the three joints' targets as the wheels rolling without slip would: forward
+    ``r (Δθ_r + Δθ_l) / 2`` along the current heading and turning by ``r (Δθ_r − Δθ_l) / separation``."""
+
+    joints: tuple[str, str, str] = Field(description="The planar chain's joints (URDF names): x, y (prismatic, m) and yaw (revolute, rad).")
+    base_link: str = Field(description="The link the chain carries (the moving base): the frame of robot_base observations.")
+    wheel_radius_m: float = Field(gt=0, le=1, description="Wheel radius, m.")
+    wheel_separation_m: float = Field(gt=0, le=5, description="Distance between the two wheels' contact points, m.")
+    action_multiplier: float = Field(1.0, gt=0, description="Factor on the task's action scale for the wheel actions.")
+    position_gain: float = Field(gt=0, le=1, description="Position gain of the three drive joints.")
+    max_force_n: float = Field(gt=0, description="Force limit of the x and y joints, N (what the wheel motors can push).")
+    max_torque_nm: float = Field(gt=0, description="Torque limit of the yaw joint, N·m.")
 
 
 class RobotControlDefaults(Strict):
@@ -78,6 +117,11 @@ class RobotPart(Strict):
     mountable: bool = Field(False, description="Mounted on furniture (e.g. Jaco on a wheelchair) when a task offers it.")
     control: RobotControlDefaults = Field(default_factory=RobotControlDefaults, description="Control defaults for tasks that do not set them.")
     base_height_m: float = Field(0.0, ge=0, description="Height of the base link above the floor when on the floor.")
+    base_drive: BaseDrive | None = Field(None, description="A mobile base driven by wheel actions (None: the base stays where it is placed).")
+    facing_yaw_deg: float = Field(
+        0.0, ge=-180, le=180, description="Base yaw (degrees) at which the robot works towards world +x (added to base_search.yaw_deg): 0 "
+        "for arms reaching along their base's +x; 90 for Stretch, whose arm extends along its base's -y."
+    )
 
     @model_validator(mode="after")
     def _one_source(self) -> "RobotPart":

@@ -72,17 +72,20 @@ def search_base(rt: ResolvedTask, arms: list, goals, offset, rng, carry: Carried
     starts from its rest pose. Raises with the goal that no sampled pose reached. With ``carry``
     the base sits at the carried furniture's mount height and the furniture moves under every
     sampled base; a pose where it touches the person or other furniture is rejected."""
-    search = rt.spec.robot.base_search
+    search = rt.spec.robot.search_for(rt.robot_name)
     anchor = np.asarray(search.origin_m[:2]) + np.asarray(offset[:2])
     z = (carry.height if carry is not None else rt.robot.part.base_height_m) + (offset[2] if len(offset) > 2 else 0.0)
     found = []
     required_misses = np.zeros(len(goals), dtype=int)
     for _ in range(search.attempts):
         xy = anchor + [rng.uniform(*search.x_range_m), rng.uniform(*search.y_range_m)]
-        yaw = math.radians(search.yaw_deg + rng.uniform(-search.yaw_noise_deg, search.yaw_noise_deg))
+        yaw = math.radians(search.yaw_deg + rt.robot.part.facing_yaw_deg + rng.uniform(-search.yaw_noise_deg, search.yaw_noise_deg))
         pos, orn = (float(xy[0]), float(xy[1]), float(z)), quat_from_rpy((0.0, 0.0, yaw))
         if not _base_clear(arms, pos, orn, carry):
             continue
+        first = goals[0][4]
+        if first.frozen:  # a mobile base drives from the sample to where its arm reaches the start pose
+            pos, orn = first.drive_to(pos, orn, goals[0][0], goals[0][1])
         reached, score, ok = 0, 0.0, True
         for k, (gpos, gorn, required, _name, kin, is_start) in enumerate(goals):
             q = kin.reach(gpos, gorn, rng, tries=2, tool_may_touch=not is_start)

@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 
+from ...ik_options import ik_damping, ik_limits
 from ...quat import quat_from_rpy_deg
 from ...resolve import ResolvedTask
 from ..task import start_for
@@ -21,7 +22,10 @@ from .client import PlacementClient
 class ArmKinematics:
     """IK, collision checks and JLWKI for one arm in the compile-time world."""
 
-    def __init__(self, pc, robot, ee_link, arm_idx, lower, upper, tool_from_ee, tool_ids, obstacles, rest):
+    def __init__(self, pc, robot, ee_link, arm_idx, lower, upper, tool_from_ee, tool_ids, obstacles, rest,
+                 followers: dict[int, int] | None = None, frozen: list[int] | None = None):
+        """``followers``: follower joint index -> its leader's position in ``arm_idx`` (set to the
+        leader's value); ``frozen``: joint indices IK must not move (a mobile base's drive)."""
         p, c = pc.p, pc.client
         self.pc, self.robot, self.ee_link, self.arm_idx = pc, robot, ee_link, arm_idx
         self.lower, self.upper = lower, upper
@@ -34,6 +38,10 @@ class ArmKinematics:
         self.hi_all = [p.getJointInfo(robot, j, physicsClientId=c)[9] for j in self.movable]
         self.ranges = [max(h - l, 1e-3) for l, h in zip(self.lo_all, self.hi_all)]
         self.cols = [self.movable.index(i) for i in arm_idx]
+        self.followers = followers or {}
+        self.groups = [[self.cols[k]] + [self.movable.index(f) for f, lead in self.followers.items() if lead == k] for k in range(len(arm_idx))]
+        self.frozen = frozen or []
+        self.damping = ik_damping(self.movable, self.frozen)
 
     def place(self, pos, orn) -> None:
         self.pc.place(self.robot, pos, orn)
@@ -41,6 +49,8 @@ class ArmKinematics:
     def set_arm(self, q) -> None:
         for i, v in zip(self.arm_idx, q):
             self.pc.p.resetJointState(self.robot, i, v, physicsClientId=self.pc.client)
+        for f, lead in self.followers.items():
+            self.pc.p.resetJointState(self.robot, f, q[lead], physicsClientId=self.pc.client)
 
     def reach(self, tool_pos, tool_orn, rng, tries: int = 2, tool_may_touch: bool = False):
         """Arm configuration putting the tool at ``tool_pos`` (with ``tool_orn`` unless None) within
@@ -57,11 +67,10 @@ class ArmKinematics:
             self.set_arm(arm_rest)
             q = arm_rest
             for _ in range(4):  # refine from the last solution
-                kwargs = dict(lowerLimits=self.lo_all, upperLimits=self.hi_all, jointRanges=self.ranges, restPoses=rest,
-                              maxNumIterations=100, residualThreshold=1e-6, physicsClientId=c)
+                kwargs = ik_limits(self, rest) | dict(maxNumIterations=100, residualThreshold=1e-6, physicsClientId=c)
                 sol = (p.calculateInverseKinematics(self.robot, self.ee_link, ee_pos, ee_orn, **kwargs) if tool_orn is not None
                        else p.calculateInverseKinematics(self.robot, self.ee_link, ee_pos, **kwargs))
-                q = [min(max(sol[k], l), u) for k, l, u in zip(self.cols, self.lower, self.upper)]
+                q = [min(max(float(np.mean([sol[k] for k in group])), l), u) for group, l, u in zip(self.groups, self.lower, self.upper)]
                 self.set_arm(q)
             got_pos, got_orn = self.pc.link_pose(self.robot, self.ee_link)
             if np.linalg.norm(np.subtract(got_pos, ee_pos)) >= 0.01:
@@ -72,6 +81,27 @@ class ArmKinematics:
                 continue
             return q
         return None
+
+    def drive_to(self, base_pos, base_orn, tool_pos, tool_orn) -> tuple[tuple, tuple]:
+        """A mobile base's pose near (``base_pos``, ``base_orn``) from which the arm reaches the tool
+        pose: IK with the drive's planar joints free (the robot drives there), their values folded
+        into the base pose and reset to 0. The caller then checks the reach with the drive frozen."""
+        p, c = self.pc.p, self.pc.client
+        self.place(base_pos, base_orn)
+        self.set_arm(self.rest)
+        ee_pos, ee_orn = p.multiplyTransforms(tool_pos, tool_orn, *self.tool_inv)
+        damping = [0.1] * len(self.movable)
+        for _ in range(4):
+            sol = p.calculateInverseKinematics(self.robot, self.ee_link, ee_pos, ee_orn, jointDamping=damping, maxNumIterations=100,
+                                               residualThreshold=1e-6, physicsClientId=c)
+            for j, v in zip(self.movable, sol):
+                p.resetJointState(self.robot, j, v, physicsClientId=c)
+        x, y, yaw = (sol[self.movable.index(j)] for j in self.frozen)
+        for j in self.frozen:
+            p.resetJointState(self.robot, j, 0.0, physicsClientId=c)
+        pos, orn = p.multiplyTransforms(base_pos, base_orn, (x, y, 0.0), p.getQuaternionFromEuler((0.0, 0.0, yaw)))
+        self.place(pos, orn)
+        return tuple(pos), tuple(orn)
 
     def collides(self, tool_pos, tool_orn, check_tool: bool = True) -> bool:
         touching = self.pc.touching
@@ -95,7 +125,12 @@ class ArmKinematics:
             qr = (u - l) / 2
             w.append(max(0.001, 1 - 0.5 ** ((qr - abs(qr - qi + l)) / (0.05 * qr) + 1)))
         M = J @ np.diag(w) @ J.T
-        return float(max(np.linalg.det(M), 0.0) ** (1 / 6) / (np.trace(M) / 6))
+        # Isotropy over the directions the arm can move in: with n = min(6, joints) it is the
+        # geometric over the arithmetic mean of M's n largest eigenvalues (det^(1/6) / (trace/6) for
+        # six or more joints; a 3-joint arm such as Stretch's has rank 3 and would always score 0).
+        n = min(6, J.shape[1])
+        eig = np.clip(np.sort(np.linalg.eigvalsh(M))[::-1][:n], 0.0, None)
+        return float(np.prod(eig) ** (1 / n) / (eig.sum() / n)) if eig.sum() > 0 else 0.0
 
 
 def arm_chains(rt: ResolvedTask, pc: PlacementClient, scene) -> list[tuple[ArmKinematics, object, tuple]]:
@@ -119,9 +154,12 @@ def arm_chains(rt: ResolvedTask, pc: PlacementClient, scene) -> list[tuple[ArmKi
             inv, side_tools = pc.p.invertTransform(*held_garments[0]), {}
         else:
             inv, side_tools = ((0, 0, 0), (0, 0, 0, 1)), {}
+        drive = robot_part.base_drive
         kin = ArmKinematics(pc, scene.robot, pc.link_index(scene.robot, arm.tool_mount), [scene.robot_joints[j] for j in arm.joints],
                             scene.lower[offset_in_action:offset_in_action + n], scene.upper[offset_in_action:offset_in_action + n],
-                            inv, side_tools, list(scene.furniture.values()), arm.rest_rad)
+                            inv, side_tools, list(scene.furniture.values()), arm.rest_rad,
+                            followers={scene.robot_joints[f]: arm.joints.index(lead) for f, lead in arm.follow.items()},
+                            frozen=[scene.robot_joints[j] for j in drive.joints] if drive else None)
         arms.append((kin, side_start, side_orn))
         offset_in_action += n
     return arms

@@ -86,7 +86,9 @@ def pose_at_first_start(rt: ResolvedTask, pc: PlacementClient, scene: PlacedScen
         k = next(i for i, b in enumerate(scene.bodies) if b.name == mounted_on(rt))
         scene.bodies[k] = scene.bodies[k].model_copy(update={"position": rounded(pos), "orientation": rounded(orn),
                                                              "carried_by_robot": (rounded(carry.inv_pos), rounded(carry.inv_orn))})
-    for i, q in zip([i for kin, _, _ in arms for i in kin.arm_idx], first.joints):
-        pc.p.resetJointState(scene.robot, i, q, physicsClientId=pc.client)
+    at = 0
+    for kin, _, _ in arms:  # each arm (and the joints following it) at its part of the first start
+        kin.set_arm(first.joints[at:at + len(kin.arm_idx)])
+        at += len(kin.arm_idx)
     return Body(name="robot", kind="robot", urdf=str(scene.robot_urdf), position=rounded(base_pos), orientation=rounded(base_orn),
                 fixed_base=True, gravity=rt.spec.robot.gravity_mps2)

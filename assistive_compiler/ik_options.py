@@ -1,0 +1,22 @@
+"""pybullet IK options shared by the compile-time placement and the scripted policy: which joints
+IK may move (a mobile base's drive must not: reaching is the arm's job) and how limits apply."""
+
+from __future__ import annotations
+
+FROZEN_DAMPING = 1e6  # IK damping of joints IK must not move (pybullet's default is 0.1)
+
+
+def ik_damping(movable: list[int], frozen: list[int]) -> list[float] | None:
+    """Per movable joint, pybullet's IK damping: huge for ``frozen`` joints (a mobile base's drive,
+    which reaching must not move), the default elsewhere; None when nothing is frozen."""
+    return [FROZEN_DAMPING if j in frozen else 0.1 for j in movable] if frozen else None
+
+
+def ik_limits(chain, rest) -> dict:
+    """pybullet IK keywords: null-space IK towards ``rest`` within the joint limits; with frozen
+    joints plain damped least squares instead (null-space IK moves heavily damped joints anyway),
+    whose result the caller clamps to the limits. ``chain`` has ``lo_all``, ``hi_all``,
+    ``ranges`` and ``damping``."""
+    if chain.damping is not None:
+        return dict(jointDamping=chain.damping)
+    return dict(lowerLimits=chain.lo_all, upperLimits=chain.hi_all, jointRanges=chain.ranges, restPoses=rest)
