@@ -12,6 +12,10 @@ import sys
 from ..errors import SpecError
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+EXIT_INTERRUPTED = 130
+
+TRAIN_EXTRA_HINT = ("the learning commands need the 'train' extra: install torch's CPU build first "
+                    "(pip install torch --index-url https://download.pytorch.org/whl/cpu), then pip install -e '.[train]'")
 
 
 def print_problems(error: SpecError) -> None:
@@ -35,3 +39,18 @@ def make_env(spec: str, robot: str | None, out: str | None = None, **kwargs):
     from ..runtime.env import AssistiveEnv
 
     return AssistiveEnv.from_spec(spec, robot=robot, out_dir=out, **kwargs)
+
+
+def require_extra(*modules: str) -> bool:
+    """Whether the optional ``modules`` (of the ``train`` extra) are installed; says how to install them if not."""
+    import importlib.util
+
+    missing = [m for m in modules if importlib.util.find_spec(m) is None]
+    if missing:
+        print(f"error: {', '.join(missing)} not installed; {TRAIN_EXTRA_HINT}", file=sys.stderr)
+    return not missing
+
+
+def engine_modules(engine: str) -> tuple[str, ...]:
+    """The modules a training engine needs."""
+    return ("torch", "stable_baselines3" if engine == "sb3" else "ray")

@@ -76,6 +76,11 @@ def task_schema() -> dict:
 
 
 def cmd_schema(args: argparse.Namespace) -> int:
+    if args.training:
+        from ..training.config import training_schema
+
+        print(json.dumps(training_schema(), indent=2, sort_keys=True))
+        return EXIT_OK
     if args.terms:
         from ..terms.registry import terms
         from .output import print_table
@@ -129,4 +134,5 @@ def add_commands(sub) -> None:
 
     p = sub.add_parser("schema", help="print the JSON Schema of a task spec (or --terms: the term library)")
     p.add_argument("--terms", action="store_true", help="list registered terms and their parameters instead")
+    p.add_argument("--training", action="store_true", help="print the JSON Schema of a training config (specs/training/*.yaml) instead")
     p.set_defaults(func=cmd_schema)
