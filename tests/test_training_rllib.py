@@ -12,6 +12,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
+pytest.importorskip("ray", reason='needs the "train" extra (README: Training); CI installs it')
+
 from assistive_compiler.cli import main
 from assistive_compiler.training.evaluate import evaluate
 from assistive_compiler.training.run_dir import RunDir

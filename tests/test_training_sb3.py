@@ -18,6 +18,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
+pytest.importorskip("stable_baselines3", reason='needs the "train" extra (README: Training); CI installs it')
+
 from assistive_compiler.cli import main
 from assistive_compiler.cli.run import rollout
 from assistive_compiler.policies import make_policy
