@@ -18,7 +18,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from .common import EXIT_OK
+from .common import EXIT_OK, add_library_argument
 
 _CHILD = r"""
 import json, resource, sys, time, numpy as np
@@ -227,6 +227,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 def add_commands(sub) -> None:
     p = sub.add_parser("bench", help="speed figures taken in one run: steps/s vs raw physics and the reference, resets, compile, import, RSS")
+    add_library_argument(p)
     p.add_argument("specs", nargs="+", metavar="spec", help="task spec file(s); several print one row each")
     p.add_argument("--robot", help="robot (default: each spec's default)")
     p.add_argument("--seed", type=int, default=0, help="seed of the first repeat's episode and of the random actions")

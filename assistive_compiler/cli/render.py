@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .common import EXIT_OK, add_spec_arguments, make_env
+from .common import EXIT_OK, add_library_argument, add_spec_arguments, make_env
 
 
 def record(env, policy, seed: int, every: int) -> tuple[list[np.ndarray], dict]:
@@ -127,6 +127,7 @@ def add_commands(sub) -> None:
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("render-person", help="draw the person variants a spec declares, side by side (PNG)")
+    add_library_argument(p)
     p.add_argument("spec", help="task spec file")
     p.add_argument("--robot", help="robot to compile the task for (default: the spec's default)")
     p.add_argument("--out", required=True, help="output .png")

@@ -17,6 +17,7 @@ import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Iterable
 
 from .. import __version__
 from ..artifact import Manifest
@@ -79,16 +80,21 @@ def compile_task(
     robot: str | None = None,
     out_dir: str | Path | None = None,
     *,
-    library: Library | None = None,
+    library: Library | Iterable[str | Path] | None = None,
     force: bool = False,
 ) -> CompileResult:
     """Compile the spec at ``spec_path`` for ``robot`` into ``out_dir`` (default generated/<task>-<robot>).
+
+    ``library``: a :class:`Library`, or extra library directories searched before
+    ``$ASSISTIVE_COMPILER_LIBRARY``, the spec's own library and the shipped parts
+    (:meth:`Library.for_spec`).
 
     Raises :class:`SpecError` for bad input; leaves ``out_dir`` untouched unless it succeeds.
     """
     t0 = time.perf_counter()
     loaded: LoadedSpec = load_spec(spec_path)
-    library = library or Library()
+    if not isinstance(library, Library):
+        library = Library.for_spec(loaded.path, library or ())
     robot = robot or loaded.spec.robot.default
     out = Path(out_dir) if out_dir else default_out_dir(loaded.spec.name, robot)
     ihash = input_hash(loaded, robot, library)

@@ -18,6 +18,11 @@ from ..paths import display, templates_dir
 _BANNER = re.compile(r"<!--\s*=+\s*-->\s*<!--.*?-->\s*<!--.*?-->\s*<!--\s*=+\s*-->\s*", re.S)
 
 
+SHIPPED_TEMPLATES_ARG = "assistive_templates"
+"""Set for every template: the shipped ``templates/`` folder, so a user's template can use the
+shipped macros with ``<xacro:include filename="$(arg assistive_templates)/common/shapes.xacro"/>``."""
+
+
 def format_param(value: object) -> str:
     """A template parameter as the string xacro receives (floats in shortest round-trip form)."""
     if isinstance(value, bool):
@@ -51,7 +56,7 @@ def _render_cached(path: Path, params: tuple[tuple[str, str], ...]) -> str:
             + did_you_mean(unknown[0], declared),
         )
     try:
-        doc = xacro.process_file(str(path), mappings=dict(params))
+        doc = xacro.process_file(str(path), mappings=dict(params) | {SHIPPED_TEMPLATES_ARG: str(templates_dir())})
     except Exception as exc:  # xacro raises plain Exceptions (XacroException, NameError, ...)
         raise SpecError.at(display(path), f"template failed to render: {exc}") from None
     text = doc.toprettyxml(indent="  ")

@@ -142,11 +142,13 @@ class AssistiveEnv(gym.Env):
         self.human_observation_space = self.human_features.space
 
     @classmethod
-    def from_spec(cls, spec: str | Path, robot: str | None = None, out_dir: str | Path | None = None, **kwargs) -> "AssistiveEnv":
-        """Compile ``spec`` for ``robot`` (a cache hit when unchanged) and build the env."""
+    def from_spec(cls, spec: str | Path, robot: str | None = None, out_dir: str | Path | None = None,
+                  library=None, **kwargs) -> "AssistiveEnv":
+        """Compile ``spec`` for ``robot`` (a cache hit when unchanged) and build the env.
+        ``library``: extra part directories (see :func:`assistive_compiler.library.Library.for_spec`)."""
         from ..compile.compiler import compile_task
 
-        result = compile_task(spec, robot, out_dir)
+        result = compile_task(spec, robot, out_dir, library=library)
         return cls(result.out_dir, **kwargs)
 
     # -- Gymnasium API ------------------------------------------------------------------------

@@ -449,6 +449,10 @@ class ToolUse(Strict):
     hand: Literal["right", "left"] = Field(description="Which hand holds it (single-arm robots: their only hand).")
     gravity_mps2: float | None = Field(0.0, ge=-20, le=0, description="Gravity on the tool (0: weightless).")
     mass_kg: float | None = Field(None, gt=0, description="Mass override in kg (None: the part's mass).")
+    grip: Name | None = Field(
+        None, description="Which of the robot part's grips (grips: in specs/robots/<robot>.yaml) holds this tool; default "
+        "the tool's part name. A new tool shaped like a shipped one can reuse its grip (e.g. grip: scratcher).",
+    )
     one_arm_same_as: Name | None = Field(
         None, description="On a robot acting with one arm (which serves as both hands), this tool is the named tool, held "
         "in the other hand: one body that both names refer to (the reference's single-arm arm manipulation, facts §2.6). "
@@ -829,7 +833,11 @@ class TaskSpec(Strict):
     name: Name = Field(description="Task name; Gymnasium ids are <TaskName><Robot>-v1.")
     title: str = Field(description="Human-readable title, e.g. 'Feeding'.")
     description: str = Field("", description="What the task is and where its numbers come from.")
-    extends: str | None = Field(None, description="Path of a spec this one builds on (relative to this file).")
+    extends: str | None = Field(
+        None, description="Path of a spec this one builds on (relative to this file, or shipped:tasks/<name>.yaml for a "
+        "shipped one). Mappings merge key by key and anything else is replaced; inside a mapping, '$delete: [key, ...]' "
+        "removes inherited keys and '$replace: VALUE' (alone) takes VALUE instead of merging.",
+    )
     sim: Sim = Field(default_factory=Sim, description="Timing and world physics.")
     scene: Scene = Field(default_factory=Scene, description="Furniture and objects.")
     person: Person = Field(description="The person being helped.")
