@@ -260,8 +260,17 @@ class Success(_Model):
     fraction_of: str | None = Field(None, description="A marker set: the threshold is this fraction of the active variant's markers.")
 
 
+class Camera(_Model):
+    """The camera of renders (world frame, m): from ``eye`` towards ``target``, z up."""
+
+    eye: tuple[float, float, float] = Field((-0.85, -1.35, 1.45), description="Camera position, world frame, m.")
+    target: tuple[float, float, float] = Field((-0.12, -0.15, 0.85), description="Point looked at, world frame, m.")
+    fov_deg: float = Field(50.0, description="Vertical field of view, degrees.")
+
+
 class Sim(_Model):
-    """World physics and timing."""
+    """World physics and timing.
+"""
 
     time_step: float = Field(description="Physics step, s.")
     frame_skip: int = Field(description="Physics steps per env step.")
@@ -298,6 +307,7 @@ class Manifest(_Model):
     success: Success
     garments: list[Garment] = Field(default_factory=list, description="Soft-body garments (their presence makes the world a deformable one).")
     scripted: dict[str, Any] | None = Field(None, description="Scripted baseline: point moved and waypoints (normalised).")
+    camera: Camera = Field(default_factory=Camera, description="The task's camera for this robot (renders).")
 
     def body(self, name: str) -> Body:
         for b in self.bodies:

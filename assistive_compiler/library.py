@@ -22,6 +22,7 @@ located error naming both files, never silently resolved.
 from __future__ import annotations
 
 import os
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -120,7 +121,7 @@ class Library:
             m = part.measurements()
             return urdf_info(render_template(PERSON_TEMPLATE_RELPATH, m.xacro_args()))
         if getattr(part, "urdf", None):
-            return urdf_info(self.urdf_path(loaded).read_text())
+            return self._urdf_file_info(loaded)
         params = dict(part.template.params) | dict(getattr(part, "mount_params", {}) or {})
         return urdf_info(render_template(self.template_path(loaded), params))
 
@@ -137,6 +138,24 @@ class Library:
                 raise SpecError([Problem(loaded.smap.value(("urdf",)), f"Python package '{package}' is not installed")])
             return Path(list(spec.submodule_search_locations)[0]) / rel
         return (loaded.path.parent / ref).resolve()
+
+    def _urdf_file_info(self, loaded: LoadedPart) -> UrdfInfo:
+        """What a bring-your-own URDF declares; a located error when it is not URDF XML."""
+        path = self.urdf_path(loaded)
+        where = loaded.smap.value(("urdf",))
+        try:
+            info = urdf_info(path.read_bytes().decode("utf-8"))
+        except UnicodeDecodeError as exc:
+            raise SpecError([Problem(where, f"{display(path)} is not a URDF: not UTF-8 text ({exc.reason} at byte {exc.start})")]) from None
+        except ET.ParseError as exc:
+            line, col = exc.position
+            raise SpecError([Problem(where, f"{display(path)} is not a URDF: XML error at line {line}, column {col + 1}: "
+                                            f"{str(exc).split(':')[0]}")]) from None
+        except (AttributeError, ValueError) as exc:
+            raise SpecError([Problem(where, f"{display(path)} is not a valid URDF: {exc}")]) from None
+        if info.root_tag != "robot":
+            raise SpecError([Problem(where, f"{display(path)} is not a URDF: its root element is <{info.root_tag}>, expected <robot>")])
+        return info
 
     def template_path(self, loaded: LoadedPart) -> Path:
         """The part's template: absolute as written, else under the ``templates/`` beside the part's

@@ -105,6 +105,7 @@ class UrdfInfo:
     links: tuple[str, ...]
     joints: dict[str, JointInfo]
     capsules: dict[str, Capsule]
+    root_tag: str = "robot"
 
     @property
     def movable_joints(self) -> dict[str, JointInfo]:
@@ -133,7 +134,7 @@ def urdf_info(urdf_xml: str) -> UrdfInfo:
             el.get("name", ""), jtype, el.find("parent").get("link", ""), child, lower, upper, axis  # type: ignore[union-attr]
         )
     roots = [l for l in links if l not in children]
-    return UrdfInfo(roots[0] if roots else "", links, joints, _capsules(root))
+    return UrdfInfo(roots[0] if roots else "", links, joints, _capsules(root), root.tag)
 
 
 def _rpy_matrix(r: float, p: float, y: float) -> list[list[float]]:

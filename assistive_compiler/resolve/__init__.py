@@ -32,6 +32,7 @@ def _load_parts(s: Scope) -> None:
     s.tools = {n: p for n, use in spec.tools.items() if (p := s.part("tools", use.part, ("tools", n, "part"), "tool"))}
     s.people = {n: p for i, n in enumerate(spec.person.variants) if (p := s.part("people", n, ("person", "variants", i), "person"))}
     robot_section.check_per_robot_keys(s, ("robot", "per_robot"), spec.robot.per_robot)
+    robot_section.check_per_robot_keys(s, ("camera", "per_robot"), spec.camera.per_robot)
     if s.problems or robot is None or not s.people:
         raise SpecError(s.problems)
     s.robot = robot

@@ -102,7 +102,10 @@ class AssistiveEnv(gym.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
 
-    def __init__(self, artifact_dir: str | Path, render_mode: str | None = None, render_size: tuple[int, int] = (480, 360)):
+    def __init__(self, artifact_dir: str | Path, render_mode: str | None = None, render_size: tuple[int, int] = (480, 360),
+                 camera: dict | None = None):
+        """``camera``: eye / target (world m) / fov_deg overriding the task's camera in renders."""
+        self.camera = camera
         self.artifact_dir = Path(artifact_dir)
         self.manifest = m = Manifest.read(self.artifact_dir)
         if render_mode not in (None, "rgb_array"):
@@ -273,7 +276,7 @@ class AssistiveEnv(gym.Env):
             return None
         from .camera import render_rgb
 
-        return render_rgb(self, *self.render_size)
+        return render_rgb(self, *self.render_size, view=self.camera)
 
     def close(self):
         self.world.close()

@@ -827,6 +827,21 @@ class Scripted(_WaypointScript):
 # The task
 
 
+class CameraView(Strict):
+    """Where renders look from (world frame: the person faces −Y; the robot usually stands at −X)."""
+
+    eye_m: Vec3 | None = Field(None, description="Camera position, world frame, m (default: the shipped default view's).")
+    target_m: Vec3 | None = Field(None, description="Point the camera looks at, world frame, m.")
+    fov_deg: float | None = Field(None, gt=5, lt=150, description="Vertical field of view, degrees.")
+
+
+class Camera(CameraView):
+    """The task's camera for renders, with per-robot overrides (each field merged over the task's)."""
+
+    per_robot: dict[Name, CameraView] = Field(
+        default_factory=dict, description="Per-robot camera fields (e.g. a robot standing farther away needs a wider view).")
+
+
 class TaskSpec(Strict):
     """A complete assistive task."""
 
@@ -854,3 +869,4 @@ class TaskSpec(Strict):
     preferences: Preferences = Field(default_factory=Preferences, description="Human-preference costs.")
     success: Success = Field(description="What counts as success.")
     scripted: Scripted | None = Field(None, description="A scripted baseline controller (optional).")
+    camera: Camera = Field(default_factory=Camera, description="The camera of renders (render, demo): eye, target, field of view; per robot.")
