@@ -104,7 +104,8 @@ def compile_task(
             existing = Manifest.read(out)
         except Exception:
             existing = None
-        if existing is not None and existing.input_hash == ihash and all((out / b.urdf).is_file() for b in existing.bodies):
+        # A cut or edited file in the cache (damage) is recompiled, never loaded.
+        if existing is not None and existing.input_hash == ihash and existing.damage(out) is None:
             return CompileResult(out, existing, True, time.perf_counter() - t0)
 
     rt = resolve(loaded, robot, library)
@@ -115,8 +116,7 @@ def compile_task(
     os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes it private; the artifact is an ordinary directory
     try:
         manifest = build(rt, tmp, library).model_copy(update={"input_hash": ihash})
-        body_bytes = b"".join((tmp / b.urdf).read_bytes() for b in sorted(manifest.bodies, key=lambda b: b.urdf))
-        manifest = manifest.model_copy(update={"content_hash": hashlib.sha256(body_bytes + manifest.to_json().encode()).hexdigest()})
+        manifest = manifest.model_copy(update={"content_hash": manifest.hash_of(tmp)})
         (tmp / "manifest.json").write_text(manifest.to_json())
         _replace_dir(tmp, out)
     except BaseException:

@@ -107,7 +107,7 @@ class AssistiveEnv(gym.Env):
         """``camera``: eye / target (world m) / fov_deg overriding the task's camera in renders."""
         self.camera = camera
         self.artifact_dir = Path(artifact_dir)
-        self.manifest = m = Manifest.read(self.artifact_dir)
+        self.manifest = m = Manifest.read(self.artifact_dir, verify=True)
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         self.render_mode = render_mode
