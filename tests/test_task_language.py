@@ -285,7 +285,7 @@ def test_markers_lie_on_the_arm_and_are_cleared_once(bathing):
 
 
 def test_nightstand_is_carried_under_the_searched_base(bathing):
-    """robot.mount_base: search (facts §2.2): Jaco's base comes from the base search and the
+    """robot.mount_base: search (paper §III-B): Jaco's base comes from the base search and the
     nightstand (only_when_mounted) is put under it: its robot_mount frame on the robot's base frame
     at every reset, whichever precomputed start is drawn, with the start arm clear of it."""
     env = bathing

@@ -38,7 +38,7 @@ print(json.dumps({"import_s": import_s, "heavy_modules_on_import": heavy,
 
 #: Env steps/s of the reference implementation (Assistive Gym v1.0 on stock pybullet, random actions,
 #: 200-step episodes, one process, a 2-core shared machine like ours), per (task, robot) it was
-#: measured for: shared/reference/performance-anchors.md. Dressing does not run on stock pybullet.
+#: was measured for. Dressing does not run on stock pybullet.
 REFERENCE_STEPS_PER_S = {
     ("scratch_itch", "jaco"): 423, ("scratch_itch", "pr2"): 188, ("scratch_itch", "sawyer"): 428, ("scratch_itch", "baxter"): 312,
     ("bed_bathing", "jaco"): 156,

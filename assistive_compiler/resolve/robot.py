@@ -47,7 +47,7 @@ def acting_sides(spec: TaskSpec, robot: LoadedPart) -> tuple[str, ...]:
 def tool_aliases(s: Scope) -> dict[str, str]:
     """Which tools share another tool's body on this robot, checking that every tool's hand is
     one the robot acts with: on a robot acting with one arm, a tool in the other hand must be
-    ``one_arm_same_as`` a tool of the same part in the acting hand (facts §2.6)."""
+    ``one_arm_same_as`` a tool of the same part in the acting hand (paper §III-B)."""
     spec = s.spec
     aliases: dict[str, str] = {}
     one_arm = len(s.sides) == 1

@@ -85,7 +85,7 @@ class Features:
 
 
 def draw_surface_point(capsules, rng: np.random.Generator) -> tuple[str, np.ndarray, np.ndarray]:
-    """A point on one of the limbs' capsules, as the reference draws an itch (facts §2.1): a limb
+    """A point on one of the limbs' capsules, as the reference draws an itch (paper §III-B): a limb
     uniformly, the distance from its joint end U(r, L) along the axis, the azimuth U(0, 2π).
     Returns (link, point, outward normal, axis away from the joint), in the link frame (m)."""
     cap = capsules[int(rng.integers(len(capsules)))]

@@ -187,7 +187,7 @@ class World:
                             pb.setCollisionFilterPair(a, b, la, lb, 0, physicsClientId=c)
 
     def _set_self_collision(self, handle: BodyHandle) -> None:
-        """Self-collision of a person body (facts §3.3): every link pair off, then the pairs the
+        """Self-collision of a person body (paper §III-A): every link pair off, then the pairs the
         compiler chose (``manifest.person.self_collision``, link names) on.
 
         The compiler lists only pairs between links that move relative to each other, of the

@@ -249,7 +249,7 @@ class PersonControl(Strict):
     arm_limits: str = Field(
         "analytic",
         description="Pose-dependent shoulder-elbow limits enforced after every physics step on the arm whose shoulder (3 axes) "
-        "and elbow are policy joints (the right one if both; facts §3.6): 'analytic' (the built-in model), 'none', or the "
+        "and elbow are policy joints (the right one if both; paper §III-C): 'analytic' (the built-in model), 'none', or the "
         "path of a .npz MLP (arrays W0, b0, W1, b1, ...; relative to the spec file that says it).",
     )
 
@@ -274,7 +274,7 @@ class Settle(Strict):
     joint_noise_rad: float = Field(0.1, ge=0, le=1, description="Half-width of the uniform noise on every joint angle, rad.")
     friction: float | None = Field(None, ge=0, description="Friction of the furniture while settling (the reference: 5); None keeps it.")
     then: "SettleStage | None" = Field(
-        None, description="A second compile-time stage after settling (e.g. an arm dropped to hang off the bed, facts §2.6)."
+        None, description="A second compile-time stage after settling (e.g. an arm dropped to hang off the bed, paper §III-B)."
     )
 
 
@@ -383,7 +383,7 @@ class Goal(Strict):
 
 
 class BaseSearch(Strict):
-    """Compile-time base-pose optimisation for robots standing on the floor (facts §5): sample base
+    """Compile-time base-pose optimisation for robots standing on the floor (paper §III-D): sample base
     poses, solve IK to each goal with collision checks, keep the poses that reach the most goals,
     ties broken by joint-limit-weighted kinematic isotropy (JLWKI). The start pose is always a
     required, oriented goal. Deterministic and bounded: exactly ``attempts`` samples."""
@@ -455,7 +455,7 @@ class ToolUse(Strict):
     )
     one_arm_same_as: Name | None = Field(
         None, description="On a robot acting with one arm (which serves as both hands), this tool is the named tool, held "
-        "in the other hand: one body that both names refer to (the reference's single-arm arm manipulation, facts §2.6). "
+        "in the other hand: one body that both names refer to (the reference's single-arm arm manipulation, paper §III-B). "
         "Two-arm robots acting with both arms hold both tools.",
     )
 

@@ -1,4 +1,4 @@
-"""The paper's seven human-preference costs c_k ≤ 0 (Erickson et al. 2020, §III-C; facts §3.7).
+"""The paper's seven human-preference costs c_k ≤ 0 (Erickson et al. 2020, paper §III-E).
 
 r_H = Σ_k α_k·ω_k·c_k: a spec's ``preferences.active`` sets α_k = 1 for the costs it lists, and ω_k
 defaults to the paper's weights (0.25, 0.01, 0.05, 1.0, 1.0, 0.01, 0.01). The compiler turns each

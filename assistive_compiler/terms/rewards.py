@@ -170,7 +170,7 @@ class SleeveProgress(Params):
 
 @term("sleeve_progress", "reward", SleeveProgress)
 class SleeveProgressTerm:
-    """How far the arm is inside the sleeve (m): the reference's r_dress (facts §2.5). Forearm in
+    """How far the arm is inside the sleeve (m): the reference's r_dress (paper §III-B). Forearm in
     the opening: distance of the opening's centre from the hand's end; upper arm in: the forearm's
     length plus the centre's distance past the elbow; neither: minus the centre's distance to the
     hand's end. See :func:`assistive_compiler.garment.sleeve_progress`.
