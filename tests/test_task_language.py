@@ -158,7 +158,7 @@ def _contact(x, force):
 
 def test_scratch_events_need_movement_gentle_force_and_nearness():
     counter = terms("reward")["contact_events"].fn()
-    p = SimpleNamespace(tool=[], on=[], target=None, radius_m=0.025, min_move_m=0.01, max_force_n=10.0)
+    p = SimpleNamespace(tool=[], onto=[], target=None, radius_m=0.025, min_move_m=0.01, max_force_n=10.0)
     steps = [
         ([], 0.0),                          # no contact
         ([_contact(0.030, 1.0)], 0.0),      # 3 cm from the itch: too far
