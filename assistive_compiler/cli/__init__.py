@@ -32,7 +32,7 @@ from typing import Callable, Sequence
 
 from ..errors import SpecError, UsageError
 from . import bench, collect, compare, evaluate, render, run, spec_commands, table, train, view
-from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, print_problems
+from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, print_problems, use_library_dirs
 
 COMMAND_MODULES = (spec_commands, run, render, bench, compare, view, collect, train, evaluate, table)
 
@@ -52,6 +52,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     func: Callable[[argparse.Namespace], int] = args.func
     try:
+        use_library_dirs(getattr(args, "library", []))
         return func(args)
     except SpecError as exc:
         print_problems(exc)

@@ -12,7 +12,7 @@ import json
 import sys
 
 from ..errors import SpecError
-from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, print_problems
+from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, add_library_argument, print_problems
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
@@ -117,10 +117,12 @@ def cmd_list(args: argparse.Namespace) -> int:
 
 def add_commands(sub) -> None:
     p = sub.add_parser("validate", help="check task specs; print PATH:LINE:COL: problem for each mistake")
+    add_library_argument(p)
     p.add_argument("paths", nargs="+", help="task spec files")
     p.set_defaults(func=cmd_validate)
 
     p = sub.add_parser("compile", help="compile a task spec for a robot into URDFs and a manifest")
+    add_library_argument(p)
     p.add_argument("spec", help="task spec file")
     p.add_argument("--robot", help="robot name (default: the spec's default robot)")
     p.add_argument("--out", help="output directory (default: generated/<task>-<robot>)")

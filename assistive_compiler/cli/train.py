@@ -10,7 +10,7 @@ import json
 import sys
 from pathlib import Path
 
-from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, engine_modules, require_extra
+from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, add_library_argument, engine_modules, require_extra
 
 SHIPPED_CONFIGS = "ppo_paper, ppo_laptop, ppo_quick, ppo_rllib_reference"
 
@@ -52,6 +52,7 @@ def cmd_train(args: argparse.Namespace) -> int:
 
 def add_commands(sub) -> None:
     p = sub.add_parser("train", help="learn a policy with PPO (SB3 on one machine; RLlib for --coop and Ray clusters)")
+    add_library_argument(p)
     p.add_argument("spec", help="task spec file")
     p.add_argument("--robot", help="robot name (default: the spec's default robot)")
     p.add_argument("--config", required=True, help=f"training config: a file, or a shipped one by name ({SHIPPED_CONFIGS})")
