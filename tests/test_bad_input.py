@@ -192,8 +192,12 @@ def test_shipped_specs_survive_a_pyyaml_load_dump_round_trip(kind_name, tmp_path
     assert all(isinstance(k, str) for k in _keys(data)), "a key PyYAML reads as a non-string"
     (tmp_path / kind).mkdir()
     (tmp_path / kind / f"{name}.yaml").write_text(yaml.safe_dump(data, sort_keys=False))
-    if kind == "tasks":
+    if kind in ("tasks", "examples"):  # examples/: task specs that are not registered ids (reach)
         validate_all_robots(load_spec(tmp_path / kind / f"{name}.yaml"), Library([specs_dir()]))
+    elif kind == "training":
+        from assistive_compiler.training.config import load_training_config
+
+        load_training_config(tmp_path / kind / f"{name}.yaml")
     else:
         Library([tmp_path]).get(kind, name)
 
