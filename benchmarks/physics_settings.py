@@ -43,7 +43,7 @@ from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.policies.scripted import ScriptedPolicy
 from assistive_compiler.runtime.env import AssistiveEnv
 from assistive_compiler.spec.load import load_spec
-from assistive_compiler.spec.reference_solver import reference_solver, solver_settings, write_reference_variant
+from assistive_compiler.spec.reference_solver import reference_solver, solver_settings, write_solver_variant
 
 #: (key, label, unit) of the per-episode figures compared, in table order.
 METRICS = (
@@ -152,16 +152,18 @@ def paired_ci(a: list[float], b: list[float], resamples: int = 2000, seed: int =
 
 
 def compare(shipped: list[dict], reference: list[dict]) -> list[dict]:
-    """One row per metric: mean ± sd per setting, the paired difference and its interval, the verdict."""
+    """One row per metric: mean ± sd per setting, the paired difference and its interval, the verdict.
+    Only seeds where both settings have the figure count (e.g. an episode whose person tremors in
+    every held joint has no held-joint drift); a metric no seed has is left out."""
     rows = []
     for key, label, unit in METRICS:
-        a = [e[key] for e in shipped]
-        b = [e[key] for e in reference]
-        if any(v is None for v in a + b):
+        pairs = [(x[key], y[key]) for x, y in zip(shipped, reference) if x[key] is not None and y[key] is not None]
+        if not pairs:
             continue
+        a, b = (list(v) for v in zip(*pairs))
         diff, lo, hi = paired_ci(a, b)
-        noise = key == "steps_per_s" or lo <= 0.0 <= hi
-        rows.append({"metric": key, "label": label, "unit": unit,
+        noise = lo <= 0.0 <= hi
+        rows.append({"metric": key, "label": label, "unit": unit, "n": len(pairs),
                      "shipped_mean": float(np.mean(a)), "shipped_sd": float(np.std(a, ddof=1)) if len(a) > 1 else 0.0,
                      "reference_mean": float(np.mean(b)), "reference_sd": float(np.std(b, ddof=1)) if len(b) > 1 else 0.0,
                      "diff": diff, "diff_ci95": [lo, hi],
@@ -173,15 +175,25 @@ def markdown(result: dict) -> str:
     """The comparison as a markdown table."""
     s, r = result["shipped_solver"], result["reference_solver"]
     lines = [f"**{result['task']} × {result['robot']}**, {result['seeds']} seeds (scripted policy); "
-             f"shipped `{s}` vs reference `{r}`", "",
+             f"shipped `{s}` vs {result.get('variant_label', 'reference')} `{r}`", "",
              "| metric | shipped (mean ± sd) | reference (mean ± sd) | reference − shipped [95% CI] | verdict |",
              "|---|---|---|---|---|"]
     for row in result["rows"]:
         unit = f" ({row['unit']})" if row["unit"] else ""
         lo, hi = row["diff_ci95"]
-        lines.append(f"| {row['label']}{unit} | {row['shipped_mean']:.3g} ± {row['shipped_sd']:.2g} | "
+        seeds = f", {row['n']} seeds" if row["n"] != result["seeds"] else ""
+        lines.append(f"| {row['label']}{unit}{seeds} | {row['shipped_mean']:.3g} ± {row['shipped_sd']:.2g} | "
                      f"{row['reference_mean']:.3g} ± {row['reference_sd']:.2g} | {row['diff']:+.3g} [{lo:+.3g}, {hi:+.3g}] | {row['verdict']} |")
     return "\n".join(lines) + "\n"
+
+
+def parse_solver(items: list[str]) -> dict:
+    """``key=value`` overrides of ``sim.solver`` (numbers)."""
+    out = {}
+    for item in items:
+        key, _, value = item.partition("=")
+        out[key] = float(value) if "." in value or "e" in value else int(value)
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -190,32 +202,22 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--robot", default="jaco")
     ap.add_argument("--seeds", type=int, default=20, help="episodes per setting (seeds 0..N-1)")
     ap.add_argument("--first-seed", type=int, default=0)
+    ap.add_argument("--solver", nargs="+", default=[], metavar="KEY=VALUE",
+                    help="compare against the reference's settings with these sim.solver keys changed "
+                         "(e.g. contact_breaking_threshold_m=0.002: which of the differences matters)")
     ap.add_argument("--artifacts", help="where to compile (default: a temporary directory)")
     ap.add_argument("--json", help="write the full result (per-episode figures too) here")
     ap.add_argument("--markdown", help="write the table here")
+    ap.add_argument("--from-json", help="re-tabulate a result written by --json (no episodes run)")
     args = ap.parse_args(argv)
 
-    spec = load_spec(args.spec).spec
-    if reference_solver(spec.name) is None:
-        print(f"{spec.name}: the reference has no such task", file=sys.stderr)
-        return 2
-    seeds = list(range(args.first_seed, args.first_seed + args.seeds))
-    with tempfile.TemporaryDirectory() as tmp:
-        root = Path(args.artifacts or tmp)
-        variant = write_reference_variant(args.spec, spec, root / "specs")
-        if variant is None:
-            print(f"{spec.name}: the shipped solver settings are the reference's; nothing to compare")
-            return 0
-        t0 = time.perf_counter()
-        shipped_dir = compile_task(args.spec, args.robot, root / f"{spec.name}-{args.robot}-shipped").out_dir
-        reference_dir = compile_task(variant, args.robot, root / f"{spec.name}-{args.robot}-reference").out_dir
-        compile_s = time.perf_counter() - t0
-        shipped = run_episodes(shipped_dir, seeds)
-        reference = run_episodes(reference_dir, seeds)
-    result = {"task": spec.name, "robot": args.robot, "seeds": len(seeds), "first_seed": args.first_seed,
-              "shipped_solver": solver_settings(spec), "reference_solver": reference_solver(spec.name),
-              "compile_s": round(compile_s, 1), "rows": compare(shipped, reference),
-              "episodes": {"shipped": shipped, "reference": reference}}
+    if args.from_json:
+        result = json.loads(Path(args.from_json).read_text())
+        result["rows"] = compare(result["episodes"]["shipped"], result["episodes"]["reference"])
+    else:
+        result = run(args)
+        if result is None:
+            return 2
     table = markdown(result)
     print(table)
     if args.json:
@@ -225,6 +227,36 @@ def main(argv: list[str] | None = None) -> int:
         Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
         Path(args.markdown).write_text(table)
     return 0
+
+
+def run(args: argparse.Namespace) -> dict | None:
+    """Compile both settings and run the seeds on each; None when there is nothing to compare."""
+    spec = load_spec(args.spec).spec
+    ref = reference_solver(spec.name)
+    if ref is None:
+        print(f"{spec.name}: the reference has no such task", file=sys.stderr)
+        return None
+    variant_solver = {**ref, **parse_solver(args.solver)}
+    if variant_solver == solver_settings(spec):
+        print(f"{spec.name}: the shipped solver settings are the compared ones; nothing to compare", file=sys.stderr)
+        return None
+    label = "reference" if not args.solver else "reference with " + ", ".join(args.solver)
+    tag = "reference" if not args.solver else "variant-" + "-".join(args.solver).replace("=", "")
+    seeds = list(range(args.first_seed, args.first_seed + args.seeds))
+    with tempfile.TemporaryDirectory() as tmp:
+        root = Path(args.artifacts or tmp)
+        variant = write_solver_variant(args.spec, variant_solver, root / "specs" / f"{spec.name}-{tag}.yaml")
+        t0 = time.perf_counter()
+        shipped_dir = compile_task(args.spec, args.robot, root / f"{spec.name}-{args.robot}-shipped").out_dir
+        variant_dir = compile_task(variant, args.robot, root / f"{spec.name}-{args.robot}-{tag}").out_dir
+        compile_s = time.perf_counter() - t0
+        shipped = run_episodes(shipped_dir, seeds)
+        other = run_episodes(variant_dir, seeds)
+    return {"task": spec.name, "robot": args.robot, "seeds": len(seeds), "first_seed": args.first_seed,
+            "shipped_solver": solver_settings(spec), "reference_solver": variant_solver, "variant_label": label,
+            "command": " ".join(["benchmarks/physics_settings.py", *sys.argv[1:]]),
+            "compile_s": round(compile_s, 1), "rows": compare(shipped, other),
+            "episodes": {"shipped": shipped, "reference": other}}
 
 
 if __name__ == "__main__":

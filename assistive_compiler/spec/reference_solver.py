@@ -42,15 +42,20 @@ def reference_solver(task: str) -> dict | None:
     return REFERENCE_SOLVER.get(task)
 
 
+def write_solver_variant(spec_path: str | Path, solver: dict, out: str | Path) -> Path:
+    """Write the spec file ``out``: the spec at ``spec_path`` with ``sim.solver`` overridden by ``solver``."""
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    settings = ", ".join(f"{k}: {v}" for k, v in solver.items())
+    out.write_text(f"# {Path(spec_path).name} with other solver settings (spec/reference_solver.py)\n"
+                   f"extends: {Path(spec_path).resolve()}\nsim:\n  solver: {{{settings}}}\n")
+    return out
+
+
 def write_reference_variant(spec_path: str | Path, spec: TaskSpec, out_dir: str | Path) -> Path | None:
     """Write ``<out_dir>/<task>_reference_solver.yaml``: the spec at ``spec_path`` with the reference's
     ``sim.solver``. None when the task has no reference settings or already uses them."""
     ref = reference_solver(spec.name)
     if ref is None or ref == solver_settings(spec):
         return None
-    out = Path(out_dir) / f"{spec.name}_reference_solver.yaml"
-    out.parent.mkdir(parents=True, exist_ok=True)
-    solver = ", ".join(f"{k}: {v}" for k, v in ref.items())
-    out.write_text(f"# {spec.name} at the reference implementation's solver settings (spec/reference_solver.py)\n"
-                   f"extends: {Path(spec_path).resolve()}\nsim:\n  solver: {{{solver}}}\n")
-    return out
+    return write_solver_variant(spec_path, ref, Path(out_dir) / f"{spec.name}_reference_solver.yaml")
