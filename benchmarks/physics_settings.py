@@ -174,9 +174,10 @@ def compare(shipped: list[dict], reference: list[dict]) -> list[dict]:
 def markdown(result: dict) -> str:
     """The comparison as a markdown table."""
     s, r = result["shipped_solver"], result["reference_solver"]
+    a, b = result.get("shipped_label", "shipped"), result.get("variant_label", "reference")
     lines = [f"**{result['task']} × {result['robot']}**, {result['seeds']} seeds (scripted policy); "
-             f"shipped `{s}` vs {result.get('variant_label', 'reference')} `{r}`", "",
-             "| metric | shipped (mean ± sd) | reference (mean ± sd) | reference − shipped [95% CI] | verdict |",
+             f"{a} `{s}` vs {b} `{r}`", "",
+             f"| metric | {a} (mean ± sd) | {b} (mean ± sd) | difference [95% CI] | verdict |",
              "|---|---|---|---|---|"]
     for row in result["rows"]:
         unit = f" ({row['unit']})" if row["unit"] else ""
@@ -208,11 +209,21 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--artifacts", help="where to compile (default: a temporary directory)")
     ap.add_argument("--json", help="write the full result (per-episode figures too) here")
     ap.add_argument("--markdown", help="write the table here")
-    ap.add_argument("--from-json", help="re-tabulate a result written by --json (no episodes run)")
+    ap.add_argument("--from-json", nargs="+", metavar="RESULT",
+                    help="re-tabulate a result written by --json (no episodes run); with two results of the same "
+                         "seeds, compare their compared settings (the first's as 'shipped', the second's as 'reference')")
     args = ap.parse_args(argv)
 
     if args.from_json:
-        result = json.loads(Path(args.from_json).read_text())
+        result = json.loads(Path(args.from_json[0]).read_text())
+        if len(args.from_json) == 2:
+            other = json.loads(Path(args.from_json[1]).read_text())
+            if [e["seed"] for e in other["episodes"]["reference"]] != [e["seed"] for e in result["episodes"]["reference"]]:
+                raise SystemExit("--from-json: the two results ran different seeds")
+            result["shipped_solver"], result["reference_solver"] = result["reference_solver"], other["reference_solver"]
+            result["shipped_label"] = result.get("variant_label", "reference")
+            result["variant_label"] = other.get("variant_label", "reference")
+            result["episodes"] = {"shipped": result["episodes"]["reference"], "reference": other["episodes"]["reference"]}
         result["rows"] = compare(result["episodes"]["shipped"], result["episodes"]["reference"])
     else:
         result = run(args)
