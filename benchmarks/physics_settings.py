@@ -101,7 +101,8 @@ class EpisodeProbe:
             for cp in pb.getContactPoints(bodyA=a, physicsClientId=c):
                 if cp[2] in targets and cp[8] < 0:
                     self.depth = max(self.depth, -cp[8])
-        for ev in env.snap.events.values():
+        for ps in env.manifest.particles:  # (snap.events also holds the markers' counts)
+            ev = env.snap.events[ps.name]
             self.lost += ev.lost
             self.consumed += ev.consumed
         for kind, (idx, hold) in self.held.items():
