@@ -6,8 +6,9 @@ default 0.02 m). A persistent contact manifold keeps an old contact point until 
 far. A rolling 5 mm food or water particle, whose contact point moves over its own surface every
 step, so piles up near-copies of its one contact (23 points for 8 particles in a spoon), each a
 solver row; at 2 mm they are dropped within a step or two (Feeding's physics: 14% fewer
-instructions, Drinking's: 21%). Stale points also widen where a contact is reported, which Bed
-Bathing's wiping counts, so tasks keep Bullet's default unless they ask otherwise.
+instructions, Drinking's: 21%). But the value changes the contacts themselves (how deep food and
+water sink, docs/physics.md), and stale points widen where a contact is reported, which Bed
+Bathing's wiping counts: every shipped task keeps Bullet's default, as the reference does.
 
 pybullet stores this threshold in one process-wide variable, read when a contact manifold is
 created. So it is set when a client opens and again before every env step of a world

@@ -118,10 +118,12 @@ def test_saturated_actions_never_leave_the_limits(task, impairment, coop_envs):
     assert env.env.human.reverts > 10  # and into poses the arm-limit model refused
 
 
-@pytest.mark.parametrize("task", ["scratch_itch", "dressing"])
-def test_a_weak_person_reaches_less_far(task, coop_envs):
+@pytest.mark.parametrize("task, at_most", [("scratch_itch", 0.8), ("dressing", 0.9)])
+def test_a_weak_person_reaches_less_far(task, at_most, coop_envs):
     """Shoulder flexion at full action for 5 env steps, the rest of the arm held by zero actions:
-    the hand of a person with strength β = 0.25 travels clearly less than at full strength."""
+    the hand of a person with strength β = 0.25 travels clearly less than at full strength.
+    Dressing runs the reference's 8 solver sub-steps (docs/physics.md): the motor pulls towards
+    its target 8 times per physics step, so the weak arm comes closer (about 80%) to the full one."""
     side = SIDE[task]
     for seed in (0, 1):  # both body variants
         travel = {}
@@ -137,7 +139,7 @@ def test_a_weak_person_reaches_less_far(task, coop_envs):
             for _ in range(5):
                 env.step({"robot": ROBOT_ZERO, "human": a})
             travel[name] = float(np.linalg.norm(wrist(env, side) - start))
-        assert travel["none"] > 0.05 and travel["weak"] < 0.8 * travel["none"], travel
+        assert travel["none"] > 0.05 and travel["weak"] < at_most * travel["none"], travel
 
 
 def into_chest(env, side: str, seed: int, self_collision: bool = True) -> tuple[float, int, float]:

@@ -1,7 +1,9 @@
 """``bench``: speed figures of (task, robot) pairs, all taken in one run.
 
 Env steps/s against raw physics (the same episodes, physics timed inside ``env.step``) and
-against the reference implementation's measured rate, both agents acting (co-optimisation),
+against the reference implementation's measured rate — at the spec's solver settings and at the
+reference's (an artifact compiled with them), so that no speed claim rests on simulating less —
+both agents acting (co-optimisation),
 resets, compile times, import time and memory. Each figure comes from a plain ``measure_*``
 function (medians over repeats) that other commands may reuse; :func:`bench` takes them all.
 """
@@ -136,17 +138,44 @@ def measure_process(artifact_dir: Path) -> dict:
     return json.loads(child.stdout.strip().splitlines()[-1])
 
 
+def measure_steps_paired(envs: dict, steps: int, repeats: int, seed: int) -> dict[str, tuple[list[float], list[float], list[float]]]:
+    """:func:`measure_steps` of several envs, their repeats interleaved (repeat r of every env, then
+    r + 1) so that a change of the machine's load falls on all of them alike; each repeat r is the
+    same seeded episode with the same random actions in every env."""
+    out: dict[str, tuple[list[float], list[float], list[float]]] = {k: ([], [], []) for k in envs}
+    for r in range(repeats):
+        for key, env in envs.items():
+            for acc, values in zip(out[key], measure_steps(env, steps, 1, seed + r)):
+                acc.extend(values)
+    return out
+
+
 def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, seed: int = 0) -> dict:
-    """Speed figures of one (task, robot), all taken in this one run (medians over repeats)."""
+    """Speed figures of one (task, robot), all taken in this one run (medians over repeats).
+
+    Env steps/s is measured at the spec's solver settings and, where they differ, at the reference
+    implementation's (:mod:`~assistive_compiler.spec.reference_solver`: an artifact compiled from
+    an ``extends:`` variant), the same episodes and actions, repeats interleaved; each against the
+    reference's measured rate, so no speed claim rests on simulating less."""
     from ..compile.compiler import compile_task
     from ..runtime.env import AssistiveEnv
+    from ..spec.load import load_spec
+    from ..spec.reference_solver import reference_solver, solver_settings, write_reference_variant
 
+    loaded = load_spec(spec).spec
     with tempfile.TemporaryDirectory() as tmp:
         cold = compile_task(spec, robot, Path(tmp) / "cold", force=True)
         cached = compile_task(spec, robot, Path(tmp) / "cold")
         assert cached.cache_hit
-        env = AssistiveEnv(cold.out_dir)
-        env_rates, raw_rates, overhead = measure_steps(env, steps, repeats, seed)
+        envs = {"shipped": AssistiveEnv(cold.out_dir)}
+        variant = write_reference_variant(spec, loaded, Path(tmp) / "specs")
+        if variant is not None:
+            envs["reference_solver"] = AssistiveEnv(compile_task(variant, robot, Path(tmp) / "reference_solver").out_dir)
+        rates = measure_steps_paired(envs, steps, repeats, seed)
+        for extra in list(envs)[1:]:
+            envs.pop(extra).close()
+        env = envs["shipped"]
+        env_rates, raw_rates, overhead = rates["shipped"]
         coop_rates = measure_coop_steps(env, steps, repeats, seed)
         raw_loop = measure_raw_loop(env, steps)
         reset_ms, seeded_ms = measure_resets(env, resets)
@@ -157,12 +186,21 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
     raw_med = statistics.median(raw_rates)
     reset_med, reset_p95 = _median_p95(reset_ms)
     reference = REFERENCE_STEPS_PER_S.get((m.task, m.robot_name))
+    ref_solver = reference_solver(m.task)
+    # At the reference's solver settings: measured on the variant's artifact, or the same figure when
+    # the spec already uses them (None: the reference has no such task).
+    at_ref = statistics.median(rates["reference_solver"][0]) if "reference_solver" in rates else (env_med if ref_solver is not None else None)
     return {
         "task": m.task, "robot": m.robot_name, "gym_id": m.gym_id,
         "obs_size": sum(t.size for t in m.observations["robot"]), "action_size": m.robot.action_size,
         "env_steps_per_s": round(env_med, 1),
         "reference_env_steps_per_s": reference,
         "vs_reference": round(env_med / reference, 2) if reference is not None else None,
+        "solver": solver_settings(loaded),
+        "reference_solver": ref_solver,
+        "reference_solver_is_shipped": ref_solver is not None and variant is None,
+        "env_steps_per_s_reference_solver": round(at_ref, 1) if at_ref is not None else None,
+        "vs_reference_at_reference_solver": round(at_ref / reference, 2) if at_ref is not None and reference is not None else None,
         "raw_physics_steps_per_s": round(raw_med, 1),
         "env_over_raw": round(env_med / raw_med, 3),
         "env_overhead_us_per_step": round(statistics.median(overhead), 1),
@@ -174,11 +212,15 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
         "import_s": round(proc["import_s"], 4), "heavy_modules_on_import": proc["heavy_modules_on_import"],
         "peak_rss_mb_one_env": round(proc["peak_rss_mb"], 1),
         "steps_per_repeat": steps, "repeats": repeats,
-        "notes": "env/raw: the same episodes, physics timed inside env.step (stepSimulation + gravity compensation) vs the whole step; random actions; coop: step_agents with both agents acting (None: the person has no policy joints); medians over repeats",
+        "notes": "env/raw: the same episodes, physics timed inside env.step (stepSimulation + gravity compensation) vs the whole step; "
+                 "reference_solver: the same episodes and actions on an artifact compiled with the reference's sim.solver, repeats "
+                 "interleaved with the shipped ones (when reference_solver_is_shipped, the same figure as env_steps_per_s); random actions; "
+                 "coop: step_agents with both agents acting (None: the person has no policy joints); medians over repeats",
     }
 
 
-BENCH_TABLE = ("task", "robot", "env_steps_per_s", "raw_physics_steps_per_s", "reset_ms_median", "reference_env_steps_per_s", "vs_reference")
+BENCH_TABLE = ("task", "robot", "env_steps_per_s", "env_steps_per_s_reference_solver", "raw_physics_steps_per_s", "reset_ms_median",
+               "reference_env_steps_per_s", "vs_reference", "vs_reference_at_reference_solver")
 """The columns of ``bench``'s table for several specs."""
 
 BENCH_COOP_TABLE = ("task", "robot", "single_agent_env_steps_per_s", "multi_agent_env_steps_per_s", "multi_over_single")

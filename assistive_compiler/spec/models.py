@@ -77,7 +77,9 @@ def scalar_bounds(value: Scalar) -> tuple[float, float]:
 
 
 class Solver(Strict):
-    """Bullet constraint-solver settings (``setPhysicsEngineParameter``)."""
+    """Bullet constraint-solver settings (``setPhysicsEngineParameter``). The defaults are PyBullet's,
+    which the reference keeps unless a task overrides them; docs/physics.md shows what fewer
+    iterations or sub-steps change."""
 
     sub_steps: int = Field(0, ge=0, le=64, description="numSubSteps: extra sub-steps per physics step (0 = none).")
     iterations: int = Field(50, ge=1, le=1000, description="numSolverIterations per physics step.")
@@ -85,9 +87,9 @@ class Solver(Strict):
         0.02, gt=0, le=0.1,
         description="Distance (m) a cached contact point may drift before Bullet drops it (Bullet's default 0.02). "
                     "Small rolling particles pile up stale copies of their one contact under the default, each a "
-                    "solver row: 0.002 cuts Feeding's physics by 14% and Drinking's by 21%. Stale points also widen "
-                    "where a contact is reported (Bed Bathing's wiping counts them), so tasks keep the default "
-                    "unless they need the speed.")
+                    "solver row: 0.002 cuts Feeding's physics by 14% and Drinking's by 21%, but changes how deep "
+                    "particles sink, and stale points widen where a contact is reported (Bed Bathing's wiping counts "
+                    "them); the shipped tasks keep the default, as the reference does (docs/physics.md).")
 
 
 class Ground(Strict):
