@@ -155,16 +155,17 @@ def serve(artifact_dir: str | Path, recording: Recording, player: EpisodePlayer 
     ``on_ready(url)`` is called once the page can be loaded."""
     import viser
 
-    from ..runtime.camera import DEFAULT_VIEW
+    from ..artifact import Manifest
 
     if threading.current_thread() is threading.main_thread():  # Ctrl-C stops the server even if the shell ignored SIGINT (a background job)
         signal.signal(signal.SIGINT, signal.default_int_handler)
     server = viser.ViserServer(host=host, port=port, label="assistive-compiler", verbose=False)
     try:
         server.scene.set_up_direction("+z")
-        eye, target = np.asarray(DEFAULT_VIEW["eye"]), np.asarray(DEFAULT_VIEW["target"])
+        camera = Manifest.read(artifact_dir).camera  # the task's camera for this robot, as renders use
+        eye, target = np.asarray(camera.eye), np.asarray(camera.target)
         server.initial_camera.position = tuple(target + 1.5 * (eye - target))  # the render's view, a step back
-        server.initial_camera.look_at = DEFAULT_VIEW["target"]
+        server.initial_camera.look_at = tuple(camera.target)
         app = ViewerApp(server, artifact_dir, recording, player)
         if on_ready is not None:
             on_ready(f"http://{host}:{server.get_port()}")
