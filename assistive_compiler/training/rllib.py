@@ -172,8 +172,10 @@ def save_checkpoint(run: RunDir, algo, steps: int) -> Path:
 
 
 def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, coop: bool, resume: bool,
-          address: str | None = None, quiet: bool = False) -> dict:
-    """Train (or continue) the run to ``config.total_steps`` env steps; Ctrl-C checkpoints and returns."""
+          address: str | None = None, quiet: bool = False, stop=None) -> dict:
+    """Train (or continue) the run to ``config.total_steps`` env steps; a stop request (``stop``:
+    Ctrl-C or SIGTERM, see :func:`.train.stop_on_signals`) ends it after the current iteration,
+    with a checkpoint."""
     init_ray(address, config.envs)  # train.train has already started or attached; a no-op then
     latest = run.latest_checkpoint() if resume else None
     start_steps = latest[0] if latest else 0
@@ -185,7 +187,7 @@ def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, coo
     every = config.checkpoint_every_steps
     next_checkpoint = (steps // every + 1) * every
     try:
-        while steps < config.total_steps:
+        while steps < config.total_steps and not stop:
             result = algo.train()
             steps += int(result["env_runners"]["num_env_steps_sampled"])
             _record(progress, result, weights)
@@ -193,7 +195,8 @@ def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, coo
             if steps >= next_checkpoint and steps < config.total_steps:
                 save_checkpoint(run, algo, steps)
                 next_checkpoint = (steps // every + 1) * every
-    except KeyboardInterrupt:
+        interrupted = bool(stop)
+    except KeyboardInterrupt:  # a second Ctrl-C: stop at once
         interrupted = True
     finally:
         save_checkpoint(run, algo, steps)

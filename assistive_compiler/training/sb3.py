@@ -86,7 +86,7 @@ def save_checkpoint(run: RunDir, model, steps: int) -> Path:
     return out
 
 
-def _callback(run: RunDir, progress: Progress, config: TrainingConfig, n_envs: int):
+def _callback(run: RunDir, progress: Progress, config: TrainingConfig, n_envs: int, stop=None):
     from stable_baselines3.common.callbacks import BaseCallback
 
     class RunCallback(BaseCallback):
@@ -108,7 +108,7 @@ def _callback(run: RunDir, progress: Progress, config: TrainingConfig, n_envs: i
                 if done:
                     tally, self.tallies[i] = self.tallies[i], EpisodeTally()
                     progress.episode(info["episode"]["r"], info["task_success"], tally.terms)
-            return True
+            return not stop  # False ends model.learn() after this step
 
         def _on_rollout_end(self) -> None:
             for key, value in progress.update(self.num_timesteps).items():
@@ -121,10 +121,12 @@ def _callback(run: RunDir, progress: Progress, config: TrainingConfig, n_envs: i
     return RunCallback()
 
 
-def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, resume: bool, quiet: bool = False) -> dict:
+def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, resume: bool, quiet: bool = False,
+          stop=None) -> dict:
     """Train (or continue) the run to ``config.total_steps``; returns the session's figures.
 
-    Ctrl-C stops after the current env step, writes a checkpoint and returns with
+    A stop request (``stop``, set by Ctrl-C or SIGTERM: :func:`.train.stop_on_signals`) ends
+    training after the current env step; a checkpoint is written and the figures come back with
     ``interrupted: True``; a later ``resume`` continues from it."""
     import torch
     from stable_baselines3 import PPO
@@ -144,9 +146,10 @@ def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, res
     try:
         remaining = max(0, config.total_steps - model.num_timesteps)
         if remaining:
-            model.learn(remaining, callback=_callback(run, progress, config, config.envs), reset_num_timesteps=not latest,
+            model.learn(remaining, callback=_callback(run, progress, config, config.envs, stop), reset_num_timesteps=not latest,
                         tb_log_name="sb3")
-    except KeyboardInterrupt:
+        interrupted = bool(stop)
+    except KeyboardInterrupt:  # a second Ctrl-C: stop at once
         interrupted = True
     finally:
         steps = model.num_timesteps

@@ -91,34 +91,52 @@ def train(spec: str, *, robot: str | None, config_path: str, coop: bool = False,
         print(f"{manifest.gym_id}{' + human (co-optimisation)' if coop else ''}: {engine} PPO, {config.envs} envs, "
               f"{config.total_steps:,} steps -> {display(run.path)}", file=sys.stderr)
         print_reward_table(weights, manifest.task)
-    with sigterm_as_interrupt():
+    with stop_on_signals() as stop:
         if engine == "sb3":
             from . import sb3
 
-            figures = sb3.train(run, config, weights, resume=resume, quiet=quiet)
+            figures = sb3.train(run, config, weights, resume=resume, quiet=quiet, stop=stop)
         else:
             from . import rllib
 
-            figures = rllib.train(run, config, weights, coop=coop, resume=resume, address=address, quiet=quiet)
+            figures = rllib.train(run, config, weights, coop=coop, resume=resume, address=address, quiet=quiet, stop=stop)
     return finish(run, manifest, engine, config, figures)
 
 
+class StopRequest:
+    """Set when the user asks training to stop (Ctrl-C, or SIGTERM from a scheduler or ``kill``).
+    The engines look at it at safe points — SB3 after each env step, RLlib after each iteration —
+    then write a checkpoint and return, so a stop never lands inside torch, TensorBoard's writer
+    or a checkpoint being written."""
+
+    def __init__(self) -> None:
+        self.requested = False
+
+    def __bool__(self) -> bool:
+        return self.requested
+
+
 @contextlib.contextmanager
-def sigterm_as_interrupt():
-    """While training, SIGTERM (a scheduler's or ``kill``'s stop) acts like Ctrl-C: the engine
-    writes a checkpoint and returns. Only the main thread can install signal handlers."""
+def stop_on_signals():
+    """While training, SIGINT and SIGTERM set a :class:`StopRequest` instead of raising; a second
+    signal interrupts at once (KeyboardInterrupt; the engine still checkpoints on its way out).
+    Only the main thread can install signal handlers: elsewhere the request is never set."""
+    stop = StopRequest()
     if threading.current_thread() is not threading.main_thread():
-        yield
+        yield stop
         return
 
-    def interrupt(signum, frame):
-        raise KeyboardInterrupt
+    def request(signum, frame):
+        if stop.requested:
+            raise KeyboardInterrupt
+        stop.requested = True
 
-    previous = signal.signal(signal.SIGTERM, interrupt)
+    previous = {sig: signal.signal(sig, request) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        yield
+        yield stop
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
 
 
 def finish(run: RunDir, manifest, engine: str, config: TrainingConfig, figures: dict) -> dict:
