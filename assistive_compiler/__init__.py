@@ -26,11 +26,15 @@ def compile_task(spec_path, robot=None, out_dir=None, **kwargs):
     return _compile(spec_path, robot, out_dir, **kwargs)
 
 
-def make(spec, robot=None, **kwargs):
-    """A Gymnasium env for the task spec at ``spec`` (a path) and ``robot``."""
+def make(spec, robot=None, library=None, **kwargs):
+    """A Gymnasium env for the task spec at ``spec`` (a path) and ``robot``.
+
+    Parts and templates are found in ``library`` (a list of directories laid out like ``specs/``),
+    then ``$ASSISTIVE_COMPILER_LIBRARY``, then the spec's own library (``<root>`` of a spec at
+    ``<root>/tasks/<name>.yaml``), then the shipped parts; see :mod:`assistive_compiler.library`."""
     from .runtime.env import AssistiveEnv
 
-    return AssistiveEnv.from_spec(spec, robot=robot, **kwargs)
+    return AssistiveEnv.from_spec(spec, robot=robot, library=library, **kwargs)
 
 
 def parallel_env(spec, robot=None, render_mode=None, out_dir=None, **kwargs):

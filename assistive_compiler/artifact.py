@@ -17,7 +17,9 @@ orientations are quaternions (x, y, z, w) as pybullet uses; joint values in radi
 
 from __future__ import annotations
 
+import hashlib
 import json
+import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any, Literal
 
@@ -292,8 +294,17 @@ class Success(_Model):
     fraction_of: str | None = Field(None, description="A marker set: the threshold is this fraction of the active variant's markers.")
 
 
+class Camera(_Model):
+    """The camera of renders (world frame, m): from ``eye`` towards ``target``, z up."""
+
+    eye: tuple[float, float, float] = Field((-0.85, -1.35, 1.45), description="Camera position, world frame, m.")
+    target: tuple[float, float, float] = Field((-0.12, -0.15, 0.85), description="Point looked at, world frame, m.")
+    fov_deg: float = Field(50.0, description="Vertical field of view, degrees.")
+
+
 class Sim(_Model):
-    """World physics and timing."""
+    """World physics and timing.
+"""
 
     time_step: float = Field(description="Physics step, s.")
     frame_skip: int = Field(description="Physics steps per env step.")
@@ -330,6 +341,7 @@ class Manifest(_Model):
     success: Success
     garments: list[Garment] = Field(default_factory=list, description="Soft-body garments (their presence makes the world a deformable one).")
     scripted: dict[str, Any] | None = Field(None, description="Scripted baseline: point moved and waypoints (normalised).")
+    camera: Camera = Field(default_factory=Camera, description="The task's camera for this robot (renders).")
 
     def body(self, name: str) -> Body:
         for b in self.bodies:
@@ -340,6 +352,41 @@ class Manifest(_Model):
     def to_json(self) -> str:
         return json.dumps(self.model_dump(mode="json"), indent=1, sort_keys=True) + "\n"
 
+    def hash_of(self, artifact_dir: str | Path) -> str:
+        """sha256 of the body files under ``artifact_dir`` and this manifest (``content_hash`` empty):
+        what ``content_hash`` records when the artifact is as compiled."""
+        files = b"".join(Path(artifact_dir, b.urdf).read_bytes() for b in sorted(self.bodies, key=lambda b: b.urdf))
+        return hashlib.sha256(files + self.model_copy(update={"content_hash": ""}).to_json().encode()).hexdigest()
+
+    def damage(self, artifact_dir: str | Path) -> str | None:
+        """What is wrong with the files of the artifact at ``artifact_dir`` (a missing, truncated or
+        edited URDF), or None when they are exactly as compiled."""
+        for b in self.bodies:
+            path = Path(artifact_dir, b.urdf)
+            if not path.is_file():
+                return f"{path}: missing"
+            try:
+                ET.parse(path)
+            except ET.ParseError as exc:
+                return f"{path}: not complete URDF XML ({exc}); truncated or edited?"
+        if self.content_hash and self.hash_of(artifact_dir) != self.content_hash:
+            return f"{artifact_dir}: files differ from what was compiled (the manifest's content hash does not match)"
+        return None
+
     @classmethod
-    def read(cls, artifact_dir: str | Path) -> "Manifest":
-        return cls.model_validate_json(Path(artifact_dir, "manifest.json").read_text())
+    def read(cls, artifact_dir: str | Path, verify: bool = False) -> "Manifest":
+        """The manifest of the artifact at ``artifact_dir``; with ``verify``, a :class:`SpecError`
+        naming what is damaged when its files are not as compiled (see :meth:`damage`)."""
+        from .errors import SpecError
+
+        path = Path(artifact_dir, "manifest.json")
+        if not path.is_file():
+            raise SpecError.at(str(artifact_dir), "not a compiled artifact (no manifest.json); compile a spec into it first")
+        try:
+            manifest = cls.model_validate_json(path.read_text())
+        except (ValueError, UnicodeDecodeError) as exc:
+            raise SpecError.at(str(path), f"not a readable manifest ({str(exc).splitlines()[0]}); recompile with 'compile --force'") from None
+        problem = manifest.damage(artifact_dir) if verify else None
+        if problem:
+            raise SpecError.at(str(artifact_dir), f"damaged artifact: {problem}; recompile it (assistive-compiler compile SPEC --out {artifact_dir} --force)")
+        return manifest

@@ -48,6 +48,11 @@ class SpecError(Exception):
         return cls([Problem(Location(str(path), line, column), message)])
 
 
+class UsageError(Exception):
+    """Bad command-line input that is not in a file (an unknown engine, an unreachable cluster);
+    the CLI prints ``error: message`` and exits 2."""
+
+
 def suggest(word: str, choices: Iterable[str]) -> str | None:
     """The closest of ``choices`` to a misspelled ``word``, or None when nothing is close."""
     choices = list(choices)

@@ -197,7 +197,7 @@ def sleeve_progress(
     beyond_shoulder_m: float,
     upper_arm_counts: bool = True,
 ) -> float:
-    """The reference's dressing reward r_dress (facts §2.5), in metres, for one arm.
+    """The reference's dressing reward r_dress (paper §III-B), in metres, for one arm.
 
     ``upper_arm_counts=False`` skips the upper-arm branch (for a caller that requires the forearm
     to have been in the sleeve first: see the ``sleeve_progress`` reward term).

@@ -1,16 +1,32 @@
 """The part library: robots, tools, furniture and people under ``specs/<kind>/<name>.yaml``.
 
 Parts are loaded lazily by name with located errors, and each part's semantic names are checked
-against its rendered URDF. Users can add a directory of their own parts with the same layout
-(``Library([their_dir, *default])``); the first directory that has a part wins.
+against its rendered URDF.
+
+**Where parts are found** (:func:`library_for`), in this order:
+
+1. directories given explicitly: ``--library DIR`` on the command line (repeatable), or
+   ``library=[...]`` to :func:`assistive_compiler.make` / ``compile_task``;
+2. ``$ASSISTIVE_COMPILER_LIBRARY``: directories separated by ``os.pathsep`` (``:`` on Linux);
+3. the spec's own library: a spec at ``<root>/tasks/<name>.yaml`` whose ``<root>`` holds any of
+   ``robots/ tools/ furniture/ people/`` (so ``myproject/specs/tasks/t.yaml`` finds
+   ``myproject/specs/tools/``);
+4. the shipped parts (``specs/``).
+
+Each library directory is laid out like ``specs/`` (``<kind>/<name>.yaml``); a part's template is
+looked up in the ``templates/`` beside its library (``<root>/../templates``), then in the shipped
+templates. A part name must be unique across all libraries: one defined in two of them is a
+located error naming both files, never silently resolved.
 """
 
 from __future__ import annotations
 
+import os
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Generic, TypeVar
+from typing import Generic, Iterable, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
@@ -22,6 +38,9 @@ from .spec.validation import problems_from_validation
 from .yamlsrc import load_located
 
 P = TypeVar("P", bound=BaseModel)
+
+LIBRARY_ENV = "ASSISTIVE_COMPILER_LIBRARY"
+"""Environment variable: extra library directories, separated by ``os.pathsep``."""
 
 PERSON_TEMPLATE_RELPATH = "person/person.urdf.xacro"
 
@@ -49,8 +68,11 @@ class LoadedPart(Generic[P]):
 class Library:
     """Parts by kind and name, from one or more directories laid out like ``specs/``."""
 
-    def __init__(self, roots: list[Path] | None = None):
-        self.roots = [Path(r) for r in (roots or [specs_dir()])]
+    def __init__(self, roots: Iterable[str | Path] | None = None):
+        unique: dict[Path, Path] = {}
+        for root in roots or [specs_dir()]:
+            unique.setdefault(Path(root).resolve(), Path(root).resolve())
+        self.roots = list(unique)
         self._cache: dict[tuple[str, str], LoadedPart] = {}
 
     def names(self, kind: str) -> list[str]:
@@ -61,11 +83,13 @@ class Library:
         return sorted(found)
 
     def path_of(self, kind: str, name: str) -> Path | None:
-        for root in self.roots:
-            candidate = root / kind / f"{name}.yaml"
-            if candidate.is_file():
-                return candidate
-        return None
+        """The file of part ``name``; raises :class:`SpecError` when two libraries define it."""
+        found = [root / kind / f"{name}.yaml" for root in self.roots if (root / kind / f"{name}.yaml").is_file()]
+        if len(found) > 1:
+            others = " and ".join(display(p) for p in found[1:])
+            raise SpecError.at(display(found[0]), f"{kind[:-1] if kind != 'people' else 'person'} '{name}' is defined in more than "
+                               f"one library: {display(found[0])} and {others}; part names must be unique, rename one")
+        return found[0] if found else None
 
     def get(self, kind: str, name: str) -> LoadedPart:
         """The part ``name`` of ``kind``; raises :class:`SpecError` located in the part's file."""
@@ -97,7 +121,7 @@ class Library:
             m = part.measurements()
             return urdf_info(render_template(PERSON_TEMPLATE_RELPATH, m.xacro_args()))
         if getattr(part, "urdf", None):
-            return urdf_info(self.urdf_path(loaded).read_text())
+            return self._urdf_file_info(loaded)
         params = dict(part.template.params) | dict(getattr(part, "mount_params", {}) or {})
         return urdf_info(render_template(self.template_path(loaded), params))
 
@@ -115,18 +139,37 @@ class Library:
             return Path(list(spec.submodule_search_locations)[0]) / rel
         return (loaded.path.parent / ref).resolve()
 
+    def _urdf_file_info(self, loaded: LoadedPart) -> UrdfInfo:
+        """What a bring-your-own URDF declares; a located error when it is not URDF XML."""
+        path = self.urdf_path(loaded)
+        where = loaded.smap.value(("urdf",))
+        try:
+            info = urdf_info(path.read_bytes().decode("utf-8"))
+        except UnicodeDecodeError as exc:
+            raise SpecError([Problem(where, f"{display(path)} is not a URDF: not UTF-8 text ({exc.reason} at byte {exc.start})")]) from None
+        except ET.ParseError as exc:
+            line, col = exc.position
+            raise SpecError([Problem(where, f"{display(path)} is not a URDF: XML error at line {line}, column {col + 1}: "
+                                            f"{str(exc).split(':')[0]}")]) from None
+        except (AttributeError, ValueError) as exc:
+            raise SpecError([Problem(where, f"{display(path)} is not a valid URDF: {exc}")]) from None
+        if info.root_tag != "robot":
+            raise SpecError([Problem(where, f"{display(path)} is not a URDF: its root element is <{info.root_tag}>, expected <robot>")])
+        return info
+
     def template_path(self, loaded: LoadedPart) -> Path:
         """The part's template: absolute as written, else under the ``templates/`` beside the part's
         library (``<root>/../templates``), else under the shipped templates."""
         rel = Path(loaded.part.template.path)
-        if rel.is_absolute():
-            return rel
-        for root in self.roots:
-            if loaded.path.is_relative_to(root):
-                candidate = root.parent / "templates" / rel
-                if candidate.is_file():
-                    return candidate
-        return templates_dir() / rel
+        searched = [rel] if rel.is_absolute() else [
+            *(root.parent / "templates" / rel for root in self.roots if loaded.path.is_relative_to(root) and root != specs_dir()),
+            templates_dir() / rel,
+        ]
+        for candidate in searched:
+            if candidate.is_file():
+                return candidate
+        raise SpecError([Problem(loaded.smap.value(("template", "path")),
+                                 f"template '{rel}' not found (looked in {', '.join(display(c.parent) + '/' for c in searched)})")])
 
     def _check_semantics(self, kind: str, loaded: LoadedPart) -> None:
         """Every URDF name a part declares must exist in the URDF it renders."""
@@ -175,6 +218,30 @@ class Library:
         if problems:
             raise SpecError(problems)
 
+    @classmethod
+    def for_spec(cls, spec_path: str | Path | None = None, dirs: Iterable[str | Path] = ()) -> "Library":
+        """The library a spec sees: ``dirs``, ``$ASSISTIVE_COMPILER_LIBRARY``, the spec's own
+        library root, the shipped parts (see the module docstring)."""
+        missing = [d for d in dirs if not Path(d).is_dir()]
+        if missing:
+            raise SpecError.at(str(missing[0]), "library directory not found (expected a folder holding robots/, tools/, furniture/ or people/)")
+        roots = [Path(d) for d in dirs] + env_library_dirs()
+        own = spec_library_root(spec_path) if spec_path is not None else None
+        return cls([*roots, *([own] if own else []), specs_dir()])
+
     @cached_property
     def everything(self) -> dict[str, list[str]]:
         return {kind: self.names(kind) for kind in KINDS}
+
+
+def env_library_dirs() -> list[Path]:
+    """The directories named by ``$ASSISTIVE_COMPILER_LIBRARY`` (empty entries skipped)."""
+    return [Path(p) for p in os.environ.get(LIBRARY_ENV, "").split(os.pathsep) if p.strip()]
+
+
+def spec_library_root(spec_path: str | Path) -> Path | None:
+    """``<root>`` for a spec at ``<root>/tasks/<name>.yaml`` when ``<root>`` holds part folders."""
+    parent = Path(spec_path).resolve().parent
+    if parent.name == "tasks" and any((parent.parent / kind).is_dir() for kind in KINDS):
+        return parent.parent
+    return None

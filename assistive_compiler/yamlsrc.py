@@ -5,8 +5,16 @@ from *paths* into that data — tuples such as ``("person", "joints_deg", "right
 file, line and column of the value and of its key. Later stages (pydantic validation, cross-
 reference checks) report problems by path and the map turns them into ``FILE:LINE:COL``.
 
-Rejected here, with a location: YAML syntax errors, duplicate keys, non-string keys, anchors that
-build recursive data, a file that is missing, empty, or whose top level is not a mapping.
+Rejected here, with a location: YAML syntax errors, duplicate keys, non-string keys, keys that
+are YAML 1.1 boolean words (``on``/``off``/``yes``/``no``/``y``/``n``: PyYAML's ``safe_load``
+reads them as true/false, so a spec scripted with it would break), anchors that build recursive
+data, merge keys (``<<``), tags, values YAML cannot construct (an integer of 5000 digits), and a
+file that is missing, not a regular file, empty, not UTF-8, or whose top level is not a mapping.
+
+Bounded, so no input can hang the loader or exhaust the stack: the file size
+(:data:`MAX_FILE_BYTES`), the nesting depth (:data:`MAX_DEPTH`, checked on the event stream before
+any recursion) and the values built after aliases are expanded (:data:`MAX_VALUES`: "billion
+laughs" anchors that expand exponentially).
 """
 
 from __future__ import annotations
@@ -21,6 +29,18 @@ from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 from .errors import Location, Problem, SpecError
 
 DataPath = tuple[Any, ...]
+
+MAX_FILE_BYTES = 4 * 1024 * 1024
+"""A spec or part file is at most this large (the largest shipped spec is ~10 KB)."""
+MAX_DEPTH = 48
+"""Mappings and sequences nest at most this deep (the shipped specs reach 6)."""
+MAX_VALUES = 200_000
+"""At most this many values are built from one file, aliases expanded."""
+
+BOOLEAN_WORDS = frozenset(w for word in ("y", "yes", "n", "no", "on", "off", "true", "false")
+                          for w in (word, word.capitalize(), word.upper()))
+"""Words YAML 1.1 (PyYAML) reads as booleans; never a spec key."""
+BOOLEAN_KEY_HINTS = {"on": "onto"}
 
 
 @dataclass
@@ -71,9 +91,17 @@ class _Builder:
         self.smap = SourceMap(default=Location(path, 1, 1))
         self.problems: list[Problem] = []
         self._active: set[int] = set()
+        self.count = 0
 
     def build(self, node: Node, at: DataPath) -> Any:
         self.smap.values[at] = _loc(self.path, node)
+        self.count += 1
+        if self.count > MAX_VALUES:
+            raise SpecError([Problem(_loc(self.path, node), f"more than {MAX_VALUES} values once anchors and aliases are expanded; "
+                                                           "a spec is far smaller (aliases that expand exponentially?)")])
+        if node.tag.startswith("!") or (node.tag.startswith("tag:yaml.org,2002:") and node.tag.rsplit(":", 1)[1] not in SAFE_TAGS):
+            self.problems.append(Problem(_loc(self.path, node), f"YAML tag '{node.tag}' is not allowed; a spec holds plain mappings, lists and scalars"))
+            return None
         if id(node) in self._active:
             self.problems.append(Problem(_loc(self.path, node), "recursive YAML alias; a spec must be a tree"))
             return None
@@ -90,7 +118,11 @@ class _Builder:
         raise AssertionError(f"unexpected YAML node {node!r}")  # pragma: no cover
 
     def _scalar(self, node: ScalarNode) -> Any:
-        return _construct_scalar(node)
+        try:
+            return _construct_scalar(node)
+        except (yaml.YAMLError, ValueError) as exc:  # e.g. int() of 5000 digits
+            self.problems.append(Problem(_loc(self.path, node), f"cannot read this value: {str(exc).splitlines()[0][:200]}"))
+            return None
 
     def _mapping(self, node: MappingNode, at: DataPath) -> dict:
         out: dict[str, Any] = {}
@@ -106,6 +138,11 @@ class _Builder:
                 self.problems.append(Problem(_loc(self.path, key_node), f"keys must be names (strings), got {key!r}"))
                 continue
             key_loc = _loc(self.path, key_node)
+            if key in BOOLEAN_WORDS:
+                hint = BOOLEAN_KEY_HINTS.get(key.lower())
+                self.problems.append(Problem(key_loc, f"'{key}' is a YAML 1.1 boolean word (PyYAML reads it as {key.lower() in ('y', 'yes', 'on', 'true')}), "
+                                                      "so no spec key may be one" + (f" (did you mean '{hint}'?)" if hint else "")))
+                continue
             if key in first_seen:
                 first = first_seen[key]
                 self.problems.append(Problem(key_loc, f"duplicate key '{key}' (first defined at line {first.line}, column {first.column})"))
@@ -114,6 +151,10 @@ class _Builder:
             self.smap.keys[at + (key,)] = key_loc
             out[key] = self.build(value_node, at + (key,))
         return out
+
+
+SAFE_TAGS = frozenset({"str", "int", "float", "bool", "null", "seq", "map", "timestamp", "merge", "value"})
+"""The standard tags a spec may carry (implicitly resolved; ``merge`` is refused by its own check)."""
 
 
 def _construct_scalar(node: ScalarNode) -> Any:
@@ -137,16 +178,30 @@ def load_located(path: str | Path, *, display_path: str | None = None) -> tuple[
         raise SpecError.at(shown, "file not found")
     if p.is_dir():
         raise SpecError.at(shown, "is a directory; expected a YAML spec file")
+    if not p.is_file():
+        raise SpecError.at(shown, "is not a regular file (a device or pipe?); expected a YAML spec file")
+    size = p.stat().st_size
+    if size > MAX_FILE_BYTES:
+        raise SpecError.at(shown, f"file is {size} bytes; a spec file is at most {MAX_FILE_BYTES} bytes")
     try:
-        text = p.read_text(encoding="utf-8")
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise SpecError.at(shown, f"cannot read: {exc.strerror}") from None
+    try:
+        text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise SpecError.at(shown, f"not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+        line = raw.count(b"\n", 0, exc.start) + 1
+        column = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise SpecError.at(shown, f"not UTF-8 text ({exc.reason} at byte {exc.start}); a spec is UTF-8 YAML", line, column) from None
     return loads_located(text, shown)
 
 
 def loads_located(text: str, shown: str) -> tuple[dict, SourceMap]:
     """Like :func:`load_located` for text already read; ``shown`` names it in messages."""
+    if len(text) > MAX_FILE_BYTES:
+        raise SpecError.at(shown, f"text is {len(text)} characters; a spec file is at most {MAX_FILE_BYTES} bytes")
     try:
+        _check_depth(text, shown)
         documents = list(yaml.compose_all(text, Loader=yaml.SafeLoader))
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
@@ -154,6 +209,10 @@ def loads_located(text: str, shown: str) -> tuple[dict, SourceMap]:
         what = exc.problem or "invalid YAML"
         context = f" ({exc.context})" if exc.context else ""
         raise SpecError.at(shown, f"YAML syntax error: {what}{context}", line, col) from None
+    except yaml.reader.ReaderError as exc:  # a control character, e.g. NUL in binary data
+        line = text.count("\n", 0, exc.position) + 1
+        column = exc.position - (text.rfind("\n", 0, exc.position) + 1) + 1
+        raise SpecError.at(shown, f"not YAML text: {exc.reason} (character U+{exc.character:04X}); a spec is plain UTF-8 YAML", line, column) from None
     except yaml.YAMLError as exc:
         raise SpecError.at(shown, f"YAML error: {exc}") from None
     documents = [d for d in documents if d is not None]
@@ -170,3 +229,17 @@ def loads_located(text: str, shown: str) -> tuple[dict, SourceMap]:
     if builder.problems:
         raise SpecError(builder.problems)
     return data, builder.smap
+
+
+def _check_depth(text: str, shown: str) -> None:
+    """Refuse nesting deeper than :data:`MAX_DEPTH` before composing (which recurses per level).
+    PyYAML's parser is a state machine, so walking its events needs no recursion."""
+    depth = 0
+    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+        if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
+            depth += 1
+            if depth > MAX_DEPTH:
+                mark = event.start_mark
+                raise SpecError.at(shown, f"nested more than {MAX_DEPTH} levels deep; a spec is a shallow tree", mark.line + 1, mark.column + 1)
+        elif isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
+            depth -= 1

@@ -26,3 +26,15 @@ def compiled_env(tmp_path_factory, spec: Path, robot: str):
     env = AssistiveEnv(compile_task(spec, robot, tmp_path_factory.mktemp(name) / name).out_dir)
     yield env
     env.close()
+
+
+def cli(*args: str, cwd: Path | None = None, env: dict | None = None, timeout: float = 600):
+    """The real ``assistive-compiler`` command in a subprocess: (exit status, stdout, stderr).
+    ``env`` entries are added to the current environment."""
+    import os
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-m", "assistive_compiler.cli", *args], cwd=cwd, capture_output=True, text=True,
+                          timeout=timeout, env=os.environ | (env or {}))
+    return proc.returncode, proc.stdout, proc.stderr

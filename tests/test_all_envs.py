@@ -32,5 +32,32 @@ def test_check_env(env_id, tmp_path_factory, monkeypatch):
         assert env.observation_space.contains(obs)
         obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
         assert {"terms", "task_success", "total_force_on_human"} <= set(info)
+        env.reset(seed=0)
+        assert_the_camera_shows_person_arm_and_tools(env.unwrapped)
     finally:
         env.close()
+
+
+MIN_PIXELS = {"person": 200, "arm": 20, "tool": 4}
+"""Pixels of a 160 x 120 picture each must cover (a tool is small: 4 px is a scratcher tip in view)."""
+
+
+def assert_the_camera_shows_person_arm_and_tools(env, width: int = 160, height: int = 120) -> None:
+    """The task's camera for this robot, first frame after a seeded reset: the person, the robot's
+    acting arm (the links its arm joints move) and every tool each cover pixels of pybullet's
+    segmentation mask (not hidden behind the robot, not outside the picture)."""
+    import numpy as np
+    import pybullet as pb
+
+    from assistive_compiler.runtime.camera import camera_matrices
+
+    w, m = env.world, env.manifest
+    view, proj = camera_matrices(m.camera.model_dump(), width, height, w.client)
+    seg = np.asarray(pb.getCameraImage(width, height, view, proj, renderer=pb.ER_TINY_RENDERER,
+                                       flags=pb.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX, physicsClientId=w.client)[4]).reshape(-1)
+    body, link = seg & ((1 << 24) - 1), (seg >> 24) - 1
+    shown = {"person": int((body == w.variant_bodies[w.active_variant.name].id).sum()),
+             "arm": int(((body == w.robot.id) & np.isin(link, env.arm_idx)).sum())}
+    shown |= {att.body: int((body == w.bodies[att.body].id).sum()) for att in m.tools}
+    hidden = [name for name, pixels in shown.items() if pixels < MIN_PIXELS.get(name, MIN_PIXELS["tool"])]
+    assert not hidden, f"{m.gym_id}: {hidden} hardly visible from the task camera ({shown} pixels of {width}x{height})"

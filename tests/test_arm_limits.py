@@ -1,6 +1,6 @@
 """Pose-dependent arm limits (assistive_compiler.person.arm_limits): the analytic model's
 properties, the user-MLP loader against a hand-written forward pass in the reference's input
-convention (facts 3.6), the loader's error messages, the revert guard, and the per-call cost."""
+convention (paper §III-C), the loader's error messages, the revert guard, and the per-call cost."""
 
 from __future__ import annotations
 
@@ -58,7 +58,7 @@ def test_protocol_and_shapes(model):
 def test_zero_pose_valid(model, side):
     assert model.valid(np.zeros(4), side)
     assert model.valid(np.zeros((1, 4)), side).all()
-    # The reference's box starts at 5 degrees of shoulder_x (facts 3.2); strict_box keeps it.
+    # The reference's box starts at 5 degrees of shoulder_x (paper §III-A); strict_box keeps it.
     assert not AnalyticArmLimits(strict_box=True).valid(np.zeros(4), side)
 
 
@@ -136,7 +136,7 @@ def test_scalar_and_vector_paths_agree(model):
 
 @pytest.mark.parametrize("side", SIDES)
 def test_reference_task_poses_valid(model, side):
-    # Initial arm postures of the reference tasks (facts 2.1-2.6), right-arm numbers.
+    # Initial arm postures of the reference tasks (paper §III-B-2.6), right-arm numbers.
     for qx, qy, qz, qe in [(30, 0, 0, -90), (0, 0, 0, -90), (45, 0, 0, -90), (60, -60, 0, 0),
                            (5, 0, 0, 0), (0, -90, 0, 0), (10, -40, 20, -125)]:
         assert model.valid(pose(qx, qy, qz, qe, side), side), (qx, qy, qz, qe)
@@ -214,7 +214,7 @@ def test_humeral_angles_conventions(model):
 
 
 def _forward(weights, biases, activations, q, side):
-    """Direct forward pass in the reference's convention (facts 3.6), one pose."""
+    """Direct forward pass in the reference's convention (paper §III-C), one pose."""
     tz, tx, ty, qe = (float(a) for a in q)
     s = -1.0 if side == "right" else 1.0
     x = np.array([(s * tz + 2 * np.pi) % (2 * np.pi), (tx + 2 * np.pi) % (2 * np.pi), s * ty,

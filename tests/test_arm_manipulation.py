@@ -1,4 +1,4 @@
-"""Arm manipulation (facts §2.6) and the language it needs, on the shipped spec with real compiles
+"""Arm manipulation (paper §III-B) and the language it needs, on the shipped spec with real compiles
 and real pybullet: ``robot.arm: both`` (two arms and two scoopers on a two-arm robot, one arm and
 one scooper serving both hands on a one-arm robot), the settle stage that leaves the right arm
 hanging off the bed, the r_h term and its success rule, and located errors for the new fields."""
@@ -148,7 +148,7 @@ def test_the_hanging_arm_is_free_to_be_lifted(jaco):
 
 
 def test_a_limited_range_leaves_the_static_limp_arm_where_it_started(jaco):
-    """The γ-scaled limits bind the person as an agent only (facts §1: enforced for the humans in
+    """The γ-scaled limits bind the person as an agent only (the reference implementation (Assistive Gym v1.0): enforced for the humans in
     the agent list): with no human action and a zero robot action, a limited-range episode's
     hanging arm stays put for 2 s, as an unimpaired one does (its settled pose lies outside γ·limits
     for small γ; clamping or enforcing them would make the arm jump by itself)."""

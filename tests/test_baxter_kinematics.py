@@ -436,7 +436,7 @@ def test_base_height_puts_the_pedestal_on_the_floor(part, urdf_path):
                      for j in range(-1, pb.getNumJoints(body, physicsClientId=cid)))
         # AABBs carry Bullet's collision margin (a few mm); the foot's bottom face is at 0.
         assert -0.01 < lowest <= 0.0
-        # s0 ends up 1.0546 m above the floor (facts §3.1).
+        # s0 ends up 1.0546 m above the floor (paper §III-A).
         s0 = pb.getLinkState(body, 4, computeForwardKinematics=True, physicsClientId=cid)[4]
         assert s0[2] == pytest.approx(1.0546, abs=1e-3)
     finally:

@@ -92,11 +92,13 @@ def test_run_json_stays_pure_json_with_progress_on_stderr(tmp_path, capsys):
 
 @pytest.mark.parametrize("module", ["assistive_compiler", "assistive_compiler.cli"])
 def test_rich_is_imported_only_when_the_cli_prints(module):
-    """``import assistive_compiler`` (and building the CLI's parser) loads neither rich nor torch."""
+    """``import assistive_compiler`` (and building the CLI's parser, and parsing a ``train``
+    command line) loads neither rich nor the training libraries."""
     code = f"import {module}, sys\n"
     if module == "assistive_compiler.cli":
-        code += "assistive_compiler.cli.build_parser()\n"
-    code += "assert 'rich' not in sys.modules and 'torch' not in sys.modules, sorted(m for m in ('rich', 'torch') if m in sys.modules)\n"
+        code += "assistive_compiler.cli.build_parser().parse_args(['train', 'x.yaml', '--config', 'ppo_quick'])\n"
+    code += ("heavy = [m for m in ('rich', 'torch', 'ray', 'stable_baselines3', 'matplotlib', 'tensorboard') if m in sys.modules]\n"
+             "assert not heavy, heavy\n")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
 
@@ -105,5 +107,6 @@ def test_every_command_group_registers_its_commands():
     from assistive_compiler.cli import COMMAND_MODULES, build_parser
 
     sub = next(a for a in build_parser()._actions if a.dest == "command")
-    assert set(sub.choices) == {"validate", "compile", "list", "schema", "run", "demo", "render", "render-person", "bench", "compare", "view", "collect"}
+    assert set(sub.choices) == {"validate", "compile", "list", "schema", "run", "demo", "render", "render-person", "bench", "compare",
+                                "view", "collect", "train", "evaluate", "table"}
     assert all(callable(m.add_commands) for m in COMMAND_MODULES)

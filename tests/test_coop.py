@@ -30,7 +30,7 @@ from helpers import at
 TASKS = Path(__file__).resolve().parents[1] / "specs" / "tasks"
 NAMES = coop.ids()
 
-#: The reference's human action and observation sizes (facts §2.7).
+#: The reference's human action and observation sizes (paper §III-B).
 REFERENCE_HUMAN = {"Feeding": (4, 23), "Drinking": (4, 23), "ScratchItch": (10, 34), "BedBathing": (10, 28),
                    "Dressing": (10, 28), "ArmManipulation": (10, 42)}
 

@@ -40,7 +40,7 @@ def r_dress(nodes) -> float:
 
 
 # --------------------------------------------------------------------------------------------
-# r_dress (facts §2.5) on constructed geometry: its three branches
+# r_dress (paper §III-B) on constructed geometry: its three branches
 
 
 def test_opening_round_the_forearm_scores_its_distance_from_the_hand_end():

@@ -178,7 +178,7 @@ def test_limits_hold_at_every_physics_step_under_saturated_actions(which, arm_en
 
 
 def test_targets_are_clamped_to_the_scaled_limits(limited_env):
-    """A limited range narrows the policy joints' targets too (facts §1: clamp to the limits)."""
+    """A limited range narrows the policy joints' targets too (the reference implementation (Assistive Gym v1.0): clamp to the limits)."""
     env = limited_env
     env.reset(seed=2)
     env.step_agents(ROBOT_ZERO, np.ones(10))

@@ -1,4 +1,4 @@
-"""The nightstand (facts §7.4: 0.55 x 0.58 m, 0.674 m tall) and mounting a robot on it.
+"""The nightstand (the reference implementation (Assistive Gym v1.0): 0.55 x 0.58 m, 0.674 m tall) and mounting a robot on it.
 
 (a) The template renders with its defaults, passes check_urdf, yourdfpy, PyBullet (no warnings)
     and the compiler's lint, has the reference's size, and its `robot_mount` frame sits on the top

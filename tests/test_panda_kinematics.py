@@ -6,9 +6,9 @@ YAML; the spoon grip; the fit on the wheelchair's robot mount; and a physical ho
 
 Independent formulations used for forward kinematics (none re-reads our URDF):
 
-* the product of the published joint transforms (facts §4.1, typed in below):
+* the product of the published joint transforms (paper §III-A, typed in below):
   T = prod_i Trans(xyz_i) Rz(yaw) Ry(pitch) Rx(roll) Rz(q_i), then the fixed flange, hand
-  (yaw -pi/4) and tool frame (panda_fingercenter, 0.1025 along the hand's z: facts §4.6);
+  (yaw -pi/4) and tool frame (panda_fingercenter, 0.1025 along the hand's z: paper §III-A);
 * Franka's published Denavit-Hartenberg parameters (Craig's modified convention, Franka
   Control Interface documentation): T_i = Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta_i) Tz(d_i)
   with a = (0, 0, 0, 0.0825, -0.0825, 0, 0.088), d = (0.333, 0, 0.316, 0, 0.384, 0, 0),
@@ -127,7 +127,7 @@ READY = [0.0, -PI / 4, 0.0, -3 * PI / 4, 0.0, PI / 2, PI / 4]
 
 
 def chain_fk(q) -> dict[str, np.ndarray]:
-    """Link frames in panda_link0 from the published joint transforms (facts §4.1)."""
+    """Link frames in panda_link0 from the published joint transforms (paper §III-A)."""
     frames = {"panda_link0": np.eye(4)}
     t = np.eye(4)
     for name, link, qi in zip(ARM_JOINTS, ARM_LINKS, q):
@@ -323,7 +323,7 @@ def test_frame_origins_at_zero(bullet):
     set_arm(bullet, [0.0] * 7)
     for name, xyz in ORIGINS_AT_ZERO.items():
         np.testing.assert_allclose(link_pose(cid, body, links[name])[:3, 3], xyz, atol=1e-6, err_msg=name)
-    # At q = 0 the hand points straight down (facts §4.1).
+    # At q = 0 the hand points straight down (paper §III-A).
     np.testing.assert_allclose(link_pose(cid, body, links[EE])[:3, 2], [0, 0, -1], atol=1e-9)
 
 
@@ -436,7 +436,7 @@ def test_part_yaml_loads():
     assert arm.end_effector == arm.tool_mount == EE
     grip = part.gripper["right"]
     assert grip.joints == FINGER_JOINTS
-    assert {k: grip.positions[k] for k in ("spoon", "none")} == {"spoon": 0.001, "none": 0.001}  # facts §4: feeding (and dressing)
+    assert {k: grip.positions[k] for k in ("spoon", "none")} == {"spoon": 0.001, "none": 0.001}  # paper §III-A: feeding (and dressing)
     assert part.mountable is True
     assert part.base_height_m == 0.0
     assert "spoon" in part.grips

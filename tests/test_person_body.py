@@ -1,5 +1,5 @@
 """The parametric person: real xacro renders loaded in real pybullet (DIRECT), checked against the
-reference's numbers (facts section 3): joints, masses, standing height, landmark heights, posture
+reference's numbers (paper §III-A): joints, masses, standing height, landmark heights, posture
 baking, urdfdom's check_urdf and the mouth point's clearance from the face."""
 
 from __future__ import annotations

@@ -17,7 +17,7 @@ from assistive_compiler.person.anthropometry import percentile_body
 from assistive_compiler.person.body import body_measurements
 from assistive_compiler.spec.parts import PersonPart
 
-PAPER = {"male": (1.733, 78.4), "female": (1.584, 62.5)}  # facts §3.1
+PAPER = {"male": (1.733, 78.4), "female": (1.584, 62.5)}  # paper §III-A
 # The source's "20 and older" rows at the 5th, 50th and 95th percentiles (NCHS Vital Health Stat
 # 3(50), 2025): Table 7 standing height (cm), Table 3 weight (kg).
 TABLE = {

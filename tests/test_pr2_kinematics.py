@@ -1,5 +1,5 @@
 """Kinematics of templates/robots/pr2.urdf.xacro (Willow Garage PR2 as the reference uses it)
-against the facts in shared/reference/robot-kinematics-more.md §2 and assistive-gym-facts.md §4.
+against the published PR2 kinematics (pr2_description) and paper §III-A
 
 Independent formulation: the published joint table (ERD-PR2, §2.1 and §2.3-2.5) is typed in
 below and multiplied out with numpy (every arm-chain origin has rpy 0, so each joint is a

@@ -1,5 +1,5 @@
 """Kinematics of templates/robots/sawyer.urdf.xacro (Rethink Sawyer) against the facts in
-shared/reference/robot-kinematics.md ("Rethink Sawyer") and assistive-gym-facts.md §4: joint
+shared/reference/robot-kinematics.md ("Rethink Sawyer") and paper §III-A: joint
 origins, limits, efforts and masses, PyBullet forward kinematics against the published standard
 DH table, the standard URDF checks, the library part, the floor height, the spoon grip, and a
 hold-still check under position control.
@@ -76,7 +76,7 @@ LIMITS = {
     "right_j5": (-2.9761, 2.9761, 9, 3.485),
     "right_j6": (-4.7124, 4.7124, 9, 4.545),
 }
-# The reference's ranges (assistive-gym-facts.md §4), rounded there to 3 decimals.
+# The reference's ranges (paper §III-A), rounded there to 3 decimals.
 REFERENCE_RANGES = [(-3.05, 3.05), (-3.818, 2.282), (-3.051, 3.051), (-3.051, 3.051),
                     (-2.984, 2.984), (-2.984, 2.984), (-4.71, 4.71)]
 REFERENCE_EFFORTS = [80, 80, 40, 40, 9, 9, 9]
@@ -104,7 +104,7 @@ DH_ALPHA = [PI / 2] * 6 + [0.0]
 DH_OFFSET = [PI, -PI / 2, PI, PI, PI, PI, -PI / 2]
 J6_PITCH = -0.17453
 
-BASE_HEIGHT = 0.975  # the reference's load height (facts §4)
+BASE_HEIGHT = 0.975  # the reference's load height (paper §III-A)
 SPOON_HANDLE_END = "spoon_handle_end"
 
 

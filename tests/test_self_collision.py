@@ -1,4 +1,4 @@
-"""Self-collision of the person (facts §3.3): the reference's groups (each arm and leg against the
+"""Self-collision of the person (paper §III-A): the reference's groups (each arm and leg against the
 rest of the body) for the links that move in a task, exact after the compiler merges static links
 (it keeps the girdle, stomach and hips, or a static thigh, out of a rigid link they would spoil),
 without the pairs that already touch at the rest pose, and nothing at all when no limb moves

@@ -14,10 +14,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 import yaml
 
 from assistive_compiler.cli import main
-from assistive_compiler.errors import one_of
+from assistive_compiler.errors import SpecError, one_of
 from assistive_compiler.library import Library
 from assistive_compiler.paths import display
 from assistive_compiler.spec.load import load_spec
@@ -91,18 +92,19 @@ def test_extending_spec_without_changes_validates(tmp_path, capsys):
     assert out == f"{path}: ok (task 'feeding', robots: {ROBOTS})\n"
 
 
-def test_on_key_stays_a_name(tmp_path, capsys):
-    """YAML 1.1 reads a bare ``on`` as ``True``; as a key it must stay the name "on"."""
-    data, _ = loads_located("on: 1\nno: 2\ny: 3\noff: 4\n", "keys.yaml")
-    assert list(data) == ["on", "no", "y", "off"]
-
+def test_yaml_11_boolean_words_are_refused_as_keys(tmp_path, capsys):
+    """PyYAML (YAML 1.1) reads a bare ``on`` as ``True``: no spec key may be such a word."""
     text = EXTENDS + "preferences:\n  active:\n    force_nontarget: {params: {on: [person], by: [robot]}}\n"
     path = write(tmp_path, text)
     rc, out, err = run_cli(capsys, "validate", str(path))
-    assert (rc, err) == (0, "")
-    assert out == f"{path}: ok (task 'feeding', robots: {ROBOTS})\n"
-    params = load_spec(path).data["preferences"]["active"]["force_nontarget"]["params"]
-    assert params == {"on": ["person"], "by": ["robot"]}
+    assert rc == 2
+    assert err == f"{path}:{at(text, 'on:')}: 'on' is a YAML 1.1 boolean word (PyYAML reads it as True), so no spec key may be one (did you mean 'onto'?)\n"
+    with pytest.raises(SpecError) as info:
+        loads_located("yes: 1\nOff: 2\n", "keys.yaml")
+    assert [str(p) for p in info.value.problems] == [
+        "keys.yaml:1:1: 'yes' is a YAML 1.1 boolean word (PyYAML reads it as True), so no spec key may be one",
+        "keys.yaml:2:1: 'Off' is a YAML 1.1 boolean word (PyYAML reads it as False), so no spec key may be one",
+    ]
 
 
 # --------------------------------------------------------------------------------------------

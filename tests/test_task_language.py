@@ -158,7 +158,7 @@ def _contact(x, force):
 
 def test_scratch_events_need_movement_gentle_force_and_nearness():
     counter = terms("reward")["contact_events"].fn()
-    p = SimpleNamespace(tool=[], on=[], target=None, radius_m=0.025, min_move_m=0.01, max_force_n=10.0)
+    p = SimpleNamespace(tool=[], onto=[], target=None, radius_m=0.025, min_move_m=0.01, max_force_n=10.0)
     steps = [
         ([], 0.0),                          # no contact
         ([_contact(0.030, 1.0)], 0.0),      # 3 cm from the itch: too far
@@ -285,7 +285,7 @@ def test_markers_lie_on_the_arm_and_are_cleared_once(bathing):
 
 
 def test_nightstand_is_carried_under_the_searched_base(bathing):
-    """robot.mount_base: search (facts §2.2): Jaco's base comes from the base search and the
+    """robot.mount_base: search (paper §III-B): Jaco's base comes from the base search and the
     nightstand (only_when_mounted) is put under it: its robot_mount frame on the robot's base frame
     at every reset, whichever precomputed start is drawn, with the start arm clear of it."""
     env = bathing

@@ -221,7 +221,7 @@ def test_force_nontarget_without_and_with_a_target(env, snap):
     spoon_cps = contacts(env, "spoon", "person")
     total = sum(cp[9] for cp in spoon_cps) + sum(cp[9] for cp in contacts(env, "robot", "person"))
     assert total > 0
-    assert call("preference", "force_nontarget", snap, on=["person"], by=["robot", "spoon"]) == pytest.approx(-total, rel=1e-12)
+    assert call("preference", "force_nontarget", snap, onto=["person"], by=["robot", "spoon"]) == pytest.approx(-total, rel=1e-12)
 
     # Target: the point on the spoon of its strongest contact; only contacts within the radius count.
     strongest = max(spoon_cps, key=lambda cp: cp[9])
@@ -229,10 +229,10 @@ def test_force_nontarget_without_and_with_a_target(env, snap):
     radius = 1e-4
     at_target = sum(cp[9] for cp in spoon_cps if np.linalg.norm(np.subtract(cp[5], strongest[5])) <= radius)
     assert 0 < at_target <= total
-    value = call("preference", "force_nontarget", snap, on=["person"], by=["robot", "spoon"], target_tool=["spoon"], target=centre, target_radius_m=radius)
+    value = call("preference", "force_nontarget", snap, onto=["person"], by=["robot", "spoon"], target_tool=["spoon"], target=centre, target_radius_m=radius)
     assert value == pytest.approx(-(total - at_target), abs=1e-12)
     # a radius that takes every contact leaves only the arm's force (none here)
-    value = call("preference", "force_nontarget", snap, on=["person"], by=["robot", "spoon"], target_tool=["spoon"], target=centre, target_radius_m=10.0)
+    value = call("preference", "force_nontarget", snap, onto=["person"], by=["robot", "spoon"], target_tool=["spoon"], target=centre, target_radius_m=10.0)
     assert value == pytest.approx(-(total - sum(cp[9] for cp in spoon_cps)), abs=1e-12)
 
 
@@ -240,9 +240,9 @@ def test_high_force_below_and_above_threshold(env, snap):
     press_spoon_into_face(env, snap)
     force = sum(spoon_face_forces(env))
     assert force > 0
-    assert call("preference", "high_force", snap, tool=["spoon"], on=["person"], threshold_n=2 * force) == 0.0
-    assert call("preference", "high_force", snap, tool=["spoon"], on=["person"], threshold_n=force / 2) == pytest.approx(-force, rel=1e-12)
-    assert call("preference", "high_force", snap, tool=["spoon"], on=["person"], threshold_n=10.0) == 0.0  # the default 10 N
+    assert call("preference", "high_force", snap, tool=["spoon"], onto=["person"], threshold_n=2 * force) == 0.0
+    assert call("preference", "high_force", snap, tool=["spoon"], onto=["person"], threshold_n=force / 2) == pytest.approx(-force, rel=1e-12)
+    assert call("preference", "high_force", snap, tool=["spoon"], onto=["person"], threshold_n=10.0) == 0.0  # the default 10 N
 
 
 def test_food_hit_and_food_velocity(snap):
@@ -258,8 +258,8 @@ def test_dressing_force(env, snap):
     press_spoon_into_face(env, snap)
     force = sum(spoon_face_forces(env))
     assert force > 0
-    assert call("preference", "dressing_force", snap, cloth=["spoon"], on=["person"]) == pytest.approx(-force, rel=1e-12)
-    assert call("preference", "dressing_force", snap, cloth=["spoon"], on=["table"]) == 0.0
+    assert call("preference", "dressing_force", snap, cloth=["spoon"], onto=["person"]) == pytest.approx(-force, rel=1e-12)
+    assert call("preference", "dressing_force", snap, cloth=["spoon"], onto=["table"]) == 0.0
 
 
 def test_pressure(env, snap):
@@ -268,14 +268,14 @@ def test_pressure(env, snap):
     # apart (just reset): no closest points within 1 cm → exactly 0
     snap.refresh()
     assert not pb.getClosestPoints(spoon_id, person_id, 0.01, physicsClientId=c)
-    assert call("preference", "pressure", snap, tools=["spoon"], on=["person"]) == 0.0
+    assert call("preference", "pressure", snap, tools=["spoon"], onto=["person"]) == 0.0
     # pressed: force / number of closest points within contact_distance_m
     press_spoon_into_face(env, snap)
     force = sum(spoon_face_forces(env))
     for distance in (0.01, 0.05):  # 4 and 19 closest points here
         count = len(pb.getClosestPoints(spoon_id, person_id, distance, physicsClientId=c))
         assert force > 0 and count > 0
-        value = call("preference", "pressure", snap, tools=["spoon"], on=["person"], contact_distance_m=distance)
+        value = call("preference", "pressure", snap, tools=["spoon"], onto=["person"], contact_distance_m=distance)
         assert value == pytest.approx(-force / count, rel=1e-12)
 
 

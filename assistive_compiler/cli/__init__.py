@@ -18,6 +18,7 @@ imports.
 * :mod:`.render` — render, render-person
 * :mod:`.bench` — bench
 * :mod:`.compare` — compare
+* :mod:`.train`, :mod:`.evaluate`, :mod:`.table` — learning (the optional ``train`` extra)
 * :mod:`.view` — view (browser or pybullet GUI)
 * :mod:`.collect` — collect (Minari datasets)
 """
@@ -29,11 +30,11 @@ import os
 import sys
 from typing import Callable, Sequence
 
-from ..errors import SpecError
-from . import bench, collect, compare, render, run, spec_commands, view
-from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, print_problems
+from ..errors import SpecError, UsageError
+from . import bench, collect, compare, evaluate, render, run, spec_commands, table, train, view
+from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, print_problems, use_library_dirs
 
-COMMAND_MODULES = (spec_commands, run, render, bench, compare, view, collect)
+COMMAND_MODULES = (spec_commands, run, render, bench, compare, view, collect, train, evaluate, table)
 
 __all__ = ["COMMAND_MODULES", "EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_OK", "build_parser", "main"]
 
@@ -51,9 +52,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     func: Callable[[argparse.Namespace], int] = args.func
     try:
+        use_library_dirs(getattr(args, "library", []))
         return func(args)
     except SpecError as exc:
         print_problems(exc)
+        return EXIT_BAD_INPUT
+    except UsageError as exc:
+        print(f"error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)

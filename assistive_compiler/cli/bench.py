@@ -18,7 +18,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from .common import EXIT_OK
+from .common import EXIT_OK, add_library_argument
 
 _CHILD = r"""
 import json, resource, sys, time, numpy as np
@@ -38,7 +38,7 @@ print(json.dumps({"import_s": import_s, "heavy_modules_on_import": heavy,
 
 #: Env steps/s of the reference implementation (Assistive Gym v1.0 on stock pybullet, random actions,
 #: 200-step episodes, one process, a 2-core shared machine like ours), per (task, robot) it was
-#: measured for: shared/reference/performance-anchors.md. Dressing does not run on stock pybullet.
+#: was measured for. Dressing does not run on stock pybullet.
 REFERENCE_STEPS_PER_S = {
     ("scratch_itch", "jaco"): 423, ("scratch_itch", "pr2"): 188, ("scratch_itch", "sawyer"): 428, ("scratch_itch", "baxter"): 312,
     ("bed_bathing", "jaco"): 156,
@@ -227,6 +227,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 def add_commands(sub) -> None:
     p = sub.add_parser("bench", help="speed figures taken in one run: steps/s vs raw physics and the reference, resets, compile, import, RSS")
+    add_library_argument(p)
     p.add_argument("specs", nargs="+", metavar="spec", help="task spec file(s); several print one row each")
     p.add_argument("--robot", help="robot (default: each spec's default)")
     p.add_argument("--seed", type=int, default=0, help="seed of the first repeat's episode and of the random actions")

@@ -7,11 +7,17 @@ Exit status: 0 success, 2 bad input (problems printed one per line as ``PATH:LIN
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+from pathlib import Path
 
 from ..errors import SpecError
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+EXIT_INTERRUPTED = 130
+
+TRAIN_EXTRA_HINT = ("the learning commands need the 'train' extra: install torch's CPU build first "
+                    "(pip install torch --index-url https://download.pytorch.org/whl/cpu), then pip install -e '.[train]'")
 
 
 def print_problems(error: SpecError) -> None:
@@ -19,10 +25,31 @@ def print_problems(error: SpecError) -> None:
         print(problem, file=sys.stderr)
 
 
+def add_library_argument(p: argparse.ArgumentParser) -> None:
+    """``--library DIR`` (repeatable): a folder of the user's own parts, laid out like ``specs/``."""
+    p.add_argument("--library", action="append", default=[], metavar="DIR",
+                   help="a folder of your own parts (robots/ tools/ furniture/ people/, templates in ../templates); "
+                        "repeatable; searched before $ASSISTIVE_COMPILER_LIBRARY, the spec's own library and the shipped parts")
+
+
+def use_library_dirs(dirs: list[str]) -> None:
+    """Put ``--library`` folders in front of ``$ASSISTIVE_COMPILER_LIBRARY`` for this process, so
+    every compile the command makes (and any worker it starts) finds them."""
+    from ..library import LIBRARY_ENV
+
+    for d in dirs:
+        if not Path(d).is_dir():
+            raise SpecError.at(d, "--library: folder not found (expected a folder holding robots/, tools/, furniture/ or people/)")
+    if dirs:
+        current = [p for p in os.environ.get(LIBRARY_ENV, "").split(os.pathsep) if p]
+        os.environ[LIBRARY_ENV] = os.pathsep.join([str(Path(d).resolve()) for d in dirs] + current)
+
+
 def add_spec_arguments(p: argparse.ArgumentParser, policy: bool = True) -> None:
-    """``spec``, ``--robot``, ``--policy`` (optional) and ``--seed``: what a rollout command needs."""
+    """``spec``, ``--robot``, ``--policy`` (optional), ``--seed`` and ``--library``: what a rollout command needs."""
     from ..policies import POLICIES
 
+    add_library_argument(p)
     p.add_argument("spec", help="task spec file")
     p.add_argument("--robot", help="robot (default: the spec's default)")
     if policy:
@@ -35,3 +62,18 @@ def make_env(spec: str, robot: str | None, out: str | None = None, **kwargs):
     from ..runtime.env import AssistiveEnv
 
     return AssistiveEnv.from_spec(spec, robot=robot, out_dir=out, **kwargs)
+
+
+def require_extra(*modules: str) -> bool:
+    """Whether the optional ``modules`` (of the ``train`` extra) are installed; says how to install them if not."""
+    import importlib.util
+
+    missing = [m for m in modules if importlib.util.find_spec(m) is None]
+    if missing:
+        print(f"error: {', '.join(missing)} not installed; {TRAIN_EXTRA_HINT}", file=sys.stderr)
+    return not missing
+
+
+def engine_modules(engine: str) -> tuple[str, ...]:
+    """The modules a training engine needs."""
+    return ("torch", "stable_baselines3" if engine == "sb3" else "ray")

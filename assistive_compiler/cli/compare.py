@@ -14,7 +14,7 @@ from typing import Callable
 
 import numpy as np
 
-from .common import EXIT_OK
+from .common import EXIT_OK, add_library_argument
 from .run import rollout
 
 COLUMNS = ("robot", "placement", "goals_reached", "jlwki", "compile_s", "scripted_success", "scripted_return")
@@ -106,6 +106,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 def add_commands(sub) -> None:
     p = sub.add_parser("compare", help="compile a task for several robots and compare placement and scripted results")
+    add_library_argument(p)
     p.add_argument("spec", help="task spec file")
     p.add_argument("--robots", required=True, help="comma-separated robot names, e.g. pr2,jaco,baxter,sawyer,panda")
     p.add_argument("--episodes", type=int, default=10, help="scripted episodes per robot")

@@ -8,11 +8,14 @@ commands reuse (``demo`` records its first episode with them).
 from __future__ import annotations
 
 import argparse
+import importlib.util
+import os
 from pathlib import Path
 
 import numpy as np
 
-from .common import EXIT_OK, add_spec_arguments, make_env
+from ..errors import SpecError
+from .common import EXIT_OK, add_library_argument, add_spec_arguments, make_env
 
 
 def record(env, policy, seed: int, every: int) -> tuple[list[np.ndarray], dict]:
@@ -39,29 +42,96 @@ def montage(frames: list[np.ndarray], at: tuple[float, ...] = MONTAGE_AT) -> np.
     return np.concatenate([frames[i] for i in idx], axis=1)
 
 
-def write_picture(frames: list[np.ndarray], out: Path, fps: int) -> None:
-    """``out``: a GIF of every frame at ``fps``, or a PNG strip (:func:`montage`)."""
+PICTURE_SUFFIXES = (".gif", ".mp4", ".png")
+"""What ``render --out`` writes: a GIF or an MP4 of every recorded frame, or a PNG strip."""
+
+
+def check_picture_path(out: Path) -> None:
+    """Refuse an output ``render`` cannot write before anything is simulated."""
+    if out.suffix.lower() not in PICTURE_SUFFIXES:
+        raise SpecError.at(str(out), f"--out must end in {', '.join(PICTURE_SUFFIXES)} (a GIF or MP4 of the episode, a PNG strip), got '{out.suffix or out.name}'")
+    if out.is_dir():
+        raise SpecError.at(str(out), "--out is a directory; expected a file name ending in .gif, .mp4 or .png")
+    parent = out.parent if str(out.parent) else Path(".")
+    existing = next((p for p in (parent, *parent.parents) if p.exists()), Path("."))
+    if not existing.is_dir() or not os.access(existing, os.W_OK):
+        raise SpecError.at(str(out), f"cannot write here: {existing} is not a writable folder")
+    if out.suffix.lower() == ".mp4" and importlib.util.find_spec("av") is None:
+        raise SpecError.at(str(out), "MP4 output needs the optional 'av' package (PyAV, which carries its own FFmpeg): "
+                                     "pip install 'assistive-compiler[video]'; or write a .gif")
+
+
+def write_picture(frames: list[np.ndarray], out: Path, fps: float) -> None:
+    """``out``: a GIF or an MP4 of every frame at ``fps`` frames per second, or a PNG strip (:func:`montage`)."""
     from PIL import Image
 
+    check_picture_path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    if out.suffix.lower() == ".gif":
+    suffix = out.suffix.lower()
+    if suffix == ".gif":
         images = [Image.fromarray(f) for f in frames]
-        images[0].save(out, save_all=True, append_images=images[1:], duration=int(1000 / fps), loop=0, optimize=False)
-    elif out.suffix.lower() == ".png":
-        Image.fromarray(montage(frames)).save(out)
+        # GIF frame delays are whole hundredths of a second.
+        images[0].save(out, save_all=True, append_images=images[1:], duration=10 * max(1, round(100 / fps)), loop=0, optimize=False)
+    elif suffix == ".mp4":
+        write_mp4(frames, out, fps)
     else:
-        raise SystemExit(f"--out must end in .gif or .png, got {out}")
+        Image.fromarray(montage(frames)).save(out)
+
+
+def write_mp4(frames: list[np.ndarray], out: Path, fps: float) -> None:
+    """An H.264 MP4 (yuv420p, so every player shows it; odd sizes cropped to even) at ``fps``."""
+    from fractions import Fraction
+
+    import av
+
+    height, width = (frames[0].shape[0] // 2) * 2, (frames[0].shape[1] // 2) * 2
+    with av.open(str(out), mode="w") as container:
+        stream = container.add_stream("libx264", rate=Fraction(fps).limit_denominator(1000))
+        stream.width, stream.height, stream.pix_fmt = width, height, "yuv420p"
+        for frame in frames:
+            for packet in stream.encode(av.VideoFrame.from_ndarray(np.ascontiguousarray(frame[:height, :width]), format="rgb24")):
+                container.mux(packet)
+        for packet in stream.encode():
+            container.mux(packet)
+
+
+def control_hz(manifest) -> float:
+    """Env steps per simulated second (the paper's 10 Hz control)."""
+    return 1.0 / (manifest.sim.time_step * manifest.sim.frame_skip)
+
+
+def parse_camera(text: str | None) -> dict | None:
+    """``--camera``: ``eye=X,Y,Z target=X,Y,Z fov=DEG`` (any of them, space- or semicolon-separated)."""
+    if not text:
+        return None
+    view, names = {}, {"eye": "eye", "target": "target", "fov": "fov_deg", "fov_deg": "fov_deg"}
+    for item in text.replace(";", " ").split():
+        key, _, value = item.partition("=")
+        try:
+            numbers = [float(v) for v in value.split(",")]
+        except ValueError:
+            numbers = []
+        want = 1 if names.get(key) == "fov_deg" else 3
+        if key not in names or len(numbers) != want:
+            raise SpecError.at("--camera", f"'{item}': expected eye=X,Y,Z, target=X,Y,Z or fov=DEG (metres in the world frame, degrees), "
+                                           "e.g. --camera 'eye=-0.9,-1.4,1.5 target=-0.1,-0.15,0.85 fov=50'")
+        view[names[key]] = numbers[0] if want == 1 else tuple(numbers)
+    return view
 
 
 def cmd_render(args: argparse.Namespace) -> int:
     from ..policies import make_policy
 
-    env = make_env(args.spec, args.robot, args.out_dir, render_mode="rgb_array", render_size=(args.width, args.height))
+    out = Path(args.out)
+    check_picture_path(out)
+    view = parse_camera(args.camera)
+    env = make_env(args.spec, args.robot, args.out_dir, render_mode="rgb_array", render_size=(args.width, args.height), camera=view)
     policy = make_policy(args.policy, env, seed=args.seed)
     frames, summary = record(env, policy, args.seed, args.every)
+    fps = args.fps or control_hz(env.manifest) / args.every
     env.close()
-    write_picture(frames, Path(args.out), fps=max(1, 10 // args.every))
-    print(f"wrote {args.out} ({len(frames)} frames; return {summary['return']:.1f}, success {'yes' if summary['success'] else 'no'})")
+    write_picture(frames, out, fps=fps)
+    print(f"wrote {args.out} ({len(frames)} frames at {fps:g} fps; return {summary['return']:.1f}, success {'yes' if summary['success'] else 'no'})")
     return EXIT_OK
 
 
@@ -119,14 +189,18 @@ def cmd_render_person(args: argparse.Namespace) -> int:
 def add_commands(sub) -> None:
     p = sub.add_parser("render", help="write a GIF (or a PNG strip) of one episode, headless")
     add_spec_arguments(p)
-    p.add_argument("--out", required=True, help="output .gif or .png")
+    p.add_argument("--out", required=True, help="output .gif or .mp4 (every recorded frame) or .png (a strip of four)")
     p.add_argument("--every", type=int, default=4, help="record every N steps (default 4)")
+    p.add_argument("--fps", type=float, help="frames per second of a GIF or MP4 (default: simulated speed, "
+                                              "the control rate / --every: 2.5 at 10 Hz and --every 4)")
+    p.add_argument("--camera", help="camera instead of the task's: 'eye=X,Y,Z target=X,Y,Z fov=DEG' (world frame, m; any subset)")
     p.add_argument("--width", type=int, default=480)
     p.add_argument("--height", type=int, default=360)
     p.add_argument("--out-dir", dest="out_dir", help="artifact directory")
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("render-person", help="draw the person variants a spec declares, side by side (PNG)")
+    add_library_argument(p)
     p.add_argument("spec", help="task spec file")
     p.add_argument("--robot", help="robot to compile the task for (default: the spec's default)")
     p.add_argument("--out", required=True, help="output .png")

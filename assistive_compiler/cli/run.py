@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..episode import EpisodeTally
-from .common import EXIT_BAD_INPUT, EXIT_OK, add_spec_arguments, make_env
+from .common import EXIT_BAD_INPUT, EXIT_OK, add_library_argument, add_spec_arguments, make_env
 
 
 def rollout(env, policy, seed: int) -> dict:
@@ -144,6 +144,7 @@ def add_commands(sub) -> None:
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("demo", help="the main job: compile Feeding for Jaco, run the scripted policy, write a picture")
+    add_library_argument(p)
     p.add_argument("--spec", default=str(_default_feeding()), help="task spec (default: the shipped feeding.yaml)")
     p.add_argument("--robot", default="jaco")
     p.add_argument("--episodes", type=int, default=3)

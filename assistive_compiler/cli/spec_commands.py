@@ -12,7 +12,7 @@ import json
 import sys
 
 from ..errors import SpecError
-from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, print_problems
+from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, add_library_argument, print_problems
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
@@ -76,6 +76,11 @@ def task_schema() -> dict:
 
 
 def cmd_schema(args: argparse.Namespace) -> int:
+    if args.training:
+        from ..training.config import training_schema
+
+        print(json.dumps(training_schema(), indent=2, sort_keys=True))
+        return EXIT_OK
     if args.terms:
         from ..terms.registry import terms
         from .output import print_table
@@ -112,10 +117,12 @@ def cmd_list(args: argparse.Namespace) -> int:
 
 def add_commands(sub) -> None:
     p = sub.add_parser("validate", help="check task specs; print PATH:LINE:COL: problem for each mistake")
+    add_library_argument(p)
     p.add_argument("paths", nargs="+", help="task spec files")
     p.set_defaults(func=cmd_validate)
 
     p = sub.add_parser("compile", help="compile a task spec for a robot into URDFs and a manifest")
+    add_library_argument(p)
     p.add_argument("spec", help="task spec file")
     p.add_argument("--robot", help="robot name (default: the spec's default robot)")
     p.add_argument("--out", help="output directory (default: generated/<task>-<robot>)")
@@ -129,4 +136,5 @@ def add_commands(sub) -> None:
 
     p = sub.add_parser("schema", help="print the JSON Schema of a task spec (or --terms: the term library)")
     p.add_argument("--terms", action="store_true", help="list registered terms and their parameters instead")
+    p.add_argument("--training", action="store_true", help="print the JSON Schema of a training config (specs/training/*.yaml) instead")
     p.set_defaults(func=cmd_schema)

@@ -17,6 +17,7 @@ import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Iterable
 
 from .. import __version__
 from ..artifact import Manifest
@@ -79,16 +80,21 @@ def compile_task(
     robot: str | None = None,
     out_dir: str | Path | None = None,
     *,
-    library: Library | None = None,
+    library: Library | Iterable[str | Path] | None = None,
     force: bool = False,
 ) -> CompileResult:
     """Compile the spec at ``spec_path`` for ``robot`` into ``out_dir`` (default generated/<task>-<robot>).
+
+    ``library``: a :class:`Library`, or extra library directories searched before
+    ``$ASSISTIVE_COMPILER_LIBRARY``, the spec's own library and the shipped parts
+    (:meth:`Library.for_spec`).
 
     Raises :class:`SpecError` for bad input; leaves ``out_dir`` untouched unless it succeeds.
     """
     t0 = time.perf_counter()
     loaded: LoadedSpec = load_spec(spec_path)
-    library = library or Library()
+    if not isinstance(library, Library):
+        library = Library.for_spec(loaded.path, library or ())
     robot = robot or loaded.spec.robot.default
     out = Path(out_dir) if out_dir else default_out_dir(loaded.spec.name, robot)
     ihash = input_hash(loaded, robot, library)
@@ -98,7 +104,8 @@ def compile_task(
             existing = Manifest.read(out)
         except Exception:
             existing = None
-        if existing is not None and existing.input_hash == ihash and all((out / b.urdf).is_file() for b in existing.bodies):
+        # A cut or edited file in the cache (damage) is recompiled, never loaded.
+        if existing is not None and existing.input_hash == ihash and existing.damage(out) is None:
             return CompileResult(out, existing, True, time.perf_counter() - t0)
 
     rt = resolve(loaded, robot, library)
@@ -109,8 +116,7 @@ def compile_task(
     os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes it private; the artifact is an ordinary directory
     try:
         manifest = build(rt, tmp, library).model_copy(update={"input_hash": ihash})
-        body_bytes = b"".join((tmp / b.urdf).read_bytes() for b in sorted(manifest.bodies, key=lambda b: b.urdf))
-        manifest = manifest.model_copy(update={"content_hash": hashlib.sha256(body_bytes + manifest.to_json().encode()).hexdigest()})
+        manifest = manifest.model_copy(update={"content_hash": manifest.hash_of(tmp)})
         (tmp / "manifest.json").write_text(manifest.to_json())
         _replace_dir(tmp, out)
     except BaseException:

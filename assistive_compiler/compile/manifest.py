@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ..artifact import Capsule, Drive, Manifest, MarkerPoint, MarkerSet, Person, PersonVariant, Robot, Sim, StartState, Success, Target, TermUse
+from ..artifact import Camera, Capsule, Drive, Manifest, MarkerPoint, MarkerSet, Person, PersonVariant, Robot, Sim, StartState, Success, Target, TermUse
 from ..paths import display
 from ..quat import capsule_axes
 from ..resolve import ResolvedTask
@@ -57,7 +57,18 @@ def build_manifest(rt: ResolvedTask, *, bodies, variants, tools, particles, garm
                         fraction_of=spec.success.relative_to if spec.success.relative_to in rt.markers else None),
         garments=list(garments),
         scripted=rt.scripted,
+        camera=camera(rt),
     )
+
+
+def camera(rt: ResolvedTask) -> Camera:
+    """The task's camera for this robot: the robot's fields over the task's over the default view."""
+    cam = rt.spec.camera
+    fields = {}
+    for view in (cam, cam.per_robot.get(rt.robot_name)):
+        if view is not None:
+            fields |= {k: v for k, v in (("eye", view.eye_m), ("target", view.target_m), ("fov_deg", view.fov_deg)) if v is not None}
+    return Camera(**fields)
 
 
 def _person(rt: ResolvedTask, variants: list[PersonVariant]) -> Person:

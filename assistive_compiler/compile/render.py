@@ -18,6 +18,11 @@ from ..paths import display, templates_dir
 _BANNER = re.compile(r"<!--\s*=+\s*-->\s*<!--.*?-->\s*<!--.*?-->\s*<!--\s*=+\s*-->\s*", re.S)
 
 
+SHIPPED_TEMPLATES_ARG = "assistive_templates"
+"""Set for every template: the shipped ``templates/`` folder, so a user's template can use the
+shipped macros with ``<xacro:include filename="$(arg assistive_templates)/common/shapes.xacro"/>``."""
+
+
 def format_param(value: object) -> str:
     """A template parameter as the string xacro receives (floats in shortest round-trip form)."""
     if isinstance(value, bool):
@@ -51,7 +56,7 @@ def _render_cached(path: Path, params: tuple[tuple[str, str], ...]) -> str:
             + did_you_mean(unknown[0], declared),
         )
     try:
-        doc = xacro.process_file(str(path), mappings=dict(params))
+        doc = xacro.process_file(str(path), mappings=dict(params) | {SHIPPED_TEMPLATES_ARG: str(templates_dir())})
     except Exception as exc:  # xacro raises plain Exceptions (XacroException, NameError, ...)
         raise SpecError.at(display(path), f"template failed to render: {exc}") from None
     text = doc.toprettyxml(indent="  ")
@@ -100,6 +105,7 @@ class UrdfInfo:
     links: tuple[str, ...]
     joints: dict[str, JointInfo]
     capsules: dict[str, Capsule]
+    root_tag: str = "robot"
 
     @property
     def movable_joints(self) -> dict[str, JointInfo]:
@@ -128,7 +134,7 @@ def urdf_info(urdf_xml: str) -> UrdfInfo:
             el.get("name", ""), jtype, el.find("parent").get("link", ""), child, lower, upper, axis  # type: ignore[union-attr]
         )
     roots = [l for l in links if l not in children]
-    return UrdfInfo(roots[0] if roots else "", links, joints, _capsules(root))
+    return UrdfInfo(roots[0] if roots else "", links, joints, _capsules(root), root.tag)
 
 
 def _rpy_matrix(r: float, p: float, y: float) -> list[list[float]]:

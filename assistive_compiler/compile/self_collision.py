@@ -16,7 +16,7 @@ def person_self_collision(urdf_xml: str, keep: set[str]) -> tuple[set[str], list
     """Which person links collide with each other, and which links the merge must keep for that.
 
     ``urdf_xml`` is the unmerged person (static joints already fixed), ``keep`` the links the
-    merge keeps anyway. The reference's groups (facts §3.3, ``SELF_COLLISION_GROUPS``: each arm
+    merge keeps anyway. The reference's groups (paper §III-A, ``SELF_COLLISION_GROUPS``: each arm
     and leg against the rest, never torso, head and girdles among themselves) are applied to the
     groups whose links move in the task (below a movable joint); a person whose arms and legs are
     all static (Feeding: only the head moves) gets no self-collision at all.

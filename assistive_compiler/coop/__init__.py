@@ -1,4 +1,4 @@
-"""Co-optimisation (paper §4.3): the robot and the person as two learning agents on a shared reward.
+"""Co-optimisation (paper §V-B): the robot and the person as two learning agents on a shared reward.
 
 * :func:`parallel_env` — a PettingZoo ``ParallelEnv`` of any task spec and robot;
 * :func:`make` / :func:`ids` — the shipped tasks by name, ``<Task><Robot>Human-v1`` (30);

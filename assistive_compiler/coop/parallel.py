@@ -1,7 +1,7 @@
 """The PettingZoo face of a compiled task: the robot and the person as two learning agents.
 
 :class:`AssistiveParallelEnv` is a PettingZoo ``ParallelEnv`` over one
-:class:`~assistive_compiler.runtime.env.AssistiveEnv` (paper §4.3, co-optimisation):
+:class:`~assistive_compiler.runtime.env.AssistiveEnv` (paper §V-B, co-optimisation):
 
 * **Agents** ``robot`` and ``human``, both live for the whole episode; both are truncated together
   after ``sim.episode_steps`` env steps (no early termination, as the paper).

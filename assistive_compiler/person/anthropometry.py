@@ -23,7 +23,7 @@ Weight was measured to the nearest 0.1 kg (digital floor scale), standing height
 Scaling choice
 --------------
 The paper's (Assistive Gym's) bodies are called 50th percentile: male 78.4 kg / 1.733 m standing,
-female 62.5 kg / 1.584 m (facts §3.1). They are not the NHANES medians (175.2 cm / 86.6 kg for
+female 62.5 kg / 1.584 m (paper §III-A). They are not the NHANES medians (175.2 cm / 86.6 kg for
 men), so percentile ``p`` keeps the paper's 50th-percentile body and applies the table's *ratio*
 to its own median::
 
@@ -81,10 +81,10 @@ WEIGHT_KG: dict[str, tuple[float, ...]] = {
     "female": (50.7, 54.7, 57.8, 62.6, 73.5, 89.2, 99.9, 107.2, 119.2),
 }
 
-#: The paper's 50th-percentile standing heights (facts §3.1), metres.
+#: The paper's 50th-percentile standing heights (paper §III-A), metres.
 PAPER_50TH_HEIGHT_M: dict[str, float] = {"male": 1.733, "female": 1.584}
 
-#: The paper's 50th-percentile masses (facts §3.1), kg.
+#: The paper's 50th-percentile masses (paper §III-A), kg.
 PAPER_50TH_MASS_KG: dict[str, float] = dict(DEFAULT_MASS_KG)
 
 

@@ -1,7 +1,7 @@
 """Pose-dependent (realistic) shoulder-elbow limits for the person's arms, and the runtime's
 revert rule. Pure NumPy: no pybullet, no Keras, nothing downloaded.
 
-The reference (Assistive Gym, facts section 3.6) enforces "realistic" arm limits with a small
+The reference (Assistive Gym, paper §III-C) enforces "realistic" arm limits with a small
 Keras MLP that classifies the four angles (shoulder_x, shoulder_y, shoulder_z, elbow) of one arm
 as valid or not; after every physics sub-step an invalid pose is reverted to the last valid one.
 Its weights are not redistributed here. This module offers:
@@ -14,7 +14,7 @@ Its weights are not redistributed here. This module offers:
   the user, behaves as in Assistive Gym).
 * :class:`ArmLimitGuard` - the reference's revert-to-last-valid rule, independent of pybullet.
 
-Joint convention (ours == the reference's, facts 3.2). Angles are radians, in the order
+Joint convention (ours == the reference's, paper §III-A). Angles are radians, in the order
 ``(shoulder_x, shoulder_y, shoulder_z, elbow)``. The person faces -Y, Z is up and their right
 side is -X. ``shoulder_x`` turns about y (abduction: + for the right arm, - for the left),
 ``shoulder_y`` about x (- is forward flexion, + is extension behind the body), ``shoulder_z``
@@ -83,7 +83,7 @@ def _as_poses(q: np.ndarray | Sequence[float]) -> tuple[np.ndarray, bool]:
 
 
 def arm_box(side: Side) -> tuple[np.ndarray, np.ndarray]:
-    """The pose-independent limits (facts 3.2) of one arm's four joints, radians: (lower, upper)."""
+    """The pose-independent limits (paper §III-A) of one arm's four joints, radians: (lower, upper)."""
     names = ARM_LIMIT_JOINTS[_check_side(side)]
     lo = np.radians([JOINT_LIMITS_DEG[n][0] for n in names])
     hi = np.radians([JOINT_LIMITS_DEG[n][1] for n in names])
@@ -127,7 +127,7 @@ class ArmLimitModel(Protocol):
 
 # ----------------------------------------------------------------------------------------------
 # The analytic model. All constants are for the RIGHT arm (left poses are mirrored first), in
-# degrees unless named _M (metres of the reference male body, facts 3.1).
+# degrees unless named _M (metres of the reference male body, paper §III-A).
 # ----------------------------------------------------------------------------------------------
 
 #: Joint sinus of the humerus: the largest humeral elevation (angle from hanging straight down)
@@ -223,7 +223,7 @@ class AnalyticArmLimits:
     A pose (right arm; a left pose is mirrored to the right first, so the model is exactly
     mirror-symmetric) is valid when all of these hold:
 
-    1. **Pose-independent box** (facts 3.2): every angle inside the reference's limits
+    1. **Pose-independent box** (paper §III-A): every angle inside the reference's limits
        (shoulder_x from 0 instead of 5 degrees unless ``strict_box``; see
        :data:`NEUTRAL_SHOULDER_X_LOWER_DEG`).
     2. **Joint sinus of the humerus.** The humerus direction, written as elevation theta (from
@@ -284,7 +284,7 @@ class AnalyticArmLimits:
         self._ua_t, self._fa_t = tuple(self._ua.tolist()), tuple(self._fa.tolist())
 
     def box(self, side: Side) -> tuple[np.ndarray, np.ndarray]:
-        """This model's hard box for ``side`` (radians): facts 3.2, shoulder_x relaxed to 0
+        """This model's hard box for ``side`` (radians): paper §III-A, shoulder_x relaxed to 0
         unless ``strict_box``."""
         if _check_side(side) == "right":
             return self._lo.copy(), self._hi.copy()
@@ -535,7 +535,7 @@ class MLPArmLimits:
 
 
 class ArmLimitGuard:
-    """The reference's rule (facts 3.6), without pybullet: after each physics sub-step the arm's
+    """The reference's rule (paper §III-C), without pybullet: after each physics sub-step the arm's
     four angles are checked; a valid pose becomes the last valid pose, an invalid one is replaced
     by the last valid pose (the caller resets the four joints to it with zero velocity). Before
     any valid pose has been seen there is nothing to revert to and the pose is left alone, as in

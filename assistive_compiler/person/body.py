@@ -5,7 +5,7 @@ the templates' convention: Z-up, the person faces -Y and their right side is -X.
 fixed-base tree rooted at link ``chest`` (the reference's base); at zero joint angles it stands
 upright. Every landmark link's frame is at its joint centre (e.g. ``right_elbow`` at the elbow).
 
-The numbers are the reference's (Assistive Gym ``human_creation.py``, facts section 3.1): the male
+The numbers are the reference's (Assistive Gym ``human_creation.py``, paper §III-A): the male
 and female segment tables (radius ``r``, capsule cylinder length ``L``, offsets), scaled by
 ``radius_scale`` (radii) and ``height_scale`` (lengths and vertical offsets; a few lateral offsets
 and the head are not scaled, as in the reference), and the mass fractions.
@@ -137,7 +137,7 @@ for _j in REVOLUTE_JOINTS:
         JOINT_AXES[_j] = _j[-1]  # type: ignore[assignment]
 del _j
 
-#: Pose-independent joint limits in degrees (facts 3.2); the template emits the same in radians.
+#: Pose-independent joint limits in degrees (paper §III-A); the template emits the same in radians.
 JOINT_LIMITS_DEG: dict[str, tuple[float, float]] = {
     "right_pecs_x": (-10, 10), "right_pecs_y": (-10, 30), "right_pecs_z": (-35, 35),
     "right_shoulder_x": (5, 198), "right_shoulder_y": (-188, 61), "right_shoulder_z": (-90, 90),
@@ -157,7 +157,7 @@ JOINT_LIMITS_DEG: dict[str, tuple[float, float]] = {
 #: (reference indices 0-23: both arms, neck and head; not the waist or legs).
 LIMIT_SCALED_JOINTS: tuple[str, ...] = JOINT_NAMES[0:24]
 
-#: Fraction of the body mass per segment (facts 3.1; sums to 1). ``abdomen`` is the reference's
+#: Fraction of the body mass per segment (paper §III-A; sums to 1). ``abdomen`` is the reference's
 #: link 26 (waist_y) mass; ``hips`` is the ``waist`` link's capsule.
 MASS_FRACTIONS: dict[str, float] = {
     "chest": 0.10, "pecs": 0.05, "neck": 0.01, "head": 0.07,
@@ -190,7 +190,7 @@ def _links(first: int, last: int) -> tuple[str, ...]:
     return tuple(ROOT_LINK if i < 0 else LINK_NAMES[i] for i in range(first, last + 1))
 
 
-#: Self-collision groups (facts 3.3). The body is loaded with self-collision on, every link pair
+#: Self-collision groups (paper §III-A). The body is loaded with self-collision on, every link pair
 #: is disabled, and only these pairs are re-enabled; torso, head and shoulder girdles never
 #: collide with each other.
 SELF_COLLISION_GROUPS: dict[str, CollisionGroup] = {

@@ -59,7 +59,10 @@ class ScriptedPolicy:
     def __init__(self, env):
         m = env.manifest
         if m.scripted is None:
-            raise ValueError(f"task '{m.task}' has no scripted: section, so there is no scripted policy for it")
+            from ..errors import SpecError
+
+            raise SpecError.at(m.sources[0] if m.sources else m.task, f"task '{m.task}' has no scripted: section, so there is no "
+                               "scripted policy for it; use --policy random or zero, or add scripted: waypoints")
         self.env = env
         links = m.robot.links
         if m.scripted.get("left") is not None:

@@ -32,6 +32,7 @@ def _load_parts(s: Scope) -> None:
     s.tools = {n: p for n, use in spec.tools.items() if (p := s.part("tools", use.part, ("tools", n, "part"), "tool"))}
     s.people = {n: p for i, n in enumerate(spec.person.variants) if (p := s.part("people", n, ("person", "variants", i), "person"))}
     robot_section.check_per_robot_keys(s, ("robot", "per_robot"), spec.robot.per_robot)
+    robot_section.check_per_robot_keys(s, ("camera", "per_robot"), spec.camera.per_robot)
     if s.problems or robot is None or not s.people:
         raise SpecError(s.problems)
     s.robot = robot
@@ -39,7 +40,7 @@ def _load_parts(s: Scope) -> None:
 
 def resolve(loaded: LoadedSpec, robot: str | None = None, library: Library | None = None) -> ResolvedTask:
     """Resolve ``loaded`` for ``robot`` (default: the spec's default robot)."""
-    s = Scope(loaded, library or Library(), robot or loaded.spec.robot.default)
+    s = Scope(loaded, library or Library.for_spec(loaded.path), robot or loaded.spec.robot.default)
     spec = s.spec
     robot_section.check_supported(s)
     _load_parts(s)
@@ -72,7 +73,7 @@ def resolve(loaded: LoadedSpec, robot: str | None = None, library: Library | Non
 
 def validate_all_robots(loaded: LoadedSpec, library: Library | None = None) -> list[ResolvedTask]:
     """Resolve the spec for every robot it supports; problems from all of them are reported together."""
-    library = library or Library()
+    library = library or Library.for_spec(loaded.path)
     resolved: list[ResolvedTask] = []
     problems: list[Problem] = []
     for robot in loaded.spec.robot.supported:

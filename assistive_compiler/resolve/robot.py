@@ -47,7 +47,7 @@ def acting_sides(spec: TaskSpec, robot: LoadedPart) -> tuple[str, ...]:
 def tool_aliases(s: Scope) -> dict[str, str]:
     """Which tools share another tool's body on this robot, checking that every tool's hand is
     one the robot acts with: on a robot acting with one arm, a tool in the other hand must be
-    ``one_arm_same_as`` a tool of the same part in the acting hand (facts §2.6)."""
+    ``one_arm_same_as`` a tool of the same part in the acting hand (paper §III-B)."""
     spec = s.spec
     aliases: dict[str, str] = {}
     one_arm = len(s.sides) == 1
@@ -130,8 +130,12 @@ def check_mount(s: Scope) -> None:
     if spec.robot.mount_base == "search":
         _check_searched_mount(s, mount)
     for name, use in spec.tools.items():
-        if use.part not in s.robot.part.grips:
-            s.problem(("tools", name, "part"), f"robot '{s.robot_name}' has no grip for tool '{use.part}' (add it under grips: in {s.robot.shown})")
+        grip = use.grip or use.part
+        if grip not in s.robot.part.grips:
+            grips = list(s.robot.part.grips)
+            where = ("tools", name, "grip" if use.grip else "part")
+            s.problem(where, f"robot '{s.robot_name}' has no grip '{grip}' for tool '{name}' (add it under grips: in {s.robot.shown}, "
+                             f"or set tools.{name}.grip to one of its grips: {one_of(grips)}){did_you_mean(grip, grips)}")
 
 
 def _check_searched_mount(s: Scope, mount: str | None) -> None:

@@ -88,7 +88,7 @@ class Features:
 
 
 def draw_surface_point(capsules, rng: np.random.Generator) -> tuple[str, np.ndarray, np.ndarray]:
-    """A point on one of the limbs' capsules, as the reference draws an itch (facts §2.1): a limb
+    """A point on one of the limbs' capsules, as the reference draws an itch (paper §III-B): a limb
     uniformly, the distance from its joint end U(r, L) along the axis, the azimuth U(0, 2π).
     Returns (link, point, outward normal, axis away from the joint), in the link frame (m)."""
     cap = capsules[int(rng.integers(len(capsules)))]
@@ -105,9 +105,12 @@ class AssistiveEnv(gym.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
 
-    def __init__(self, artifact_dir: str | Path, render_mode: str | None = None, render_size: tuple[int, int] = (480, 360)):
+    def __init__(self, artifact_dir: str | Path, render_mode: str | None = None, render_size: tuple[int, int] = (480, 360),
+                 camera: dict | None = None):
+        """``camera``: eye / target (world m) / fov_deg overriding the task's camera in renders."""
+        self.camera = camera
         self.artifact_dir = Path(artifact_dir)
-        self.manifest = m = Manifest.read(self.artifact_dir)
+        self.manifest = m = Manifest.read(self.artifact_dir, verify=True)
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         self.render_mode = render_mode
@@ -153,11 +156,13 @@ class AssistiveEnv(gym.Env):
         self.human_observation_space = self.human_features.space
 
     @classmethod
-    def from_spec(cls, spec: str | Path, robot: str | None = None, out_dir: str | Path | None = None, **kwargs) -> "AssistiveEnv":
-        """Compile ``spec`` for ``robot`` (a cache hit when unchanged) and build the env."""
+    def from_spec(cls, spec: str | Path, robot: str | None = None, out_dir: str | Path | None = None,
+                  library=None, **kwargs) -> "AssistiveEnv":
+        """Compile ``spec`` for ``robot`` (a cache hit when unchanged) and build the env.
+        ``library``: extra part directories (see :func:`assistive_compiler.library.Library.for_spec`)."""
         from ..compile.compiler import compile_task
 
-        result = compile_task(spec, robot, out_dir)
+        result = compile_task(spec, robot, out_dir, library=library)
         return cls(result.out_dir, **kwargs)
 
     # -- Gymnasium API ------------------------------------------------------------------------
@@ -295,7 +300,7 @@ class AssistiveEnv(gym.Env):
             return None
         from .camera import render_rgb
 
-        return render_rgb(self, *self.render_size)
+        return render_rgb(self, *self.render_size, view=self.camera)
 
     def close(self):
         self.world.close()

@@ -8,7 +8,7 @@ single-agent task) or drives the policy joints from a human action; after every 
 (:meth:`PersonController.after_physics_step`, run by :meth:`World.step_physics` only when
 needed) it enforces the hard joint limits and the pose-dependent arm limits.
 
-Action application (facts §1, the same rule as the robot's): each policy joint's target is
+Action application (the reference implementation (Assistive Gym v1.0), the same rule as the robot's): each policy joint's target is
 ``q_measured + frame_skip · action_scale · clip(a, −1, 1)`` clamped to the joint's limits — the
 URDF limits, or the γ-scaled ones of a limited-range impairment — and one position-control
 command goes out per env step with gain ``person.position_gain`` and force ``person.max_force``.
@@ -27,9 +27,9 @@ env. Switching from acting back to holding returns the joints to those initial a
 
 After every physics step, when the person acts, tremors or has a limited range of motion:
 
-* **hard joint limits** (facts §3.2): a movable joint past its limit (γ-scaled under the
+* **hard joint limits** (paper §III-A): a movable joint past its limit (γ-scaled under the
   limited-range impairment, intersected with the URDF's) is reset to the limit with zero
-  velocity — every movable joint while the person is an agent (acts or tremors: facts §1, "for
+  velocity — every movable joint while the person is an agent (acts or tremors: the reference implementation (Assistive Gym v1.0), "for
   every human in the agent list"); on a static person only the stiffly held joints (standing in
   for the limits the reference builds into the body), not the compliant (limp) ones. Episodes start with every stiffly held joint inside these limits (the reference's
   clamped ``set_joint_angles``); a compliant (limp) joint starts where the compile-time settle
@@ -37,7 +37,7 @@ After every physics step, when the person acts, tremors or has a limited range o
   episode's γ-scaled limits at every reset; we settle once at compile time, and clamping a limp
   joint into a narrower range, away from its rest, would only make the limb fall by itself at
   the start of the episode. So a static person's limp joints do not feel a limited range;
-* **pose-dependent arm limits** (facts §3.6), only while the person acts and only when the policy
+* **pose-dependent arm limits** (paper §III-C), only while the person acts and only when the policy
   joints include a whole arm's shoulder (3 axes) and elbow — the right arm if its shoulder is
   controlled, else the left: :class:`~assistive_compiler.person.arm_limits.ArmLimitGuard` with
   the model the spec names (``person.control.arm_limits``: the built-in

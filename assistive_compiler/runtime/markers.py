@@ -12,7 +12,10 @@ import numpy as np
 import pybullet as pb
 
 from .snapshot import Snapshot
-from .world import PARK, World, rotation_matrix
+from .world import World, rotation_matrix
+
+MARKER_RADIUS_M = 0.008
+"""Radius of a marker's dot in renders, m."""
 
 
 class MarkerSystem:
@@ -67,12 +70,12 @@ class MarkerSystem:
     def count(self, name: str) -> int:
         return len(self.remaining[name])
 
-    def place_visuals(self) -> None:
-        """Move the marker spheres (renders only) onto the markers not yet cleared."""
-        c = self.world.client
+    def visual_spheres(self) -> list[tuple[list[float], float, tuple]]:
+        """(position, radius m, rgba) of each shown marker not yet cleared, for renders."""
+        out = []
         for ms in self.sets:
-            bodies = self.world.marker_visuals.get(ms.name, [])
+            if ms.show_rgba is None:
+                continue
             where = self.positions(ms.name)
-            for k, body in enumerate(bodies):
-                pos = where[k].tolist() if k < len(where) and self.remaining[ms.name][k] else list(PARK)
-                pb.resetBasePositionAndOrientation(body, pos, (0, 0, 0, 1), physicsClientId=c)
+            out += [(where[k].tolist(), MARKER_RADIUS_M, tuple(ms.show_rgba)) for k in range(len(where)) if self.remaining[ms.name][k]]
+        return out

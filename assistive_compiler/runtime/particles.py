@@ -23,7 +23,7 @@ the limit they are put back at their carried positions with the container's velo
 every active particle is inside the container and none moves faster than ``rest.max_speed``
 relative to it. A reset carries them at their settled start positions when the container starts
 within the limit. Carried particles are active and inside their container, so they produce no
-events; renders draw them with visual-only ghosts (:meth:`ParticleSystem.place_visuals`). Every
+events; renders draw them where they are carried (:meth:`ParticleSystem.visual_spheres`). Every
 decision is a function of the world's state, so seeded episodes stay reproducible.
 """
 
@@ -268,18 +268,19 @@ class ParticleSystem:
             out[carried] = pos + self.carried_at[name][carried] @ rot.T
         return out
 
-    def place_visuals(self) -> None:
-        """Put the render ghosts of carried particles where they are carried (the others' ghosts far away)."""
-        w, c = self.world, self.world.client
+    def visual_spheres(self) -> list[tuple[list[float], float, tuple]]:
+        """(position, radius m, rgba) of each carried particle, for renders to draw where it is
+        carried (its body is parked: see above). Reads the world, changes nothing."""
+        out = []
         for ps, _, _ in self.sets:
-            ghosts = w.particle_ghosts.get(ps.name)
-            if not ghosts:
+            if ps.rest is None:
                 continue
             carried = self.carried[ps.name] & self.active[ps.name]
-            shown = self.shown_positions(ps.name) if carried.any() else None
-            for k, ghost in enumerate(ghosts):
-                p = shown[k].tolist() if carried[k] else [PARK[0] - 5.0 - 0.1 * k, PARK[1] + 2.0, PARK[2]]
-                pb.resetBasePositionAndOrientation(ghost, p, (0, 0, 0, 1), physicsClientId=c)
+            if not carried.any():
+                continue
+            shown = self.shown_positions(ps.name)
+            out += [(shown[k].tolist(), ps.radius, tuple(ps.colors[k])) for k in np.flatnonzero(carried)]
+        return out
 
     def remaining(self, name: str) -> int:
         return int(self.active[name].sum())

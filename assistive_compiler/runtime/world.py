@@ -132,13 +132,10 @@ class World:
         self.active_variant = self.m.person.variants[0]
         self._attach_tools()
         self._create_particles()
-        self._create_markers()
         self._create_garments()
         self._set_gravity()
         self._set_stepping()
-        visual_only = {b for bodies in self.marker_visuals.values() for b in bodies} | set(self.markers.values())
-        visual_only |= {b for bodies in self.particle_ghosts.values() for b in bodies}
-        visual_only |= {b for g in self.garments for b in (g.soft_id, g.anchor_id)}  # garments are reset by reset_garments()
+        visual_only = {b for g in self.garments for b in (g.soft_id, g.anchor_id)}  # garments are reset by reset_garments()
         self._all_bodies = [b for b in range(pb.getNumBodies(physicsClientId=c)) if b != self.ground and b not in visual_only]
         # Bodies at rest would otherwise fall asleep after ~2 s; sleep is not part of a saved state,
         # so an episode would depend on how long the previous one left something resting.
@@ -190,7 +187,7 @@ class World:
                             pb.setCollisionFilterPair(a, b, la, lb, 0, physicsClientId=c)
 
     def _set_self_collision(self, handle: BodyHandle) -> None:
-        """Self-collision of a person body (facts §3.3): every link pair off, then the pairs the
+        """Self-collision of a person body (paper §III-A): every link pair off, then the pairs the
         compiler chose (``manifest.person.self_collision``, link names) on.
 
         The compiler lists only pairs between links that move relative to each other, of the
@@ -237,35 +234,13 @@ class World:
         c = self.client
         self.particles: dict[str, list[int]] = {}
         #: Per set that can rest in a container: one visual-only sphere per particle, drawn in
-        #: renders where a carried particle is (see runtime/particles.py); physics never sees them.
-        self.particle_ghosts: dict[str, list[int]] = {}
         for ps in self.m.particles:
             shape = pb.createCollisionShape(pb.GEOM_SPHERE, radius=ps.radius, physicsClientId=c)
-            ids, ghosts = [], []
+            ids = []
             for i in range(ps.count):
                 visual = pb.createVisualShape(pb.GEOM_SPHERE, radius=ps.radius, rgbaColor=list(ps.colors[i]), physicsClientId=c)
                 ids.append(pb.createMultiBody(ps.mass, shape, visual, [PARK[0] - 5.0 - 0.1 * i, PARK[1] + 1.0, PARK[2]], physicsClientId=c))
-                if ps.rest is not None:
-                    ghosts.append(pb.createMultiBody(0, -1, visual, [PARK[0] - 5.0 - 0.1 * i, PARK[1] + 2.0, PARK[2]], physicsClientId=c))
             self.particles[ps.name] = ids
-            if ghosts:
-                self.particle_ghosts[ps.name] = ghosts
-
-    def _create_markers(self) -> None:
-        """Visual-only spheres for targets and marker sets that ask to be shown (created before the
-        state is saved; they have no collision shape, so physics never sees them)."""
-        c = self.client
-        self.markers: dict[str, int] = {}
-        for name, t in self.m.targets.items():
-            if t.show_rgba is not None:
-                vis = pb.createVisualShape(pb.GEOM_SPHERE, radius=0.012, rgbaColor=list(t.show_rgba), physicsClientId=c)
-                self.markers[name] = pb.createMultiBody(0, -1, vis, list(PARK), physicsClientId=c)
-        self.marker_visuals: dict[str, list[int]] = {}
-        for ms in self.m.markers:
-            if ms.show_rgba is not None:
-                count = max(len(v.markers.get(ms.name, [])) for v in self.m.person.variants)
-                vis = pb.createVisualShape(pb.GEOM_SPHERE, radius=0.008, rgbaColor=list(ms.show_rgba), physicsClientId=c)
-                self.marker_visuals[ms.name] = [pb.createMultiBody(0, -1, vis, list(PARK), physicsClientId=c) for _ in range(count)]
 
     def _create_garments(self) -> None:
         """Load each garment as a soft body with its held nodes pinned to an anchor body (see

@@ -8,8 +8,8 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from ..errors import Problem, SpecError
-from ..paths import display
+from ..errors import Location, Problem, SpecError, did_you_mean
+from ..paths import display, specs_dir
 from ..yamlsrc import SourceMap, load_located
 from .models import TaskSpec
 from .validation import problems_from_validation
@@ -32,14 +32,71 @@ class LoadedSpec:
         return self.files[0]
 
 
-def deep_merge(base: Any, override: Any) -> Any:
-    """``override`` laid over ``base``: mappings merge key by key, anything else is replaced."""
-    if isinstance(base, dict) and isinstance(override, dict):
-        out = dict(base)
+DELETE, REPLACE = "$delete", "$replace"
+"""``extends`` markers, plain mapping keys so that a spec survives any YAML library's round trip:
+``{$delete: [a, b]}`` inside a mapping removes the inherited keys ``a`` and ``b`` (other keys
+beside it merge as usual); ``{$replace: VALUE}`` takes ``VALUE`` instead of merging with what is
+inherited (alone in its mapping)."""
+
+SHIPPED_PREFIX = "shipped:"
+"""``extends: shipped:tasks/feeding.yaml`` names a spec shipped with the package (``specs/``)."""
+
+
+class _Merger:
+    """``override`` laid over ``base`` with the ``$delete`` / ``$replace`` markers, collecting
+    located problems (``smap`` is the override file's source map)."""
+
+    def __init__(self, smap: SourceMap):
+        self.smap = smap
+        self.problems: list[Problem] = []
+
+    def merge(self, base: Any, override: Any, at: tuple = ()) -> Any:
+        if not isinstance(override, dict):
+            return override
+        if REPLACE in override:
+            if len(override) > 1:
+                others = ", ".join(sorted(k for k in override if k != REPLACE))
+                self.problems.append(Problem(self.smap.key(at + (REPLACE,)), f"'{REPLACE}' stands alone in its mapping (it replaces the whole inherited value); move {others} inside it"))
+            return self.merge(None, override[REPLACE], at + (REPLACE,))
+        out = dict(base) if isinstance(base, dict) else {}
+        for key in self._deleted(base, override, at):
+            out.pop(key, None)
         for key, value in override.items():
-            out[key] = deep_merge(base[key], value) if key in base else value
+            if key != DELETE:
+                out[key] = self.merge(out.get(key), value, at + (key,))
         return out
-    return override
+
+    def _deleted(self, base: Any, override: dict, at: tuple) -> list[str]:
+        if DELETE not in override:
+            return []
+        names, where = override[DELETE], self.smap.value(at + (DELETE,))
+        names = [names] if isinstance(names, str) else names
+        inherited = sorted(base) if isinstance(base, dict) else []
+        if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+            self.problems.append(Problem(where, f"'{DELETE}' takes a list of inherited keys to remove, e.g. {DELETE}: [female_50th]"))
+            return []
+        for name in names:
+            if name not in inherited:
+                has = f"inherited keys here: {', '.join(inherited)}" if inherited else "nothing is inherited here"
+                self.problems.append(Problem(where, f"'{DELETE}': no inherited key '{name}' to remove ({has}){did_you_mean(name, inherited)}"))
+        return names
+
+
+def deep_merge(base: Any, override: Any, smap: SourceMap | None = None) -> Any:
+    """``override`` laid over ``base``: mappings merge key by key, anything else is replaced;
+    ``$delete`` / ``$replace`` (see :data:`DELETE`) remove or replace inherited values.
+    Raises :class:`SpecError` for a misused marker."""
+    merger = _Merger(smap or SourceMap(default=Location("<spec>", 1, 1)))
+    out = merger.merge(base, override)
+    if merger.problems:
+        raise SpecError(merger.problems)
+    return out
+
+
+def _parent_path(path: Path, ref: str) -> Path:
+    if ref.startswith(SHIPPED_PREFIX):
+        return (specs_dir() / ref[len(SHIPPED_PREFIX):]).resolve()
+    return (path.parent / ref).resolve()
 
 
 def _load_tree(path: Path, chain: tuple[Path, ...]) -> tuple[dict, SourceMap, tuple[Path, ...]]:
@@ -47,20 +104,21 @@ def _load_tree(path: Path, chain: tuple[Path, ...]) -> tuple[dict, SourceMap, tu
     files = (path,)
     parent_ref = data.get("extends")
     if parent_ref is None:
-        return data, smap, files
+        return deep_merge(None, data, smap), smap, files
     where = smap.value(("extends",))
     if not isinstance(parent_ref, str) or not parent_ref:
         raise SpecError([Problem(where, "extends: expected the path of another spec file")])
-    parent = (path.parent / parent_ref).resolve()
+    parent = _parent_path(path, parent_ref)
     if parent in chain or parent == path:
         cycle = " -> ".join(display(p) for p in (*chain, path, parent))
         raise SpecError([Problem(where, f"extends forms a cycle: {cycle}")])
     if not parent.is_file():
-        raise SpecError([Problem(where, f"extends: file not found: {display(parent)} (paths are relative to {display(path.parent)}/)")])
+        relative_to = "the shipped specs/" if parent_ref.startswith(SHIPPED_PREFIX) else f"{display(path.parent)}/"
+        raise SpecError([Problem(where, f"extends: file not found: {display(parent)} (paths are relative to {relative_to})")])
     if len(chain) >= MAX_EXTENDS_DEPTH:
         raise SpecError([Problem(where, f"extends is nested more than {MAX_EXTENDS_DEPTH} deep")])
     base_data, base_smap, base_files = _load_tree(parent, chain + (path,))
-    merged = deep_merge(base_data, {k: v for k, v in data.items() if k != "extends"})
+    merged = deep_merge(base_data, {k: v for k, v in data.items() if k != "extends"}, smap)
     return merged, smap.merged_over(base_smap), files + base_files
 
 

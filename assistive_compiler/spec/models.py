@@ -249,7 +249,7 @@ class PersonControl(Strict):
     arm_limits: str = Field(
         "analytic",
         description="Pose-dependent shoulder-elbow limits enforced after every physics step on the arm whose shoulder (3 axes) "
-        "and elbow are policy joints (the right one if both; facts §3.6): 'analytic' (the built-in model), 'none', or the "
+        "and elbow are policy joints (the right one if both; paper §III-C): 'analytic' (the built-in model), 'none', or the "
         "path of a .npz MLP (arrays W0, b0, W1, b1, ...; relative to the spec file that says it).",
     )
 
@@ -274,7 +274,7 @@ class Settle(Strict):
     joint_noise_rad: float = Field(0.1, ge=0, le=1, description="Half-width of the uniform noise on every joint angle, rad.")
     friction: float | None = Field(None, ge=0, description="Friction of the furniture while settling (the reference: 5); None keeps it.")
     then: "SettleStage | None" = Field(
-        None, description="A second compile-time stage after settling (e.g. an arm dropped to hang off the bed, facts §2.6)."
+        None, description="A second compile-time stage after settling (e.g. an arm dropped to hang off the bed, paper §III-B)."
     )
 
 
@@ -383,7 +383,7 @@ class Goal(Strict):
 
 
 class BaseSearch(Strict):
-    """Compile-time base-pose optimisation for robots standing on the floor (facts §5): sample base
+    """Compile-time base-pose optimisation for robots standing on the floor (paper §III-D): sample base
     poses, solve IK to each goal with collision checks, keep the poses that reach the most goals,
     ties broken by joint-limit-weighted kinematic isotropy (JLWKI). The start pose is always a
     required, oriented goal. Deterministic and bounded: exactly ``attempts`` samples."""
@@ -458,9 +458,13 @@ class ToolUse(Strict):
     hand: Literal["right", "left"] = Field(description="Which hand holds it (single-arm robots: their only hand).")
     gravity_mps2: float | None = Field(0.0, ge=-20, le=0, description="Gravity on the tool (0: weightless).")
     mass_kg: float | None = Field(None, gt=0, description="Mass override in kg (None: the part's mass).")
+    grip: Name | None = Field(
+        None, description="Which of the robot part's grips (grips: in specs/robots/<robot>.yaml) holds this tool; default "
+        "the tool's part name. A new tool shaped like a shipped one can reuse its grip (e.g. grip: scratcher).",
+    )
     one_arm_same_as: Name | None = Field(
         None, description="On a robot acting with one arm (which serves as both hands), this tool is the named tool, held "
-        "in the other hand: one body that both names refer to (the reference's single-arm arm manipulation, facts §2.6). "
+        "in the other hand: one body that both names refer to (the reference's single-arm arm manipulation, paper §III-B). "
         "Two-arm robots acting with both arms hold both tools.",
     )
 
@@ -832,13 +836,32 @@ class Scripted(_WaypointScript):
 # The task
 
 
+class CameraView(Strict):
+    """Where renders look from (world frame: the person faces −Y; the robot usually stands at −X)."""
+
+    eye_m: Vec3 | None = Field(None, description="Camera position, world frame, m (default: the shipped default view's).")
+    target_m: Vec3 | None = Field(None, description="Point the camera looks at, world frame, m.")
+    fov_deg: float | None = Field(None, gt=5, lt=150, description="Vertical field of view, degrees.")
+
+
+class Camera(CameraView):
+    """The task's camera for renders, with per-robot overrides (each field merged over the task's)."""
+
+    per_robot: dict[Name, CameraView] = Field(
+        default_factory=dict, description="Per-robot camera fields (e.g. a robot standing farther away needs a wider view).")
+
+
 class TaskSpec(Strict):
     """A complete assistive task."""
 
     name: Name = Field(description="Task name; Gymnasium ids are <TaskName><Robot>-v1.")
     title: str = Field(description="Human-readable title, e.g. 'Feeding'.")
     description: str = Field("", description="What the task is and where its numbers come from.")
-    extends: str | None = Field(None, description="Path of a spec this one builds on (relative to this file).")
+    extends: str | None = Field(
+        None, description="Path of a spec this one builds on (relative to this file, or shipped:tasks/<name>.yaml for a "
+        "shipped one). Mappings merge key by key and anything else is replaced; inside a mapping, '$delete: [key, ...]' "
+        "removes inherited keys and '$replace: VALUE' (alone) takes VALUE instead of merging.",
+    )
     sim: Sim = Field(default_factory=Sim, description="Timing and world physics.")
     scene: Scene = Field(default_factory=Scene, description="Furniture and objects.")
     person: Person = Field(description="The person being helped.")
@@ -855,3 +878,4 @@ class TaskSpec(Strict):
     preferences: Preferences = Field(default_factory=Preferences, description="Human-preference costs.")
     success: Success = Field(description="What counts as success.")
     scripted: Scripted | None = Field(None, description="A scripted baseline controller (optional).")
+    camera: Camera = Field(default_factory=Camera, description="The camera of renders (render, demo): eye, target, field of view; per robot.")

@@ -213,9 +213,10 @@ def _one(err: dict, path: DataPath, data: Any, smap: SourceMap, root: type[BaseM
         return Problem(smap.value(full), f"{_section(full)}: {err['msg']}")
     message = _strip(err["msg"])
     if kind in ("value_error", "assertion_error") and message.startswith("@"):
-        # A model-level check that names the field at fault: "@threshold: message".
+        # A model-level check that names the field at fault: "@threshold: message" (or a dotted
+        # path below the model: "@ppo.minibatch_size: message").
         field, _, message = message[1:].partition(": ")
-        full, path = full + (field,), path + (field,)
+        full, path = full + tuple(field.split(".")), path + tuple(field.split("."))
         return Problem(smap.value(full), f"{_section(full)}: {message}")
     if kind == "literal_error":
         expected = [e.strip().strip("'") for e in str(err.get("ctx", {}).get("expected", "")).replace(" or ", ", ").split(",") if e.strip()]

@@ -1,4 +1,4 @@
-"""The paper's seven human-preference costs c_k ≤ 0 (Erickson et al. 2020, §III-C; facts §3.7).
+"""The paper's seven human-preference costs c_k ≤ 0 (Erickson et al. 2020, paper §III-E).
 
 r_H = Σ_k α_k·ω_k·c_k: a spec's ``preferences.active`` sets α_k = 1 for the costs it lists, and ω_k
 defaults to the paper's weights (0.25, 0.01, 0.05, 1.0, 1.0, 0.01, 0.01). The compiler turns each
@@ -18,7 +18,7 @@ class Velocity(Params):
 
 
 class ForceNonTarget(Params):
-    on: BodiesRef
+    onto: BodiesRef
     by: BodiesRef
     target_tool: BodiesRef = Field(default_factory=list)
     target: PointRef | None = None
@@ -27,7 +27,7 @@ class ForceNonTarget(Params):
 
 class HighForce(Params):
     tool: BodiesRef
-    on: BodiesRef
+    onto: BodiesRef
     target: PointRef | None = None
     target_radius_m: float = Field(0.025, gt=0)
     threshold_n: float = Field(10.0, gt=0)
@@ -39,12 +39,12 @@ class ParticleSet(Params):
 
 class DressingForce(Params):
     cloth: BodiesRef
-    on: BodiesRef
+    onto: BodiesRef
 
 
 class Pressure(Params):
     tools: list[BodyRef] = Field(min_length=1)
-    on: BodiesRef
+    onto: BodiesRef
     contact_distance_m: float = Field(0.01, gt=0)
 
 
@@ -64,18 +64,18 @@ def velocity(snap, p) -> float:
 def force_nontarget(snap, p) -> float:
     """C_f = −(F_total − F_target) (N): contact force on the person away from the task target.
 
-    F_total pools the contacts of ``by`` on ``on``. F_target is the force of ``target_tool`` within
+    F_total pools the contacts of ``by`` on ``onto``. F_target is the force of ``target_tool`` within
     ``target_radius_m`` of ``target`` (0 when no target is given, as in feeding: all force counts).
     """
-    total = snap.contact_force(p.by, p.on)
-    at_target = _tool_force(snap, p.target_tool, p.on, p.target, p.target_radius_m) if p.target_tool and p.target else 0.0
+    total = snap.contact_force(p.by, p.onto)
+    at_target = _tool_force(snap, p.target_tool, p.onto, p.target, p.target_radius_m) if p.target_tool and p.target else 0.0
     return -float(total - at_target)
 
 
 @term("high_force", "preference", HighForce)
 def high_force(snap, p) -> float:
     """C_hf = −F if the tool's force on the person (near the target) is ≥ threshold, else 0 (N)."""
-    force = _tool_force(snap, p.tool, p.on, p.target, p.target_radius_m)
+    force = _tool_force(snap, p.tool, p.onto, p.target, p.target_radius_m)
     return -float(force) if force >= p.threshold_n else 0.0
 
 
@@ -94,7 +94,7 @@ def food_velocity(snap, p) -> float:
 @term("dressing_force", "preference", DressingForce)
 def dressing_force(snap, p) -> float:
     """C_d = −Σ‖f‖ of the garment's contact forces on the person (N)."""
-    return -float(snap.contact_force(p.cloth, p.on))
+    return -float(snap.contact_force(p.cloth, p.onto))
 
 
 @term("pressure", "preference", Pressure)
@@ -102,7 +102,7 @@ def pressure(snap, p) -> float:
     """C_p = −Σ_tools F/n (N per contact): force spread over few contacts hurts (0 when n = 0)."""
     cost = 0.0
     for tool in p.tools:
-        force, count = snap.contact_force_and_count(tool, p.on, p.contact_distance_m)
+        force, count = snap.contact_force_and_count(tool, p.onto, p.contact_distance_m)
         if count:
             cost -= force / count
     return cost

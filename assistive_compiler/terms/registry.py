@@ -69,7 +69,8 @@ class TermDef:
     size: Callable[[Params, "SizeContext"], int] | None = None
 
     def summary(self) -> str:
-        return (self.doc.strip().splitlines() or [""])[0]
+        """The docstring's first paragraph, whole (its lines joined)."""
+        return " ".join(self.doc.strip().split("\n\n")[0].split())
 
 
 @dataclass(frozen=True)

@@ -83,7 +83,7 @@ def contact_force(snap, p) -> float:
 
 class ContactEvents(Params):
     tool: BodiesRef
-    on: BodiesRef
+    onto: BodiesRef
     target: PointRef
     radius_m: float = Field(0.025, gt=0, description="Contacts within this distance of the target count, m.")
     min_move_m: float = Field(0.01, ge=0, description="An event needs the contact to have moved this far since the last event, m.")
@@ -95,7 +95,7 @@ class ContactEventCounter:
     """1 when the tool touches the person near the target gently and has moved since the last
     event, else 0 (count; the reference's scratch: within 2.5 cm, moved > 1 cm, force < 10 N).
 
-    The contact point p_c is the last contact of ``tool`` with ``on`` within ``radius_m`` of the
+    The contact point p_c is the last contact of ``tool`` with ``onto`` within ``radius_m`` of the
     target (the point on the tool); the force is the sum of those contacts' normal forces. An event
     fires when force < ``max_force_n`` and p_c lies farther than ``min_move_m`` from the contact
     point of the previous event (or there was none this episode) — a hysteresis, so resting on the
@@ -109,7 +109,7 @@ class ContactEventCounter:
 
     def __call__(self, snap, p) -> float:
         centre = snap.position(p.target).tolist()
-        near = [cp for cp in snap.contacts(p.tool, p.on) if math.dist(cp[5], centre) <= p.radius_m]
+        near = [cp for cp in snap.contacts(p.tool, p.onto) if math.dist(cp[5], centre) <= p.radius_m]
         if not near:
             return 0.0
         force = sum(cp[9] for cp in near)
@@ -170,7 +170,7 @@ class SleeveProgress(Params):
 
 @term("sleeve_progress", "reward", SleeveProgress)
 class SleeveProgressTerm:
-    """How far the arm is inside the sleeve (m): the reference's r_dress (facts §2.5). Forearm in
+    """How far the arm is inside the sleeve (m): the reference's r_dress (paper §III-B). Forearm in
     the opening: distance of the opening's centre from the hand's end; upper arm in: the forearm's
     length plus the centre's distance past the elbow; neither: minus the centre's distance to the
     hand's end. See :func:`assistive_compiler.garment.sleeve_progress`.

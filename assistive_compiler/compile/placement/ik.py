@@ -4,7 +4,7 @@
 acting side (action order), the arm's kinematics, its start pose (spec part) and the tool's
 start orientation (quaternion x, y, z, w). :meth:`ArmKinematics.reach` solves IK for a tool
 pose (world frame, m) with collision checks against person and furniture;
-:meth:`ArmKinematics.jlwki` scores a configuration (facts §5)."""
+:meth:`ArmKinematics.jlwki` scores a configuration (paper §III-D)."""
 
 from __future__ import annotations
 
@@ -114,7 +114,7 @@ class ArmKinematics:
         return False
 
     def jlwki(self, q) -> float:
-        """Joint-limit-weighted kinematic isotropy at ``q`` (facts §5: φ = 0.5, λ = 0.05)."""
+        """Joint-limit-weighted kinematic isotropy at ``q`` (paper §III-D: φ = 0.5, λ = 0.05)."""
         p, c = self.pc.p, self.pc.client
         all_q = [p.getJointState(self.robot, j, physicsClientId=c)[0] for j in self.movable]
         zeros = [0.0] * len(self.movable)

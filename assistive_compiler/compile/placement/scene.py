@@ -137,7 +137,7 @@ def _load_tools(rt: ResolvedTask, pc: PlacementClient, emitted: EmittedScene, ou
     bodies: list[Body] = []
     for name, use in rt.tool_uses.items():
         tpart = rt.tools[name].part
-        grip = robot_part.grips[tpart.name]
+        grip = robot_part.grips[use.grip or tpart.name]
         _, hand = robot_part.arm_for(use.hand)
         ids[name] = pc.load(emitted.written[name], (0, 0, -10), (0, 0, 0, 1), True)
         attachments.append(ToolAttachment(body=name, parent_link=hand.tool_mount, position=rounded(grip.position_m),

@@ -1,4 +1,4 @@
-"""Settling each particle set in its container (``particles:`` of a task; facts: the spoon's and
+"""Settling each particle set in its container (``particles:`` of a task: the spoon's and
 cup's contents).
 
 :func:`settle_particles` takes the task, the placement client (its bodies at the first start),

@@ -1,4 +1,4 @@
-"""Settling a supine person onto the furniture (``person.placement.settle``; facts §2.2).
+"""Settling a supine person onto the furniture (``person.placement.settle``; paper §III-B).
 
 :func:`settle_people` takes the resolved task and the scene emitted so far (robot, furniture)
 and returns, per person variant, the settled base pose of the URDF frame (position m,
@@ -31,7 +31,7 @@ def settle_people(rt: ResolvedTask, scene: EmittedScene) -> dict[str, tuple[tupl
 
 
 def settle_person(rt: ResolvedTask, scene: EmittedScene, variant: str) -> tuple[tuple, tuple, dict[str, float]]:
-    """Drop the limp person onto the furniture (facts §2.2): every joint free and perturbed by
+    """Drop the limp person onto the furniture (paper §III-B): every joint free and perturbed by
     U(±joint_noise_rad) around the spec's posture, a free base at the placement pose, the settle
     gravity and furniture friction, ``steps`` physics steps. Returns the settled base pose (URDF
     frame) and joint angles (rad). Deterministic per (task, robot, variant)."""

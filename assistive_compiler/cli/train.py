@@ -1,0 +1,69 @@
+"""``train``: learn a policy with PPO — Stable-Baselines3 on one machine, Ray RLlib for
+co-optimisation (``--coop``) and Ray clusters (``--address``). The work is in
+:mod:`assistive_compiler.training`; it needs the optional ``train`` extra, which the package
+itself never imports."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, add_library_argument, engine_modules, require_extra
+
+SHIPPED_CONFIGS = "ppo_paper, ppo_laptop, ppo_quick, ppo_rllib_reference"
+
+
+def training_config_path(name: str) -> str:
+    """A config path as given, or a shipped config by name (``ppo_quick`` -> specs/training/ppo_quick.yaml)."""
+    from ..paths import specs_dir
+
+    if Path(name).exists() or "/" in name or name.endswith((".yaml", ".yml")):
+        return name
+    return str(specs_dir() / "training" / f"{name}.yaml")
+
+
+def _summary_line(summary: dict) -> str:
+    ret, rate = summary["final_mean_return"], summary["final_success_rate"]
+    return (f"{summary['gym_id']}: {summary['steps']:,} steps in {summary['wall_s']:.0f} s "
+            f"({summary['steps_per_s_including_learning']:.0f} steps/s including learning); "
+            f"last mean return {'-' if ret is None else f'{ret:.1f}'}, success {'-' if rate is None else f'{rate:.2f}'}; "
+            f"checkpoint {summary['checkpoint']}")
+
+
+def cmd_train(args: argparse.Namespace) -> int:
+    from ..training.train import choose_engine
+
+    engine = choose_engine(args.engine, args.coop, args.address)  # a bad --engine is reported before heavy imports
+    if not require_extra(*engine_modules(engine)):
+        return EXIT_FAILED
+    from ..training.train import train
+
+    summary = train(args.spec, robot=args.robot, config_path=training_config_path(args.config), coop=args.coop, engine=engine,
+                    steps=args.steps, seed=args.seed, envs=args.envs, out=args.out, resume=args.resume,
+                    address=args.address, quiet=args.quiet)
+    print(json.dumps(summary, indent=1) if args.json else _summary_line(summary))
+    if summary["interrupted"]:
+        print("interrupted: checkpoint written; continue with the same command and --resume", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    return EXIT_OK
+
+
+def add_commands(sub) -> None:
+    p = sub.add_parser("train", help="learn a policy with PPO (SB3 on one machine; RLlib for --coop and Ray clusters)")
+    add_library_argument(p)
+    p.add_argument("spec", help="task spec file")
+    p.add_argument("--robot", help="robot name (default: the spec's default robot)")
+    p.add_argument("--config", required=True, help=f"training config: a file, or a shipped one by name ({SHIPPED_CONFIGS})")
+    p.add_argument("--coop", action="store_true", help="co-optimisation: train the robot and the person (policies robot and human)")
+    p.add_argument("--engine", default="auto", help="sb3 | rllib | auto (default: rllib for --coop or --address, else sb3)")
+    p.add_argument("--address", help="attach to a running Ray cluster at HOST:PORT (or ray://HOST:PORT, or auto)")
+    p.add_argument("--steps", type=int, help="total env steps (overrides the config's total_steps)")
+    p.add_argument("--seed", type=int, help="seed (overrides the config's)")
+    p.add_argument("--envs", type=int, help="env processes (overrides the config's)")
+    p.add_argument("--out", help="run directory (default: runs/<task>-<robot>[-coop]-s<seed>)")
+    p.add_argument("--resume", action="store_true", help="continue the run in --out from its newest checkpoint")
+    p.add_argument("--quiet", action="store_true", help="no progress bar or reward table")
+    p.add_argument("--json", action="store_true", help="print the run's summary as JSON")
+    p.set_defaults(func=cmd_train)

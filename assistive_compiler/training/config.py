@@ -1,0 +1,124 @@
+"""Training configs are specs too: validated YAML (``specs/training/*.yaml``) with located errors.
+
+A :class:`TrainingConfig` says *how* to learn a task's policy — algorithm, network, rollout and
+batch sizes, epochs, discounting, learning rate, how many steps and env processes, the seed and
+how often to checkpoint. The same config drives Stable-Baselines3 (single agent, one machine) and
+Ray RLlib (co-optimisation, clusters); :mod:`.sb3` and :mod:`.rllib` translate it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from ..errors import SpecError, UsageError
+from ..paths import display
+from ..yamlsrc import load_located
+
+
+class Strict(BaseModel):
+    """Unknown keys are errors, NaN and infinities are refused."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+
+
+class Network(Strict):
+    """The policy and value networks: separate MLPs of the same shape."""
+
+    hidden: list[int] = Field(
+        [64, 64], min_length=1, max_length=8,
+        description="Hidden layer widths (the paper: [64, 64]; the reference v1.0 RLlib config: [100, 100]).",
+    )
+    activation: Literal["tanh", "relu"] = Field("tanh", description="Hidden-layer activation (the paper: tanh).")
+
+    @model_validator(mode="after")
+    def _positive(self) -> "Network":
+        if any(w < 1 for w in self.hidden):
+            raise ValueError(f"@hidden: every layer width must be ≥ 1, got {self.hidden}")
+        return self
+
+
+class PPO(Strict):
+    """Proximal policy optimisation (Schulman et al. 2017) settings."""
+
+    rollout_steps: int = Field(
+        ge=1, le=1_000_000,
+        description="Env steps each env process collects per update; the batch is rollout_steps × envs (the paper: 200 × 36 = 7,200).",
+    )
+    minibatch_size: int = Field(ge=1, description="Samples per gradient step (the reference v1.0 RLlib config: 128).")
+    epochs: int = Field(ge=1, le=1000, description="Passes over each batch (the paper: 10; the reference v1.0 RLlib config: 50).")
+    gamma: float = Field(0.99, gt=0, le=1, description="Discount factor γ per env step.")
+    gae_lambda: float = Field(0.95, ge=0, le=1, description="GAE λ (the reference: 0.95).")
+    learning_rate: float = Field(3e-4, gt=0, le=1, description="Adam learning rate.")
+    clip_range: float = Field(0.2, gt=0, le=1, description="PPO's probability-ratio clip ε.")
+    entropy_coef: float = Field(0.0, ge=0, le=1, description="Weight of the entropy bonus.")
+    value_coef: float = Field(0.5, ge=0, le=10, description="Weight of the value loss.")
+    max_grad_norm: float = Field(0.5, gt=0, le=100, description="Gradient norm clip.")
+    normalize_observations: bool = Field(
+        True, description="Running mean/std normalisation of observations (pytorch-a2c-ppo-acktr, the paper's trainer, does this)."
+    )
+    normalize_rewards: bool = Field(True, description="Scale rewards by a running std of the discounted return (as that trainer).")
+
+
+class TrainingConfig(Strict):
+    """How to train a policy for one task and robot."""
+
+    algorithm: Literal["ppo"] = Field(description="The learning algorithm (the paper: PPO).")
+    description: str = Field("", description="What this config is for, in a sentence.")
+    network: Network = Field(default_factory=Network, description="Policy and value network shape.")
+    ppo: PPO = Field(description="PPO settings.")
+    total_steps: int = Field(ge=1, description="Env steps to train for, over all env processes (the paper: 10,000,000).")
+    envs: int = Field(1, ge=1, le=1024, description="Env processes collecting experience in parallel (the paper: 36).")
+    seed: int = Field(0, ge=0, description="Seed of the policy's initialisation, the envs and the sampling.")
+    checkpoint_every_steps: int = Field(ge=1, description="Env steps between checkpoints (a checkpoint is also written at the end and on Ctrl-C).")
+    eval_episodes: int = Field(100, ge=1, description="Episodes `evaluate` runs by default (the paper: 100 rollouts).")
+
+    @model_validator(mode="after")
+    def _batch(self) -> "TrainingConfig":
+        batch = self.ppo.rollout_steps * self.envs
+        if self.ppo.minibatch_size > batch:
+            raise ValueError(
+                f"@ppo.minibatch_size: minibatch_size {self.ppo.minibatch_size} is larger than the batch "
+                f"rollout_steps × envs = {self.ppo.rollout_steps} × {self.envs} = {batch}"
+            )
+        return self
+
+    @property
+    def batch_size(self) -> int:
+        """Env steps per update, over all env processes."""
+        return self.ppo.rollout_steps * self.envs
+
+    def with_overrides(self, *, steps: int | None = None, seed: int | None = None, envs: int | None = None) -> "TrainingConfig":
+        """This config with command-line overrides applied, validated again."""
+        data = self.model_dump()
+        for key, value in (("total_steps", steps), ("seed", seed), ("envs", envs)):
+            if value is not None:
+                data[key] = value
+        try:
+            return TrainingConfig.model_validate(data)
+        except ValidationError as exc:
+            raise UsageError("; ".join(e["msg"] for e in exc.errors())) from None
+
+
+def load_training_config(path: str | Path) -> TrainingConfig:
+    """Load and validate a training config; raises :class:`SpecError` with located problems."""
+    from ..spec.validation import problems_from_validation
+
+    path = Path(path)
+    if not path.is_file():
+        raise SpecError.at(display(path), "training config not found")
+    data, smap = load_located(path, display_path=display(path))
+    try:
+        return TrainingConfig.model_validate(data)
+    except ValidationError as exc:
+        raise SpecError(problems_from_validation(exc, data, smap, TrainingConfig)) from None
+
+
+def training_schema() -> dict:
+    """JSON Schema of a training config, for editors."""
+    schema = TrainingConfig.model_json_schema()
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = "assistive-compiler training config"
+    return schema

@@ -1,0 +1,132 @@
+"""``evaluate``: roll out a run's trained policy as the reference evaluates (facts §6.2): mean and
+std of the episode return, of the per-episode mean total force on the person (N) and of the
+final-step task success, over ``episodes`` episodes seeded ``seed``, ``seed + 1``, ...
+
+Actions are the policy's deterministic ones (the mean of its Gaussian), so the same run, seed
+and episode count give the same figures. SB3 and RLlib runs alike: a co-optimised run's robot
+and human policies act together in the task's co-optimisation face (``step_agents``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import UsageError
+from ..paths import display
+from .run_dir import RunDir, RunInfo
+
+
+def latest_checkpoint(run: RunDir) -> tuple[int, Path]:
+    found = run.latest_checkpoint()
+    if found is None:
+        raise UsageError(f"{display(run.path)}: the run has no complete checkpoint yet (checkpoints/step_*/COMPLETE)")
+    return found
+
+
+def load_policy(info: RunInfo, checkpoint: Path):
+    """The run's policy as ``obs -> action`` (co-optimised runs: ``(robot_obs, human_obs) -> (a_r, a_h)``)."""
+    if info.engine == "sb3":
+        from .sb3 import SB3Policy
+
+        return SB3Policy(checkpoint)
+    from .rllib import RLlibPolicy
+
+    return RLlibPolicy(checkpoint, coop=info.coop)
+
+
+def _stats(values: list[float]) -> tuple[float, float]:
+    return float(np.mean(values)), float(np.std(values))
+
+
+def evaluate(run_dir: str | Path, episodes: int | None = None, seed: int = 0, render: str | None = None) -> dict:
+    """Evaluate the run's newest checkpoint; optionally write a rollout (``render``: .gif or .png)."""
+    from ..cli.run import rollout
+    from ..runtime.env import AssistiveEnv
+
+    run = RunDir(run_dir)
+    info = run.info()
+    steps, checkpoint = latest_checkpoint(run)
+    episodes = episodes or info.training_config.eval_episodes
+    policy = load_policy(info, checkpoint)
+    if info.coop:
+        from ..coop.parallel import AssistiveParallelEnv
+        from ..coop.rollout import rollout_coop
+
+        env = AssistiveParallelEnv(run.artifact)
+        results = [rollout_coop(env, policy.agent("robot"), policy.agent("human"), seed + k) for k in range(episodes)]
+    else:
+        env = AssistiveEnv(run.artifact)
+        results = [rollout(env, policy, seed + k) for k in range(episodes)]
+    env.close()
+    mean_r, std_r = _stats([e["return"] for e in results])
+    mean_f, std_f = _stats([e["mean_force_on_human_n"] for e in results])
+    mean_s, std_s = _stats([float(e["success"]) for e in results])
+    out = {
+        "run": display(run.path), "gym_id": info.gym_id, "task": info.task, "robot": info.robot, "coop": info.coop,
+        "engine": info.engine, "checkpoint": display(checkpoint), "trained_steps": steps, "episodes": episodes, "seed": seed,
+        "mean_return": mean_r, "std_return": std_r, "success_rate": mean_s, "std_success": std_s,
+        "mean_force_on_human_n": mean_f, "std_force_on_human_n": std_f, "per_episode": results,
+    }
+    if render:
+        out["render"] = render_rollout(run, info, checkpoint, seed, Path(render))
+    return out
+
+
+class BothAgents:
+    """A co-optimisation env seen as a robot-only one, so single-agent tools (``record``) can run
+    it: the robot's action comes from :meth:`robot_action`, which also picks the human's."""
+
+    def __init__(self, env, policy):
+        self.env, self.policy, self.human_action = env, policy, None
+
+    def __getattr__(self, name):
+        return getattr(self.env, name)
+
+    def robot_action(self, obs):
+        a_robot, self.human_action = self.policy(obs, self.env.observe_human())
+        return a_robot
+
+    def step(self, a_robot):
+        obs, _, reward, terminated, truncated, info = self.env.step_agents(a_robot, self.human_action)
+        return obs, reward, terminated, truncated, info
+
+
+def _both(env, policy):
+    both = BothAgents(env, policy)
+    return both, both.robot_action
+
+
+def render_rollout(run: RunDir, info: RunInfo, checkpoint: Path, seed: int, out: Path, every: int = 2) -> str:
+    """Write one rollout of the trained policy as a GIF (or a PNG strip); returns a line saying so."""
+    from ..cli.render import record, write_picture
+    from ..runtime.env import AssistiveEnv
+
+    env = AssistiveEnv(run.artifact, render_mode="rgb_array")
+    policy = load_policy(info, checkpoint)
+    target, act = (env, policy) if not info.coop else _both(env, policy)
+    frames, summary = record(target, act, seed, every)
+    env.close()
+    write_picture(frames, out, fps=max(1, 10 // every))
+    return f"wrote {display(out)} ({len(frames)} frames; return {summary['return']:.1f}, success {'yes' if summary['success'] else 'no'})"
+
+
+def save_evaluation(run: RunDir, result: dict) -> Path:
+    """Write ``evaluation.json`` in the run directory (``table`` reads it)."""
+    import json
+
+    out = run.path / "evaluation.json"
+    out.write_text(json.dumps(result, indent=1))
+    return out
+
+
+def format_report(result: dict) -> str:
+    """The human-readable evaluation summary."""
+    return "\n".join([
+        f"{result['gym_id']}  {result['engine']}  checkpoint {result['checkpoint']} ({result['trained_steps']:,} steps)",
+        f"episodes {result['episodes']} (seeds {result['seed']}..{result['seed'] + result['episodes'] - 1}), deterministic actions",
+        f"return          {result['mean_return']:9.2f} ± {result['std_return']:.2f}",
+        f"success rate    {result['success_rate']:9.2f} ± {result['std_success']:.2f}",
+        f"force on person {result['mean_force_on_human_n']:9.2f} ± {result['std_force_on_human_n']:.2f} N (per-episode mean)",
+    ] + ([result["render"]] if "render" in result else []))

@@ -1,0 +1,242 @@
+"""Co-optimisation and clusters: Ray RLlib PPO (the new API stack: RLModules, EnvRunners).
+
+* **Co-optimisation** (``coop``): the task's PettingZoo face (robot and human, shared reward)
+  behind RLlib's :class:`ParallelPettingZooEnv`, two policies ``robot`` and ``human`` mapped by
+  agent id, as the reference. RLlib sums the agents' identical rewards into its own episode
+  return; the returns this module reports are the task's (Σ weight × term, counted once), which
+  is the reference's "logged co-op rewards divided by 2".
+* **Clusters**: ``address`` attaches to a running Ray cluster (``ray start --head`` on one
+  machine, ``ray start --address=...`` on the others); env runners then spread over it.
+* A checkpoint is RLlib's own (``Algorithm.save_to_path``) under ``checkpoints/step_<N>/algo``.
+
+RLlib runs apply no observation or return normalisation (the reference's RLlib configs used no
+filter); ``ppo.normalize_*`` are SB3's.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import UsageError
+from .config import TrainingConfig
+from .progress import Progress
+from .run_dir import RunDir
+
+ENV_NAME = "assistive_compiler"
+AGENTS = ("robot", "human")
+SINGLE_MODULE = "default_policy"
+CONNECT_TIMEOUT_S = 3.0
+GCS_WAIT_VAR = "RAY_gcs_server_port_wait_time_s"
+
+
+def make_rllib_env(env_config: dict):
+    """RLlib's env creator: the run's compiled task, as two agents (co-op) or one."""
+    if env_config["coop"]:
+        from ray.rllib.env.wrappers.pettingzoo_env import ParallelPettingZooEnv
+
+        from ..coop.parallel import AssistiveParallelEnv
+
+        return ParallelPettingZooEnv(AssistiveParallelEnv(env_config["artifact_dir"]))
+    from ..runtime.env import AssistiveEnv
+
+    return AssistiveEnv(env_config["artifact_dir"])
+
+
+def check_address(address: str) -> None:
+    """Fail fast, with a message, when nothing listens at a Ray cluster ``address``
+    (``host:port`` or ``ray://host:port``); ``auto`` is left to Ray."""
+    if address == "auto":
+        return
+    target = address.split("://", 1)[-1]
+    host, _, port = target.rpartition(":")
+    if not host or not port.isdigit():
+        raise UsageError(f"--address: expected HOST:PORT or ray://HOST:PORT (e.g. 10.0.0.5:6379), got '{address}'")
+    try:
+        socket.create_connection((host, int(port)), timeout=CONNECT_TIMEOUT_S).close()
+    except OSError as exc:
+        raise UsageError(f"--address: no Ray cluster reachable at {address} ({exc.strerror or exc}); "
+                                             "start one with `ray start --head` there, or leave out --address to train locally") from None
+
+
+def init_ray(address: str | None, envs: int) -> None:
+    """Attach to ``address``, or start a local Ray instance (unless one is already running)."""
+    import ray
+
+    if address:
+        check_address(address)
+    if ray.is_initialized():
+        return
+    if address:
+        # Something answers at the address; give Ray a few seconds (not its default 20) to find a
+        # cluster there. The variable is read when connecting, by this process only.
+        previous = os.environ.get(GCS_WAIT_VAR)
+        os.environ[GCS_WAIT_VAR] = str(int(CONNECT_TIMEOUT_S))
+        try:
+            ray.init(address=address, log_to_driver=False)
+        except (ConnectionError, RuntimeError) as exc:
+            raise UsageError(f"--address: no Ray cluster at {address} ({str(exc).splitlines()[0]}); "
+                             "start one with `ray start --head` there, or leave out --address to train locally") from None
+        finally:
+            if previous is None:
+                os.environ.pop(GCS_WAIT_VAR, None)
+            else:
+                os.environ[GCS_WAIT_VAR] = previous
+    else:
+        ray.init(num_cpus=max(2, envs + 1), include_dashboard=False, log_to_driver=False)
+
+
+def _callbacks_class():
+    from ray.rllib.callbacks.callbacks import RLlibCallback
+
+    class EpisodeTerms(RLlibCallback):
+        """Sums each reward term over an episode (the robot's view: both agents share the reward)
+        and logs, per training iteration, the episodes' return, success and weighted term sums."""
+
+        def on_episode_step(self, *, episode, **kwargs) -> None:
+            info = _task_info(episode.get_infos(-1))
+            if info is None:
+                return
+            sums = episode.custom_data.setdefault("terms", {})
+            for name, value in info["terms"].items():
+                sums[name] = sums.get(name, 0.0) + value
+            episode.custom_data["success"] = info["task_success"]
+
+        def on_episode_end(self, *, episode, env_runner=None, metrics_logger=None, **kwargs) -> None:
+            weights = env_runner.config.env_config["weights"]
+            sums = episode.custom_data.get("terms", {})
+            metrics_logger.log_value(("task", "episodes"), 1, reduce="sum")
+            metrics_logger.log_value(("task", "return"), sum(w * sums.get(n, 0.0) for n, w in weights.items()), reduce="sum")
+            metrics_logger.log_value(("task", "success"), float(episode.custom_data.get("success", 0)), reduce="sum")
+            for name, weight in weights.items():
+                metrics_logger.log_value(("task", "terms", name), weight * sums.get(name, 0.0), reduce="sum")
+
+    return EpisodeTerms
+
+
+def _task_info(infos):
+    """The task's step info from RLlib's per-step infos (one agent's dict, or agent -> dict)."""
+    if not infos:
+        return None
+    if "terms" in infos:
+        return infos
+    robot = infos.get("robot")
+    return robot if robot and "terms" in robot else None
+
+
+def build_config(run: RunDir, config: TrainingConfig, weights: dict[str, float], coop: bool):
+    """RLlib's PPOConfig for this run."""
+    from ray.rllib.algorithms.ppo import PPOConfig
+    from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
+    from ray.tune.registry import register_env
+
+    register_env(ENV_NAME, make_rllib_env)
+    p = config.ppo
+    cfg = (
+        PPOConfig()
+        .environment(ENV_NAME, env_config={"artifact_dir": str(run.artifact.resolve()), "coop": coop, "weights": weights})
+        .framework("torch")
+        .env_runners(num_env_runners=config.envs if config.envs > 1 else 0, num_envs_per_env_runner=1,
+                     rollout_fragment_length=p.rollout_steps, num_cpus_per_env_runner=1)
+        .learners(num_learners=0)
+        .training(train_batch_size_per_learner=config.batch_size, minibatch_size=p.minibatch_size, num_epochs=p.epochs,
+                  gamma=p.gamma, lambda_=p.gae_lambda, lr=p.learning_rate, clip_param=p.clip_range,
+                  vf_loss_coeff=p.value_coef, entropy_coeff=p.entropy_coef, grad_clip=p.max_grad_norm)
+        .rl_module(model_config=DefaultModelConfig(fcnet_hiddens=list(config.network.hidden),
+                                                   fcnet_activation=config.network.activation, vf_share_layers=False))
+        .callbacks(_callbacks_class())
+        .debugging(seed=config.seed, log_level="ERROR")
+    )
+    if coop:
+        cfg = cfg.multi_agent(policies=set(AGENTS), policy_mapping_fn=lambda agent_id, *args, **kwargs: agent_id)
+    return cfg
+
+
+def _record(progress: Progress, result: dict, weights: dict[str, float]) -> None:
+    task = result.get("env_runners", {}).get("task", {})
+    n = int(task.get("episodes", 0))
+    if n:
+        terms = {name: task.get("terms", {}).get(name, 0.0) / n for name in weights}
+        progress.episodes_summary(n, task["return"] / n, task["success"] / n, terms)
+
+
+def save_checkpoint(run: RunDir, algo, steps: int) -> Path:
+    out = run.begin_checkpoint(steps)
+    algo.save_to_path(str((out / "algo").resolve()))
+    run.end_checkpoint(out, steps, {"engine": "rllib"})
+    return out
+
+
+def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, coop: bool, resume: bool,
+          address: str | None = None, quiet: bool = False) -> dict:
+    """Train (or continue) the run to ``config.total_steps`` env steps; Ctrl-C checkpoints and returns."""
+    init_ray(address, config.envs)  # train.train has already started or attached; a no-op then
+    latest = run.latest_checkpoint() if resume else None
+    start_steps = latest[0] if latest else 0
+    algo = build_config(run, config, weights, coop).build_algo()
+    if latest:
+        algo.restore_from_path(str((latest[1] / "algo").resolve()))
+    progress = Progress(run, weights, config.total_steps, start_steps, quiet=quiet)
+    steps, interrupted = start_steps, False
+    every = config.checkpoint_every_steps
+    next_checkpoint = (steps // every + 1) * every
+    try:
+        while steps < config.total_steps:
+            result = algo.train()
+            steps += int(result["env_runners"]["num_env_steps_sampled"])
+            _record(progress, result, weights)
+            progress.update(steps)
+            if steps >= next_checkpoint and steps < config.total_steps:
+                save_checkpoint(run, algo, steps)
+                next_checkpoint = (steps // every + 1) * every
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        save_checkpoint(run, algo, steps)
+        wall = progress.wall_s()
+        rate = (steps - start_steps) / max(1e-9, wall - progress.wall_before)
+        progress.close()
+        algo.stop()
+    if not quiet and interrupted:
+        print("interrupted: checkpoint written", file=sys.stderr)
+    return {"steps": int(steps), "wall_s": wall, "steps_per_s_including_learning": rate, "interrupted": interrupted}
+
+
+# --------------------------------------------------------------------------------------------
+# evaluation side
+
+
+class RLlibPolicy:
+    """A trained RLlib run's policies as plain functions (deterministic: the Gaussian's mean).
+
+    Single agent: ``obs -> action``; co-optimised: ``(robot_obs, human_obs) -> (a_robot, a_human)``.
+    Loads the RLModules from the checkpoint alone: no Ray instance is needed."""
+
+    def __init__(self, checkpoint: Path, coop: bool):
+        from ray.rllib.core.rl_module.rl_module import RLModule
+
+        root = checkpoint / "algo" / "learner_group" / "learner" / "rl_module"
+        names = AGENTS if coop else (SINGLE_MODULE,)
+        self.modules = {name: RLModule.from_checkpoint(str((root / name).resolve())) for name in names}
+        self.coop = coop
+
+    def _act(self, name: str, obs: np.ndarray) -> np.ndarray:
+        import torch
+
+        with torch.no_grad():
+            out = self.modules[name].forward_inference({"obs": torch.as_tensor(obs, dtype=torch.float32)[None]})
+        dist = out["action_dist_inputs"][0].numpy()
+        return dist[: dist.shape[0] // 2]  # a diagonal Gaussian's inputs: means, then log-stds
+
+    def agent(self, name: str):
+        """One co-optimised agent's policy, ``obs -> action``."""
+        return lambda obs: self._act(name, obs)
+
+    def __call__(self, obs: np.ndarray, human_obs: np.ndarray | None = None):
+        if self.coop:
+            return self._act("robot", obs), self._act("human", human_obs)
+        return self._act(SINGLE_MODULE, obs)

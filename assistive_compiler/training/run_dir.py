@@ -1,0 +1,152 @@
+"""A run directory: everything one training run needs to be understood, resumed and evaluated.
+
+Layout (``runs/<task>-<robot>[-coop]-s<seed>/`` by default)::
+
+    run.json          what was trained: spec, robot, co-op, engine, the compiled spec's content
+                      hash, the resolved training config, package versions, the command line
+    config.yaml       the resolved training config (command-line overrides applied)
+    artifact/         the compiled task the run trained on (evaluation rebuilds envs from it)
+    tb/               TensorBoard logs (Episode_Reward/<term>, Episode/success_rate, ...)
+    checkpoints/      step_<N>/ — one directory per checkpoint, resumable
+    curve.csv         the learning curve: env steps, wall seconds, mean return, success rate
+    learning_curve.png
+    summary.json      the run's final figures (steps, wall time, throughput, last returns)
+"""
+
+from __future__ import annotations
+
+import json
+import platform
+import shutil
+import sys
+import time
+from dataclasses import asdict, dataclass
+from importlib import metadata
+from pathlib import Path
+
+import yaml
+
+from ..errors import SpecError, UsageError
+from ..paths import display
+from .config import TrainingConfig
+
+RUN_FILE = "run.json"
+PACKAGES = ("assistive-compiler", "pybullet", "gymnasium", "numpy", "torch", "stable-baselines3", "ray", "pettingzoo")
+
+
+def package_versions() -> dict[str, str | None]:
+    """Versions of the packages a run depends on (None: not installed), and Python's."""
+    out: dict[str, str | None] = {"python": platform.python_version()}
+    for name in PACKAGES:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = None
+    return out
+
+
+@dataclass(frozen=True)
+class RunInfo:
+    """What a run trains; written once to ``run.json`` when the run starts."""
+
+    spec: str
+    task: str
+    robot: str
+    coop: bool
+    engine: str
+    content_hash: str
+    gym_id: str
+    config: dict
+    versions: dict
+    command: list[str]
+    created: str
+
+    @property
+    def training_config(self) -> TrainingConfig:
+        return TrainingConfig.model_validate(self.config)
+
+
+class RunDir:
+    """A run directory on disk (see the module docstring for its layout)."""
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+
+    # -- layout --------------------------------------------------------------------------------
+    artifact = property(lambda self: self.path / "artifact")
+    tb = property(lambda self: self.path / "tb")
+    checkpoints = property(lambda self: self.path / "checkpoints")
+    curve_csv = property(lambda self: self.path / "curve.csv")
+    curve_png = property(lambda self: self.path / "learning_curve.png")
+    summary_json = property(lambda self: self.path / "summary.json")
+
+    def exists(self) -> bool:
+        return (self.path / RUN_FILE).is_file()
+
+    def info(self) -> RunInfo:
+        """The run's ``run.json``; a clear error when ``path`` is not a run directory."""
+        file = self.path / RUN_FILE
+        if not file.is_file():
+            raise UsageError(f"{display(self.path)}: not a run directory (no {RUN_FILE}); `assistive-compiler train` writes one")
+        return RunInfo(**json.loads(file.read_text()))
+
+    def create(self, info: RunInfo, artifact_src: Path) -> None:
+        """Write a new run: its description, config and a copy of the compiled task."""
+        self.path.mkdir(parents=True, exist_ok=True)
+        if self.artifact.exists():
+            shutil.rmtree(self.artifact)
+        shutil.copytree(artifact_src, self.artifact)
+        (self.path / "config.yaml").write_text(yaml.safe_dump(info.config, sort_keys=False))
+        (self.path / RUN_FILE).write_text(json.dumps(asdict(info), indent=1))
+
+    # -- checkpoints ---------------------------------------------------------------------------
+    def checkpoint_dir(self, steps: int) -> Path:
+        return self.checkpoints / f"step_{steps:010d}"
+
+    def latest_checkpoint(self) -> tuple[int, Path] | None:
+        """(env steps, directory) of the newest complete checkpoint, or None."""
+        done = sorted(p for p in self.checkpoints.glob("step_*") if (p / "COMPLETE").is_file()) if self.checkpoints.is_dir() else []
+        if not done:
+            return None
+        return int(done[-1].name.split("_")[1]), done[-1]
+
+    def begin_checkpoint(self, steps: int) -> Path:
+        """A fresh, empty directory for the checkpoint at ``steps`` (replacing an incomplete one)."""
+        out = self.checkpoint_dir(steps)
+        if out.exists():
+            shutil.rmtree(out)
+        out.mkdir(parents=True)
+        return out
+
+    def end_checkpoint(self, out: Path, steps: int, extra: dict | None = None) -> None:
+        """Mark a checkpoint complete: only complete checkpoints are resumed from."""
+        (out / "COMPLETE").write_text(json.dumps({"steps": steps, "time": time.time(), **(extra or {})}))
+
+    # -- results -------------------------------------------------------------------------------
+    def write_summary(self, summary: dict) -> None:
+        self.summary_json.write_text(json.dumps(summary, indent=1))
+
+
+def new_run_info(spec: str, manifest, robot: str, coop: bool, engine: str, config: TrainingConfig) -> RunInfo:
+    return RunInfo(
+        spec=display(Path(spec)), task=manifest.task, robot=robot, coop=coop, engine=engine,
+        content_hash=manifest.content_hash, gym_id=manifest.gym_id + ("" if not coop else " (Human)"),
+        config=config.model_dump(), versions=package_versions(), command=sys.argv[:],
+        created=time.strftime("%Y-%m-%dT%H:%M:%S"),
+    )
+
+
+def check_resumable(run: RunDir, content_hash: str, robot: str, coop: bool, engine: str) -> RunInfo:
+    """The run's info, after checking it trains the same compiled task the same way."""
+    info = run.info()
+    where = display(run.path / RUN_FILE)
+    if info.content_hash != content_hash:
+        raise SpecError.at(
+            where,
+            f"--resume: this run trained a different compiled task (content hash {info.content_hash[:12]}, spec {info.spec}); "
+            f"the spec given compiles to {content_hash[:12]}. Resume with the run's own spec, or start a new run (another --out)",
+        )
+    for what, ours, theirs in (("robot", robot, info.robot), ("--coop", coop, info.coop), ("engine", engine, info.engine)):
+        if ours != theirs:
+            raise SpecError.at(where, f"--resume: this run was trained with {what} {theirs!r}, not {ours!r}")
+    return info

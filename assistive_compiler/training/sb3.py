@@ -1,0 +1,186 @@
+"""Single-agent training on one machine: Stable-Baselines3 PPO over ``envs`` env processes.
+
+The envs are SB3's process-based vector env (:class:`SubprocVecEnv`; one env runs in-process),
+each a :class:`~assistive_compiler.runtime.env.AssistiveEnv` built from the run's compiled
+artifact, optionally behind :class:`VecNormalize` (running observation and return statistics,
+saved with every checkpoint). A checkpoint is a directory holding ``model.zip`` and
+``vecnormalize.pkl``; resuming loads both and continues the step count.
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+import numpy as np
+
+from .config import TrainingConfig
+from ..episode import EpisodeTally
+from .progress import Progress
+from .run_dir import RunDir
+
+ACTIVATIONS = {"tanh": "Tanh", "relu": "ReLU"}
+
+
+def make_monitored_env(artifact_dir: str, in_worker: bool = False):
+    """One env of the vector env: the compiled task behind SB3's episode Monitor. In a worker
+    process Ctrl-C is ignored: the trainer stops the workers after writing its checkpoint."""
+    from stable_baselines3.common.monitor import Monitor
+
+    if in_worker:
+        import signal
+
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    from ..runtime.env import AssistiveEnv
+
+    return Monitor(AssistiveEnv(artifact_dir))
+
+
+def make_vec_env(artifact_dir: Path, n_envs: int, seed: int):
+    """``n_envs`` envs (processes when more than one), seeded ``seed``, ``seed + 1``, ..."""
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
+
+    fns = [functools.partial(make_monitored_env, str(artifact_dir), n_envs > 1) for _ in range(n_envs)]
+    venv = SubprocVecEnv(fns, start_method="forkserver") if n_envs > 1 else DummyVecEnv(fns)
+    venv.seed(seed)
+    return venv
+
+
+def policy_kwargs(config: TrainingConfig) -> dict:
+    import torch.nn as nn
+
+    hidden = list(config.network.hidden)
+    return {"net_arch": {"pi": hidden, "vf": hidden}, "activation_fn": getattr(nn, ACTIVATIONS[config.network.activation])}
+
+
+def _normalized(venv, config: TrainingConfig, checkpoint: Path | None):
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    if not (config.ppo.normalize_observations or config.ppo.normalize_rewards):
+        return venv
+    if checkpoint is not None:
+        return VecNormalize.load(str(checkpoint / "vecnormalize.pkl"), venv)
+    return VecNormalize(venv, norm_obs=config.ppo.normalize_observations, norm_reward=config.ppo.normalize_rewards,
+                        gamma=config.ppo.gamma)
+
+
+def _new_model(venv, config: TrainingConfig, run: RunDir):
+    from stable_baselines3 import PPO
+
+    p = config.ppo
+    return PPO("MlpPolicy", venv, n_steps=p.rollout_steps, batch_size=p.minibatch_size, n_epochs=p.epochs, gamma=p.gamma,
+               gae_lambda=p.gae_lambda, learning_rate=p.learning_rate, clip_range=p.clip_range, ent_coef=p.entropy_coef,
+               vf_coef=p.value_coef, max_grad_norm=p.max_grad_norm, policy_kwargs=policy_kwargs(config),
+               tensorboard_log=str(run.tb), seed=config.seed, device="cpu", verbose=0)
+
+
+def save_checkpoint(run: RunDir, model, steps: int) -> Path:
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    out = run.begin_checkpoint(steps)
+    model.save(str(out / "model.zip"))
+    venv = model.get_env()
+    if isinstance(venv, VecNormalize):
+        venv.save(str(out / "vecnormalize.pkl"))
+    run.end_checkpoint(out, steps, {"engine": "sb3"})
+    return out
+
+
+def _callback(run: RunDir, progress: Progress, config: TrainingConfig, n_envs: int):
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    class RunCallback(BaseCallback):
+        """Per-term episode sums, the learning curve and checkpoints, at the end of each rollout."""
+
+        def __init__(self) -> None:
+            super().__init__()
+            self.tallies = [EpisodeTally() for _ in range(n_envs)]
+            self.next_checkpoint = 0
+
+        def _on_training_start(self) -> None:
+            every = config.checkpoint_every_steps
+            self.next_checkpoint = (self.num_timesteps // every + 1) * every
+
+        def _on_step(self) -> bool:
+            for i, (info, done) in enumerate(zip(self.locals["infos"], self.locals["dones"])):
+                # The rewards SB3 sees may be normalised: the episode's return is the Monitor's.
+                self.tallies[i].add(0.0, info)
+                if done:
+                    tally, self.tallies[i] = self.tallies[i], EpisodeTally()
+                    progress.episode(info["episode"]["r"], info["task_success"], tally.terms)
+            return True
+
+        def _on_rollout_end(self) -> None:
+            for key, value in progress.update(self.num_timesteps).items():
+                self.logger.record(key, value)
+            if self.num_timesteps >= self.next_checkpoint:
+                save_checkpoint(run, self.model, self.num_timesteps)
+                every = config.checkpoint_every_steps
+                self.next_checkpoint = (self.num_timesteps // every + 1) * every
+
+    return RunCallback()
+
+
+def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, resume: bool, quiet: bool = False) -> dict:
+    """Train (or continue) the run to ``config.total_steps``; returns the session's figures.
+
+    Ctrl-C stops after the current env step, writes a checkpoint and returns with
+    ``interrupted: True``; a later ``resume`` continues from it."""
+    import torch
+    from stable_baselines3 import PPO
+
+    torch.set_num_threads(1)  # a 2×64 MLP: more threads only contend with the env processes
+    latest = run.latest_checkpoint() if resume else None
+    start_steps = latest[0] if latest else 0
+    venv = make_vec_env(run.artifact, config.envs, config.seed + start_steps)
+    venv = _normalized(venv, config, latest[1] if latest else None)
+    if latest:
+        model = PPO.load(str(latest[1] / "model.zip"), env=venv, device="cpu")
+        model.set_random_seed(config.seed + start_steps)
+    else:
+        model = _new_model(venv, config, run)
+    progress = Progress(run, weights, config.total_steps, start_steps, quiet=quiet)
+    interrupted = False
+    try:
+        remaining = max(0, config.total_steps - model.num_timesteps)
+        if remaining:
+            model.learn(remaining, callback=_callback(run, progress, config, config.envs), reset_num_timesteps=not latest,
+                        tb_log_name="sb3")
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        steps = model.num_timesteps
+        save_checkpoint(run, model, steps)
+        wall = progress.wall_s()
+        session_rate = (steps - start_steps) / max(1e-9, wall - progress.wall_before)
+        progress.close()
+        venv.close()
+    return {"steps": int(steps), "wall_s": wall, "steps_per_s_including_learning": session_rate, "interrupted": interrupted}
+
+
+# --------------------------------------------------------------------------------------------
+# evaluation side
+
+
+class SB3Policy:
+    """A trained SB3 policy as a function of raw observations (normalised as during training)."""
+
+    def __init__(self, checkpoint: Path):
+        from stable_baselines3 import PPO
+
+        self.model = PPO.load(str(checkpoint / "model.zip"), device="cpu")
+        self.obs_rms = None
+        stats = checkpoint / "vecnormalize.pkl"
+        if stats.is_file():
+            import pickle
+
+            with stats.open("rb") as f:
+                vn = pickle.load(f)
+            self.obs_rms = vn.obs_rms if vn.norm_obs else None
+            self.clip, self.eps = vn.clip_obs, vn.epsilon
+
+    def __call__(self, obs: np.ndarray) -> np.ndarray:
+        if self.obs_rms is not None:
+            obs = np.clip((obs - self.obs_rms.mean) / np.sqrt(self.obs_rms.var + self.eps), -self.clip, self.clip)
+        action, _ = self.model.predict(obs.astype(np.float32), deterministic=True)
+        return action

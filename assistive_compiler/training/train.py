@@ -1,0 +1,142 @@
+"""``train``: compile the task, open (or resume) a run directory, and hand it to an engine.
+
+Engines: ``sb3`` (Stable-Baselines3 PPO, single agent, one machine) and ``rllib`` (Ray RLlib PPO:
+co-optimisation with policies ``robot`` and ``human``, or any run on a Ray cluster via
+``--address``). ``auto`` picks RLlib for ``--coop`` or an ``--address``, SB3 otherwise.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import sys
+import threading
+from pathlib import Path
+
+from ..errors import SpecError, UsageError
+from ..paths import display
+from .config import TrainingConfig, load_training_config
+from .run_dir import RunDir, check_resumable, new_run_info
+
+ENGINES = ("auto", "sb3", "rllib")
+
+
+def choose_engine(engine: str, coop: bool, address: str | None) -> str:
+    from ..errors import did_you_mean, one_of
+
+    if engine not in ENGINES:
+        raise UsageError(f"--engine: unknown engine '{engine}'; expected one of {one_of(ENGINES)}{did_you_mean(engine, ENGINES)}")
+    if engine == "auto":
+        return "rllib" if coop or address else "sb3"
+    if engine == "sb3" and coop:
+        raise UsageError("--coop trains two policies (robot and human): use --engine rllib (or auto)")
+    if engine == "sb3" and address:
+        raise UsageError("--address attaches to a Ray cluster: use --engine rllib (or auto)")
+    return engine
+
+
+def compile_for_run(spec: str, robot: str | None, coop: bool):
+    """Compile the task (cached in the artifact cache) and check it can be trained as asked."""
+    from ..compile.compiler import compile_task
+    from ..registration import cache_dir
+    from ..spec.load import load_spec
+
+    loaded = load_spec(spec)
+    if coop:
+        from ..coop.parallel import check_coop_spec
+
+        check_coop_spec(loaded)  # located: the person must control joints and observe something
+    robot = robot or loaded.spec.robot.default
+    result = compile_task(spec, robot, cache_dir() / f"{loaded.spec.name}-{robot}")
+    return result, robot
+
+
+def reward_weights(manifest) -> dict[str, float]:
+    """Each reward term's weight, by name (preference costs included)."""
+    return {t.name: t.weight for t in manifest.reward}
+
+
+def default_run_dir(task: str, robot: str, coop: bool, seed: int) -> Path:
+    return Path("runs") / f"{task}-{robot}{'-coop' if coop else ''}-s{seed}"
+
+
+def train(spec: str, *, robot: str | None, config_path: str, coop: bool = False, engine: str = "auto",
+          steps: int | None = None, seed: int | None = None, envs: int | None = None, out: str | None = None,
+          resume: bool = False, address: str | None = None, quiet: bool = False) -> dict:
+    """Train a policy for ``spec`` and ``robot`` as ``config_path`` says; returns the run's summary."""
+    engine = choose_engine(engine, coop, address)
+    config: TrainingConfig = load_training_config(config_path).with_overrides(steps=steps, seed=seed, envs=envs)
+    result, robot = compile_for_run(spec, robot, coop)
+    if engine == "rllib":
+        from .rllib import init_ray
+
+        init_ray(address, config.envs)  # an unreachable cluster fails here, before the run directory is written
+    manifest = result.manifest
+    run = RunDir(out or default_run_dir(manifest.task, robot, coop, config.seed))
+    if resume:
+        info = check_resumable(run, manifest.content_hash, robot, coop, engine)
+        resumed = info.training_config
+        for flag, given, kept in (("--seed", seed, resumed.seed), ("--envs", envs, resumed.envs)):
+            if given is not None and given != kept:
+                raise UsageError(f"{flag} {given}: --resume continues the run with its own config ({flag} {kept}); only --steps may change")
+        config = resumed.with_overrides(steps=steps)
+    elif run.exists():
+        raise UsageError(f"{display(run.path)}: the run directory already holds a run; pass --resume to continue it, or choose another --out")
+    else:
+        run.create(new_run_info(spec, manifest, robot, coop, engine, config), result.out_dir)
+    weights = reward_weights(manifest)
+    if not quiet:
+        from .progress import print_reward_table
+
+        print(f"{manifest.gym_id}{' + human (co-optimisation)' if coop else ''}: {engine} PPO, {config.envs} envs, "
+              f"{config.total_steps:,} steps -> {display(run.path)}", file=sys.stderr)
+        print_reward_table(weights, manifest.task)
+    with sigterm_as_interrupt():
+        if engine == "sb3":
+            from . import sb3
+
+            figures = sb3.train(run, config, weights, resume=resume, quiet=quiet)
+        else:
+            from . import rllib
+
+            figures = rllib.train(run, config, weights, coop=coop, resume=resume, address=address, quiet=quiet)
+    return finish(run, manifest, engine, config, figures)
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt():
+    """While training, SIGTERM (a scheduler's or ``kill``'s stop) acts like Ctrl-C: the engine
+    writes a checkpoint and returns. Only the main thread can install signal handlers."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def finish(run: RunDir, manifest, engine: str, config: TrainingConfig, figures: dict) -> dict:
+    """Write the learning-curve figure and ``summary.json``; returns the summary."""
+    from .curves import plot_curves, read_curve
+
+    curve = read_curve(run.curve_csv)
+    tail = curve[-5:]
+    summary = {
+        "gym_id": manifest.gym_id, "engine": engine, **figures,
+        "total_steps_configured": config.total_steps, "envs": config.envs,
+        "episodes": curve[-1]["episodes"] if curve else 0,
+        "final_mean_return": sum(r["mean_return"] for r in tail) / len(tail) if tail else None,
+        "final_success_rate": sum(r["success_rate"] for r in tail) / len(tail) if tail else None,
+        "checkpoint": display(run.latest_checkpoint()[1]) if run.latest_checkpoint() else None,
+    }
+    if curve:
+        plot_curves({run.path.name: curve}, run.curve_png, title=manifest.gym_id)
+        summary["learning_curve"] = display(run.curve_png)
+    run.write_summary(summary)
+    return summary

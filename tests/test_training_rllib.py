@@ -1,0 +1,82 @@
+"""Ray RLlib: multi-agent PPO (policies robot and human) on a co-optimised task against a local
+Ray instance the test starts — one tiny iteration, a checkpoint, a resume, an evaluation of the
+checkpoint — and an unreachable cluster address failing fast with a message."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+pytest.importorskip("ray", reason='needs the "train" extra (README: Training); CI installs it')
+
+from assistive_compiler.cli import main
+from assistive_compiler.training.evaluate import evaluate
+from assistive_compiler.training.run_dir import RunDir
+from assistive_compiler.training.train import train
+
+REPO = Path(__file__).resolve().parents[1]
+FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
+REACH = REPO / "specs" / "examples" / "reach.yaml"
+
+TINY = """\
+algorithm: ppo
+network: {hidden: [32, 32]}
+ppo: {rollout_steps: 200, minibatch_size: 100, epochs: 2, normalize_observations: false, normalize_rewards: false}
+total_steps: 200
+envs: 1
+checkpoint_every_steps: 200
+eval_episodes: 1
+"""
+
+
+@pytest.fixture(scope="module")
+def local_ray():
+    import ray
+
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    yield
+    ray.shutdown()
+
+
+@pytest.mark.slow
+def test_multi_agent_ppo_iteration_checkpoint_resume_evaluate(local_ray, tmp_path):
+    config = tmp_path / "tiny.yaml"
+    config.write_text(TINY)
+    out = tmp_path / "feeding-coop"
+    first = train(str(FEEDING), robot="jaco", config_path=str(config), coop=True, out=str(out), quiet=True)
+    run = RunDir(out)
+    info = run.info()
+    assert (info.engine, info.coop, first["steps"]) == ("rllib", True, 200)
+    steps, checkpoint = run.latest_checkpoint()
+    modules = checkpoint / "algo" / "learner_group" / "learner" / "rl_module"
+    assert steps == 200 and (modules / "robot").is_dir() and (modules / "human").is_dir()
+
+    resumed = train(str(FEEDING), robot="jaco", config_path=str(config), coop=True, out=str(out), resume=True, steps=400, quiet=True)
+    assert resumed["steps"] == 400 and run.latest_checkpoint()[0] == 400
+    rows = (out / "curve.csv").read_text().splitlines()
+    assert [int(r.split(",")[0]) for r in rows[1:]] == [200, 400]
+
+    strip = tmp_path / "coop.png"
+    result = evaluate(out, episodes=1, seed=0, render=str(strip))
+    assert result["engine"] == "rllib" and result["coop"] and result["trained_steps"] == 400
+    assert Image.open(strip).size == (4 * 480, 360)  # a rollout of both trained policies, as a strip of 4 frames
+    assert np.isfinite(result["mean_return"]) and result["per_episode"][0]["seed"] == 0
+    assert evaluate(out, episodes=1, seed=0)["mean_return"] == result["mean_return"]  # deterministic for a seed
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["engine"] == "rllib" and summary["steps"] == 400
+
+
+def test_unreachable_ray_address_fails_fast_with_a_message(tmp_path, capsys):
+    out = tmp_path / "run"
+    t0 = time.perf_counter()
+    code = main(["train", str(REACH), "--config", "ppo_quick", "--address", "127.0.0.1:1", "--out", str(out), "--quiet"])
+    elapsed = time.perf_counter() - t0
+    err = capsys.readouterr().err
+    assert code == 2 and elapsed < 20
+    assert "error: --address: no Ray cluster reachable at 127.0.0.1:1" in err
+    assert not out.exists()
