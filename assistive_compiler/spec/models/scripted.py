@@ -1,0 +1,88 @@
+"""``scripted``: waypoints of the built-in IK baseline, per arm and per robot."""
+
+from __future__ import annotations
+
+from pydantic import Field, model_validator
+
+from .common import Name, Ref, Strict, Vec3
+
+
+class Waypoint(Strict):
+    """A goal for the scripted controller: a point near a target, reached within a tolerance."""
+
+    to: Ref = Field(description="Target or link the goal is relative to, e.g. mouth.")
+    offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Goal offset from that point, world frame, metres.")
+    tolerance_m: float = Field(0.02, ge=0, le=1, description="Distance at which the next waypoint starts, metres.")
+    normal_offset_m: float = Field(
+        0.0, ge=-0.5, le=0.5, description="Offset along the target's outward surface normal (targets drawn on a surface), metres."
+    )
+    axis_offset_m: float = Field(
+        0.0, ge=-0.5, le=0.5, description="Offset along the limb's axis, away from its joint (targets drawn on a surface), metres."
+    )
+    rpy_deg: Vec3 | None = Field(
+        None, description="Orientation of the moved point's link at this waypoint (roll, pitch, yaw; world, degrees), e.g. "
+        "to tilt a cup; None keeps the tool's start orientation."
+    )
+    face_normal_within_deg: float | None = Field(
+        None, ge=0, le=180, description="Turn the tool, by the smallest rotation from its start orientation, until its "
+        "pointing axis (from the end effector to the moved point) lies within this angle of the target's inward surface "
+        "normal (targets drawn on a surface), so the tool meets the surface tip first instead of lying across the limb; "
+        "degrees. None keeps the start orientation (or rpy_deg's)."
+    )
+    step_m: float | None = Field(
+        None, gt=0, le=0.5, description="Largest distance, metres, between the moved point and the goal handed to IK while heading "
+        "for this waypoint: the point then follows the straight line from where it is (e.g. wiping along a limb) instead of the "
+        "joint-space path one IK jump takes. None: IK aims at the waypoint itself."
+    )
+
+
+class _WaypointScript(Strict):
+    """A list of waypoints with an optional repeat_from (ScriptedArm, ScriptedRobot, Scripted)."""
+
+    @model_validator(mode="after")
+    def _repeat_in_range(self) -> "_WaypointScript":
+        if self.repeat_from is not None and self.repeat_from >= len(self.waypoints):  # type: ignore[attr-defined]
+            raise ValueError(f"@repeat_from: repeat_from {self.repeat_from} is not a waypoint index (0..{len(self.waypoints) - 1})")  # type: ignore[attr-defined]
+        return self
+
+
+class ScriptedArm(_WaypointScript):
+    """The left arm's part of a scripted baseline when the robot acts with both arms."""
+
+    move: Ref = Field(description="The point the left arm moves, e.g. scooper_left.blade.")
+    waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order; the last is held unless repeat_from is given.")
+    repeat_from: int | None = Field(None, ge=0, description="After the last waypoint, go on from this index; None holds the last.")
+
+
+class ScriptedRobot(_WaypointScript):
+    """One robot's own script: its waypoints replace the task's for that robot (robots differ in
+    reach and in the wrist orientations they can hold, so one set of waypoints rarely suits all)."""
+
+    move: Ref | None = Field(None, description="The point moved; None: the task's scripted.move.")
+    waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order, replacing scripted.waypoints for this robot; the last is held unless repeat_from is given.")
+    repeat_from: int | None = Field(None, ge=0, description="After the last waypoint, go on from this index (replacing scripted.repeat_from); None holds the last.")
+
+
+class Scripted(_WaypointScript):
+    """A privileged baseline controller (IK each step) that moves a point of the tool through
+    waypoints, keeping the tool's start orientation. It shows the task is solvable and checks the
+    reward wiring; it is not a learned policy."""
+
+    move: Ref = Field(description="The point moved, e.g. spoon (its reference link) or spoon.tip.")
+    waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order; the last is held unless repeat_from is given.")
+    repeat_from: int | None = Field(
+        None, ge=0, description="After the last waypoint, go on from this index (e.g. to rub back and forth); None holds the last."
+    )
+    left: ScriptedArm | None = Field(
+        None, description="The left arm's waypoints when the robot acts with both arms (robot.arm: both, a two-arm robot); "
+        "move/waypoints then drive the right arm. Ignored on one-arm robots."
+    )
+    right: ScriptedArm | None = Field(
+        None, description="The right arm's part when the robot acts with both arms (robot.arm: both, a two-arm robot): it "
+        "replaces move/waypoints/repeat_from there, so that a two-arm script (e.g. lift with both hands) can differ from the "
+        "one-arm script that move/waypoints give. Ignored on one-arm robots."
+    )
+    per_robot: dict[Name, ScriptedRobot] = Field(
+        default_factory=dict, description="Scripts by robot name: the named robot follows its own move/waypoints/repeat_from "
+        "instead of the ones above (left/right still apply to two-arm robots acting with both arms)."
+    )
