@@ -250,6 +250,19 @@ def test_cli_bench_coop(capsys):
     assert out["multi_over_single"] == pytest.approx(out["multi_agent_env_steps_per_s"] / out["single_agent_env_steps_per_s"], rel=1e-2)
 
 
+def test_bench_coop_goes_on_past_the_end_of_an_episode(tmp_path):
+    """bench's default --steps (400) is longer than an episode (200): both envs start a new one
+    when it ends, rather than the PettingZoo env refusing to step a finished episode."""
+    from assistive_compiler.compile.compiler import compile_task
+    from assistive_compiler.coop import bench_coop
+
+    spec = tmp_path / "short.yaml"
+    spec.write_text(f"extends: {TASKS / 'feeding.yaml'}\nsim:\n  episode_steps: 15\n")
+    out = bench_coop(compile_task(spec, "jaco", tmp_path / "short").out_dir, steps=40, repeats=1, chunk=10)
+    assert out["steps_per_repeat"] == 40
+    assert out["single_agent_env_steps_per_s"] > 0 and out["multi_agent_env_steps_per_s"] > 0
+
+
 def test_cli_coop_refuses_a_person_with_nothing_to_control(tmp_path, capsys):
     from assistive_compiler.cli import main
 

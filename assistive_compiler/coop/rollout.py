@@ -35,7 +35,8 @@ def bench_coop(artifact_dir: str | Path, steps: int = 200, repeats: int = 5, see
     and as the multi-agent env (the PettingZoo step, both agents acting), random actions: two envs
     of the artifact side by side, ``repeats`` episodes of ``steps`` each, stepped in alternating
     chunks of ``chunk`` steps (the order flips every chunk), so that the load of a shared machine
-    weighs on both alike. Medians over episodes, and their ratio."""
+    weighs on both alike; where ``steps`` is longer than an episode, both envs start a new one
+    (unseeded, untimed) when it ends. Medians over repeats, and their ratio."""
     from ..runtime.env import AssistiveEnv
 
     single, multi = AssistiveEnv(artifact_dir), AssistiveParallelEnv(artifact_dir)
@@ -57,17 +58,23 @@ def bench_coop(artifact_dir: str | Path, steps: int = 200, repeats: int = 5, see
             multi.step({"robot": draw("robot"), "human": draw("human")})
         return time.perf_counter() - t0
 
+    episode_steps = single.manifest.sim.episode_steps
     rates: dict[str, list[float]] = {"single": [], "multi": []}
     try:
         for r in range(repeats):
             single.reset(seed=seed + r)
             multi.reset(seed=seed + r)
             spent = {"single": 0.0, "multi": 0.0}
-            for k, start in enumerate(range(0, steps, chunk)):
-                n = min(chunk, steps - start)
+            start, k = 0, 0
+            while start < steps:
+                if not multi.agents:  # an episode ended (sim.episode_steps): both go on in a new one, untimed
+                    single.reset()
+                    multi.reset()
+                n = min(chunk, steps - start, episode_steps - multi.env.steps)
                 order = (("single", run_single), ("multi", run_multi))
                 for name, run in order if k % 2 == 0 else order[::-1]:
                     spent[name] += run(n)
+                start, k = start + n, k + 1
             for name in rates:
                 rates[name].append(steps / spent[name])
         reverts = multi.env.human.reverts
