@@ -30,7 +30,7 @@ def test_shipped_configs_validate_and_match_the_schema(path):
 
 
 def test_paper_config_is_the_papers_setup():
-    """Paper §4: 2×64 tanh, 36 actors × 200-step rollouts (7,200 per update), 10 epochs, 10M steps."""
+    """Paper §IV: 2×64 tanh, 36 actors × 200-step rollouts (7,200 per update), 10 epochs, 10M steps."""
     c = load_training_config(REPO / "specs" / "training" / "ppo_paper.yaml")
     assert (c.network.hidden, c.network.activation) == ([64, 64], "tanh")
     assert (c.envs, c.ppo.rollout_steps, c.batch_size, c.ppo.epochs, c.total_steps) == (36, 200, 7200, 10, 10_000_000)

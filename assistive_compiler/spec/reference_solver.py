@@ -28,7 +28,7 @@ REFERENCE_SOLVER: dict[str, dict] = {
     "drinking": {**PYBULLET_DEFAULT_SOLVER, "sub_steps": 4, "iterations": 10},
     "dressing": {**PYBULLET_DEFAULT_SOLVER, "sub_steps": 8},
 }
-"""The reference's ``sim.solver`` per task name (facts §1, "Solver settings")."""
+"""The reference's ``sim.solver`` per task name (the reference implementation, Assistive Gym v1.0: PyBullet's defaults unless a task overrides them)."""
 
 
 def solver_settings(spec: TaskSpec) -> dict:

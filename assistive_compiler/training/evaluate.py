@@ -1,4 +1,4 @@
-"""``evaluate``: roll out a run's trained policy as the reference evaluates (facts §6.2): mean and
+"""``evaluate``: roll out a run's trained policy as the reference evaluates (the reference implementation, Assistive Gym v1.0): mean and
 std of the episode return, of the per-episode mean total force on the person (N) and of the
 final-step task success, over ``episodes`` episodes seeded ``seed``, ``seed + 1``, ...
 

@@ -1,5 +1,5 @@
 """The paper's learned-policy results (Erickson et al., "Assistive Gym: A Physics Simulation
-Framework for Assistive Robotics", ICRA 2020, §4): average reward over 100 rollouts per task and
+Framework for Assistive Robotics", ICRA 2020, §V): average reward over 100 rollouts per task and
 robot, and the success rate of the robot with the highest reward.
 
 Table I: a static person. Table II: an active person (co-optimisation); the paper does not

@@ -96,7 +96,7 @@ def make_tables(run_dirs: list[str], out: str | None = None, episodes: int | Non
         title = PAPER[coop][0]
         header, rows, recs = table_rows(best, coop)
         records += recs
-        parts.append(f"### {title}\n\nMean return over the evaluation episodes, ours (paper, §4); "
+        parts.append(f"### {title}\n\nMean return over the evaluation episodes, ours (paper, §V); "
                      f"Success: the best robot's success rate, ours (paper).\n\n{markdown_table(header, rows)}\n")
     used = sorted({(r["run"], r["episodes"], r["trained_steps"], r["seed"]) for r in best.values()})
     parts.append("Runs: " + "; ".join(f"`{run}` ({steps:,} steps, {n} episodes from seed {s})" for run, n, steps, s in used) + "\n")
