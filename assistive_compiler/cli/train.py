@@ -36,6 +36,11 @@ def cmd_train(args: argparse.Namespace) -> int:
     from ..training.train import choose_engine
 
     engine = choose_engine(args.engine, args.coop, args.address)  # a bad --engine is reported before heavy imports
+    if args.coop:  # a person with nothing to control is the spec's mistake: say so before asking for installs
+        from ..coop.parallel import check_coop_spec
+        from ..spec.load import load_spec
+
+        check_coop_spec(load_spec(args.spec))
     if not require_extra(*engine_modules(engine)):
         return EXIT_FAILED
     from ..training.train import train
