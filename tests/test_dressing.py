@@ -215,10 +215,10 @@ def _cloth_pixels(image: np.ndarray, xy: np.ndarray, half: int = 6) -> float:
 
 def _pixel(env, point, width=480, height=360) -> np.ndarray:
     """Where world ``point`` (m) lands in a render of the task's camera, pixels (x right, y down)."""
-    from assistive_compiler.runtime.camera import _clip_transform, camera_matrices
+    from assistive_compiler.runtime.camera import clip_transform, camera_matrices
 
     view_m, proj = camera_matrices(env.manifest.camera.model_dump(), width, height, env.world.client)
-    clip = _clip_transform(view_m, proj) @ np.array([*point, 1.0])
+    clip = clip_transform(view_m, proj) @ np.array([*point, 1.0])
     return np.array([(clip[0] / clip[3] + 1.0) / 2.0 * width, (1.0 - clip[1] / clip[3]) / 2.0 * height])
 
 

@@ -68,7 +68,7 @@ def render_rgb(env, width: int = 480, height: int = 360, view: dict | None = Non
     return image
 
 
-def _clip_transform(view_m, proj) -> np.ndarray:
+def clip_transform(view_m, proj) -> np.ndarray:
     """4×4 world → clip-space matrix of pybullet's (column-major) view and projection matrices."""
     return np.asarray(proj, dtype=np.float64).reshape(4, 4).T @ np.asarray(view_m, dtype=np.float64).reshape(4, 4).T
 
@@ -83,7 +83,7 @@ def draw_mesh(image: np.ndarray, depth: np.ndarray, vertices: np.ndarray, faces:
     in place, flat shaded from both sides and blended by ``rgba``'s alpha, where it is nearer
     than the depth buffer; ``depth`` is updated where it is drawn."""
     height, width = depth.shape
-    clip = np.c_[np.asarray(vertices, dtype=np.float64), np.ones(len(vertices))] @ _clip_transform(view_m, proj).T
+    clip = np.c_[np.asarray(vertices, dtype=np.float64), np.ones(len(vertices))] @ clip_transform(view_m, proj).T
     w = clip[:, 3]
     px = np.stack([(clip[:, 0] / w + 1.0) / 2.0 * width, (1.0 - clip[:, 1] / w) / 2.0 * height], axis=1)
     scene_m = _view_distance_m(depth)
@@ -124,7 +124,7 @@ def draw_spheres(image: np.ndarray, depth: np.ndarray, spheres, view_m, proj) ->
     """Paint each (position, radius, rgba) sphere onto ``image`` in place, shaded, where nothing in
     the depth buffer (pybullet's, in [0, 1]) is nearer than the sphere's front."""
     height, width = depth.shape
-    to_clip = _clip_transform(view_m, proj)
+    to_clip = clip_transform(view_m, proj)
     scene_m = _view_distance_m(depth)  # distance along the view axis, m
     rows, cols = np.mgrid[0:height, 0:width]
     for pos, radius, rgba in spheres:
