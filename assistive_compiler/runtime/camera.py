@@ -89,7 +89,8 @@ def draw_mesh(image: np.ndarray, depth: np.ndarray, vertices: np.ndarray, faces:
     scene_m = _view_distance_m(depth)
     light = np.asarray(LIGHT_DIRECTION, dtype=np.float64) / np.linalg.norm(LIGHT_DIRECTION)
     colour, alpha = np.asarray(rgba[:3], dtype=np.float64) * 255.0, float(rgba[3])
-    for tri in np.asarray(faces):
+    faces = np.asarray(faces)
+    for tri in faces[np.argsort(-w[faces].mean(axis=1), kind="stable")]:  # far to near: the front blends over the back
         if (w[tri] <= NEAR_M).any():
             continue
         (ax, ay), (bx, by), (cx, cy) = px[tri]
