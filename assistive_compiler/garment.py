@@ -104,6 +104,14 @@ def write_obj(path: str | Path, vertices: np.ndarray, faces: np.ndarray, *, name
     return path
 
 
+def read_obj_faces(path: str | Path) -> np.ndarray:
+    """(M, 3) 0-based vertex indices of an OBJ's triangles (``f`` lines as :func:`write_obj` writes
+    them; ``v/vt/vn`` forms keep their vertex index)."""
+    faces = [[int(tok.split("/")[0]) - 1 for tok in line.split()[1:4]]
+             for line in Path(path).read_text().splitlines() if line.startswith("f ")]
+    return np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+
+
 def ring_indices(ring: int, segments: int) -> np.ndarray:
     """Vertex (= soft-body node) indices of ring ``ring``, in increasing angle."""
     return ring * segments + np.arange(segments)

@@ -199,3 +199,58 @@ def test_scripted_policy_pulls_the_sleeve_onto_the_upper_arm(env):
     # no node strayed: the whole sleeve stays within a metre of the person's shoulder
     shoulder = env.snap.position(env.snap.point({"body": "person", "link": "left_shoulder"}))
     assert np.linalg.norm(_nodes(env) - shoulder, axis=1).max() < 1.0
+
+
+# --------------------------------------------------------------------------------------------
+# Renders: the cloth is drawn where its nodes are, and drawing it changes nothing
+
+
+def _cloth_pixels(image: np.ndarray, xy: np.ndarray, half: int = 6) -> float:
+    """Fraction of the (2·half)² pixels round pixel ``xy`` that have the sleeve's green."""
+    x, y = (int(round(v)) for v in xy)
+    patch = image[max(y - half, 0):y + half, max(x - half, 0):x + half].astype(int)
+    r, g, b = patch[..., 0], patch[..., 1], patch[..., 2]
+    return float(((g > r + 20) & (g > b + 40)).mean())
+
+
+def _pixel(env, point, width=480, height=360) -> np.ndarray:
+    """Where world ``point`` (m) lands in a render of the task's camera, pixels (x right, y down)."""
+    from assistive_compiler.runtime.camera import clip_transform, camera_matrices
+
+    view_m, proj = camera_matrices(env.manifest.camera.model_dump(), width, height, env.world.client)
+    clip = clip_transform(view_m, proj) @ np.array([*point, 1.0])
+    return np.array([(clip[0] / clip[3] + 1.0) / 2.0 * width, (1.0 - clip[1] / clip[3]) / 2.0 * height])
+
+
+def test_first_frame_after_reset_shows_the_sleeve_at_the_hand_not_where_it_was_loaded(env):
+    from assistive_compiler.runtime.camera import render_rgb
+
+    env.reset(seed=0)
+    g = env.world.garments[0]
+    at_hand = _pixel(env, _nodes(env).mean(axis=0))
+    # pybullet's render copy of the soft body is still where the mesh was loaded until a step
+    stale_mesh = np.asarray(pb.getMeshData(g.soft_id, -1, physicsClientId=env.world.client)[1])
+    stale = _pixel(env, stale_mesh.mean(axis=0))
+    assert np.linalg.norm(at_hand - stale) > 50.0  # the two places are far apart in the picture
+    image = render_rgb(env)
+    assert _cloth_pixels(image, at_hand) > 0.5
+    assert _cloth_pixels(image, stale) == 0.0
+
+
+def test_rendering_every_step_changes_no_bit_of_the_episode(env):
+    from assistive_compiler.runtime.camera import render_rgb
+
+    actions = np.random.default_rng(4).uniform(-1, 1, (8, 7))
+
+    def episode(render: bool):
+        obs, _ = env.reset(seed=6)
+        out = [(_nodes(env).copy(), obs.copy(), 0.0)]
+        for a in actions:
+            if render:
+                render_rgb(env, 160, 120)
+            obs, reward, *_ = env.step(a)
+            out.append((_nodes(env).copy(), obs.copy(), reward))
+        return out
+
+    for (x1, o1, r1), (x2, o2, r2) in zip(episode(False), episode(True)):
+        assert np.array_equal(x1, x2) and np.array_equal(o1, o2) and r1 == r2

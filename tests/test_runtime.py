@@ -432,6 +432,29 @@ def test_render_rgb_array(make_env):
     assert len(np.unique(img.reshape(-1, 3), axis=0)) > 10
 
 
+def test_draw_mesh_paints_a_triangle_only_where_nothing_is_nearer():
+    """A triangle 2 m in front of the camera, behind a wall 1 m away covering the left half of
+    the picture: painted (in its colour, shaded) on the right half only, the depth buffer moved
+    to it there, and nothing outside its projection touched."""
+    from assistive_compiler.runtime.camera import FAR_M, NEAR_M, draw_mesh
+
+    width = height = 40
+    view_m = pb.computeViewMatrix([0, 0, 0], [0, 0, -1], [0, 1, 0])
+    proj = pb.computeProjectionMatrixFOV(90.0, 1.0, NEAR_M, FAR_M)
+    depth_of = lambda m: (FAR_M - FAR_M * NEAR_M / m) / (FAR_M - NEAR_M)  # noqa: E731 (buffer value at m)
+    depth = np.full((height, width), depth_of(5.0))
+    depth[:, : width // 2] = depth_of(1.0)
+    image = np.zeros((height, width, 3), dtype=np.uint8)
+    big = [[-1.0, -1.0, -2.0], [1.0, -1.0, -2.0], [0.0, 1.0, -2.0]]  # covers the middle of the view
+    draw_mesh(image, depth, np.array(big), np.array([[0, 1, 2]]), (0.0, 1.0, 0.0, 1.0), view_m, proj)
+    painted = image[..., 1] > 0
+    assert not painted[:, : width // 2].any()  # behind the wall
+    assert painted[28, width // 2 + 1 : width // 2 + 8].all()  # in front of the far background (row 28: 1.85 m wide)
+    assert (image[painted][:, [0, 2]] == 0).all()  # the triangle's colour only
+    assert np.allclose(depth[painted], depth_of(2.0))
+    assert not painted[0].any() and not painted[-1].any()  # outside the triangle (it spans rows 10..30)
+
+
 @pytest.mark.parametrize("suffix", ["png", "gif"])
 def test_cli_render_writes_a_picture(artifact, tmp_path, capsys, suffix):
     from PIL import Image

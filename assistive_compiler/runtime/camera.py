@@ -3,7 +3,13 @@
 **A render never changes the simulation.** It only reads the world: one ``getCameraImage``, then
 the things drawn for people only — shown targets (e.g. the itch), markers not yet wiped, water
 carried in a cup — are painted onto the picture as shaded dots, hidden where the depth buffer
-says something is in front. They are not bodies: moving even a collision-less body reorders
+says something is in front.
+
+Garments (soft bodies) are drawn the same way, from their simulation nodes: TinyRenderer's copy of a
+soft body's mesh is refreshed only by a physics step, so right after ``reset`` (which puts the
+nodes back with ``resetMeshData``) it would draw the cloth where it was before. The renderer hides
+the soft body from ``getCameraImage`` (its colour's alpha set to 0, restored after: a visual
+property only) and rasterises the nodes' triangles onto the picture with the depth buffer. They are not bodies: moving even a collision-less body reorders
 Bullet's broadphase, and with it the contact solver, so a rendered episode would drift from an
 unrendered one with the same seed.
 
@@ -43,22 +49,84 @@ def render_rgb(env, width: int = 480, height: int = 360, view: dict | None = Non
     """An (height, width, 3) uint8 image of the env's current state from the task's camera for
     its robot (``view``: eye / target / fov_deg overriding it)."""
     v = env.manifest.camera.model_dump() | (view or {})
-    c = env.world.client
+    w = env.world
+    c = w.client
     view_m, proj = camera_matrices(v, width, height, c)
-    _, _, rgba, depth, _ = pb.getCameraImage(width, height, view_m, proj, renderer=pb.ER_TINY_RENDERER,
-                                             lightDirection=list(LIGHT_DIRECTION), shadow=0, physicsClientId=c)
+    for g in w.garments:  # TinyRenderer's soft-body mesh may be stale (see the module doc)
+        pb.changeVisualShape(g.soft_id, -1, rgbaColor=[*g.rgba[:3], 0.0], physicsClientId=c)
+    try:
+        _, _, rgba, depth, _ = pb.getCameraImage(width, height, view_m, proj, renderer=pb.ER_TINY_RENDERER,
+                                                 lightDirection=list(LIGHT_DIRECTION), shadow=0, physicsClientId=c)
+    finally:
+        for g in w.garments:
+            pb.changeVisualShape(g.soft_id, -1, rgbaColor=list(g.rgba), physicsClientId=c)
     image = np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3].copy()
     depth = np.asarray(depth, dtype=np.float64).reshape(height, width)
+    for g in w.garments:
+        draw_mesh(image, depth, w.garment_nodes(g), g.faces, g.rgba, view_m, proj)
     draw_spheres(image, depth, overlay_spheres(env), view_m, proj)
     return image
+
+
+def clip_transform(view_m, proj) -> np.ndarray:
+    """4×4 world → clip-space matrix of pybullet's (column-major) view and projection matrices."""
+    return np.asarray(proj, dtype=np.float64).reshape(4, 4).T @ np.asarray(view_m, dtype=np.float64).reshape(4, 4).T
+
+
+def _view_distance_m(depth: np.ndarray) -> np.ndarray:
+    """Distance along the view axis, m, of pybullet's depth buffer values (in [0, 1])."""
+    return FAR_M * NEAR_M / (FAR_M - (FAR_M - NEAR_M) * depth)
+
+
+def draw_mesh(image: np.ndarray, depth: np.ndarray, vertices: np.ndarray, faces: np.ndarray, rgba, view_m, proj) -> None:
+    """Paint a triangle mesh (world-frame ``vertices`` m, ``faces`` vertex indices) onto ``image``
+    in place, flat shaded from both sides and blended by ``rgba``'s alpha, where it is nearer
+    than the depth buffer; ``depth`` is updated where it is drawn."""
+    height, width = depth.shape
+    clip = np.c_[np.asarray(vertices, dtype=np.float64), np.ones(len(vertices))] @ clip_transform(view_m, proj).T
+    w = clip[:, 3]
+    px = np.stack([(clip[:, 0] / w + 1.0) / 2.0 * width, (1.0 - clip[:, 1] / w) / 2.0 * height], axis=1)
+    scene_m = _view_distance_m(depth)
+    light = np.asarray(LIGHT_DIRECTION, dtype=np.float64) / np.linalg.norm(LIGHT_DIRECTION)
+    colour, alpha = np.asarray(rgba[:3], dtype=np.float64) * 255.0, float(rgba[3])
+    faces = np.asarray(faces)
+    for tri in faces[np.argsort(-w[faces].mean(axis=1), kind="stable")]:  # far to near: the front blends over the back
+        if (w[tri] <= NEAR_M).any():
+            continue
+        (ax, ay), (bx, by), (cx, cy) = px[tri]
+        area = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+        if abs(area) < 1e-12:
+            continue
+        c0, c1 = max(int(np.floor(px[tri, 0].min())), 0), min(int(np.ceil(px[tri, 0].max())), width)
+        r0, r1 = max(int(np.floor(px[tri, 1].min())), 0), min(int(np.ceil(px[tri, 1].max())), height)
+        if c0 >= c1 or r0 >= r1:
+            continue
+        ys, xs = np.mgrid[r0:r1, c0:c1] + 0.5
+        l1 = ((cx - bx) * (ys - by) - (cy - by) * (xs - bx)) / area  # barycentric weight of vertex a
+        l2 = ((ax - cx) * (ys - cy) - (ay - cy) * (xs - cx)) / area  # of vertex b
+        l3 = 1.0 - l1 - l2
+        inside = (l1 >= 0) & (l2 >= 0) & (l3 >= 0)
+        inv_w = l1 / w[tri[0]] + l2 / w[tri[1]] + l3 / w[tri[2]]  # 1/w is linear on the screen
+        dist = 1.0 / np.where(inside, inv_w, 1.0)
+        block = scene_m[r0:r1, c0:c1]
+        inside &= dist < block
+        if not inside.any():
+            continue
+        a, b, c = np.asarray(vertices, dtype=np.float64)[tri]
+        normal = np.cross(b - a, c - a)
+        shade = 0.55 + 0.45 * abs(float(normal @ light)) / max(float(np.linalg.norm(normal)), 1e-12)
+        region = image[r0:r1, c0:c1]
+        region[inside] = np.clip((1.0 - alpha) * region[inside] + alpha * shade * colour, 0, 255).astype(np.uint8)
+        block[inside] = dist[inside]
+        depth[r0:r1, c0:c1][inside] = (FAR_M - FAR_M * NEAR_M / dist[inside]) / (FAR_M - NEAR_M)
 
 
 def draw_spheres(image: np.ndarray, depth: np.ndarray, spheres, view_m, proj) -> None:
     """Paint each (position, radius, rgba) sphere onto ``image`` in place, shaded, where nothing in
     the depth buffer (pybullet's, in [0, 1]) is nearer than the sphere's front."""
     height, width = depth.shape
-    to_clip = np.asarray(proj, dtype=np.float64).reshape(4, 4).T @ np.asarray(view_m, dtype=np.float64).reshape(4, 4).T
-    scene_m = FAR_M * NEAR_M / (FAR_M - (FAR_M - NEAR_M) * depth)  # distance along the view axis, m
+    to_clip = clip_transform(view_m, proj)
+    scene_m = _view_distance_m(depth)  # distance along the view axis, m
     rows, cols = np.mgrid[0:height, 0:width]
     for pos, radius, rgba in spheres:
         clip = to_clip @ np.array([*pos, 1.0])

@@ -70,6 +70,8 @@ class GarmentHandle:
     link: int
     grip: tuple  # (position, orientation) of the held frame in the link's URDF frame
     nodes_in_held: np.ndarray  # (n, 3) settled node positions, held frame, m
+    faces: np.ndarray  # (m, 3) node indices of the mesh's triangles (renders draw the cloth from these)
+    rgba: tuple  # colour
 
 
 class World:
@@ -247,7 +249,7 @@ class World:
         :func:`assistive_compiler.garment.load_garment`); it waits parked until :meth:`reset_garments`.
         The garment's body handle has the soft body's id (contacts) and the anchor's pose (its
         ``held`` point)."""
-        from ..garment import load_garment
+        from ..garment import load_garment, read_obj_faces
 
         c = self.client
         self.garments: list[GarmentHandle] = []
@@ -256,7 +258,7 @@ class World:
             sb, anchor = load_garment(pb, c, self.dir / g.obj, park, (0, 0, 0, 1), g.mass, g.collision_margin, g.elastic_stiffness,
                                       g.damping_stiffness, g.bending_stiffness, g.friction, g.anchored, rgba=g.rgba)
             self.garments.append(GarmentHandle(g.name, sb, anchor, self.robot.links[g.parent_link], (g.grip_position, g.grip_orientation),
-                                               np.asarray(g.nodes_in_held, dtype=float)))
+                                               np.asarray(g.nodes_in_held, dtype=float), read_obj_faces(self.dir / g.obj), tuple(g.rgba)))
             self.bodies[g.name] = BodyHandle(g.name, sb, {"held": -1}, {}, ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)), pose_id=anchor)
             if g.collides_with is not None:  # contact with every other body (and the floor) off
                 keep = {b.name for b in self.m.bodies if (b.kind == "person" and "person" in g.collides_with) or b.name in g.collides_with}
