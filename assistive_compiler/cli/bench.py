@@ -87,21 +87,6 @@ def measure_steps(env, steps: int, repeats: int, seed: int) -> tuple[list[float]
     return env_rates, raw_rates, overhead
 
 
-def measure_coop_steps(env, steps: int, repeats: int, seed: int) -> list[float]:
-    """Env steps/s with both agents acting (``step_agents``); empty when the person has no policy joints."""
-    if env.human_action_space is None:
-        return []
-    env.human_action_space.seed(seed)
-    rates = []
-    for r in range(repeats):
-        env.reset(seed=seed + r)
-        t0 = time.perf_counter()
-        for _ in range(steps):
-            env.step_agents(env.action_space.sample(), env.human_action_space.sample())
-        rates.append(steps / (time.perf_counter() - t0))
-    return rates
-
-
 def measure_raw_loop(env, steps: int) -> float:
     """Env steps/s of a bare ``stepSimulation`` loop (frame_skip physics steps each) with the scene at rest."""
     import pybullet as pb
@@ -176,7 +161,6 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
             envs.pop(extra).close()
         env = envs["shipped"]
         env_rates, raw_rates, overhead = rates["shipped"]
-        coop_rates = measure_coop_steps(env, steps, repeats, seed)
         raw_loop = measure_raw_loop(env, steps)
         reset_ms, seeded_ms = measure_resets(env, resets)
         m = env.manifest
@@ -204,7 +188,6 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
         "raw_physics_steps_per_s": round(raw_med, 1),
         "env_over_raw": round(env_med / raw_med, 3),
         "env_overhead_us_per_step": round(statistics.median(overhead), 1),
-        "coop_env_steps_per_s": round(statistics.median(coop_rates), 1) if coop_rates else None,
         "raw_loop_steps_per_s_at_rest": round(raw_loop, 1),
         "reset_ms_median": round(reset_med, 3), "reset_ms_p95": round(reset_p95, 3), "resets": resets,
         "seeded_reset_ms_median": round(statistics.median(seeded_ms), 2),
@@ -215,7 +198,7 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
         "notes": "env/raw: the same episodes, physics timed inside env.step (stepSimulation + gravity compensation) vs the whole step; "
                  "reference_solver: the same episodes and actions on an artifact compiled with the reference's sim.solver, repeats "
                  "interleaved with the shipped ones (when reference_solver_is_shipped, the same figure as env_steps_per_s); random actions; "
-                 "coop: step_agents with both agents acting (None: the person has no policy joints); medians over repeats",
+                 "medians over repeats; both agents acting: bench --coop",
     }
 
 
