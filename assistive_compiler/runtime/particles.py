@@ -29,7 +29,8 @@ step's up has turned more than ``rest.max_turn`` from the remembered one, or its
 exceeds ``rest.max_tilt``: a heap that came to rest tilted stays carried while the cup is held
 at that tilt, and only a turn of the apparent gravity makes it flow. A reset carries them at
 their settled start positions (settled at compile time, so at rest) when the container starts
-within ``max_tilt``. Carried particles are active and inside their container, so they produce no
+within ``max_tilt``. While carried, their weight pushes on the container (:meth:`World.set_load`), as it would
+through their contacts. Carried particles are active and inside their container, so they produce no
 events; renders draw them where they are carried (:meth:`ParticleSystem.visual_spheres`). Every
 decision is a function of the world's state, so seeded episodes stay reproducible.
 """
@@ -125,6 +126,14 @@ class ParticleSystem:
             at[k] = local[k]
             carried[k] = True
             self._park(ids[k], int(k))
+        self._carry_weight(ps)
+
+    def _carry_weight(self, ps: ParticleSet) -> None:
+        """The carried particles' weight (their gravity, N) pushes on the container's link, as it would
+        through their contacts if they were simulated (0 when none are carried)."""
+        w, box = self.world, ps.rest.container
+        holder = w.bodies[box.body]
+        w.set_load(holder.id, holder.links[box.link], float(self.carried[ps.name].sum()) * ps.mass * w.m.sim.gravity)
 
     def _release(self, ps: ParticleSet, ids: list[int]) -> None:
         """Put the carried particles back where they were carried, moving with the container."""
@@ -139,6 +148,7 @@ class ParticleSystem:
             pb.resetBaseVelocity(ids[k], v.tolist(), (0, 0, 0), physicsClientId=c)
         carried[:] = False
         self._still_steps[ps.name] = 0
+        self._carry_weight(ps)
 
     # -- lifecycle -------------------------------------------------------------------------------
     def reset(self) -> None:
@@ -159,6 +169,7 @@ class ParticleSystem:
             if ps.rest is not None:
                 self.carried[ps.name] = np.zeros(ps.count, dtype=bool)
                 self.carried_at[ps.name] = np.zeros((ps.count, 3))
+                self._carry_weight(ps)
                 self._container_velocity.pop(ps.name, None)
                 self._still_steps[ps.name] = 0
                 self._maybe_carry(ps, ids, settled=True)
