@@ -29,10 +29,11 @@ step's up has turned more than ``rest.max_turn`` from the remembered one, or its
 exceeds ``rest.max_tilt``: a heap that came to rest tilted stays carried while the cup is held
 at that tilt, and only a turn of the apparent gravity makes it flow. A reset carries them at
 their settled start positions (settled at compile time, so at rest) when the container starts
-within ``max_tilt``. While carried, their weight pushes on the container (:meth:`World.set_load`), as it would
-through their contacts. Carried particles are active and inside their container, so they produce no
-events; renders draw them where they are carried (:meth:`ParticleSystem.visual_spheres`). Every
-decision is a function of the world's state, so seeded episodes stay reproducible.
+within ``max_tilt``. While carried, their weight pushes on the container
+(:meth:`World.set_load`), as it would through their contacts. Carried particles are active and
+inside their container, so they produce no events; renders draw them where they are carried
+(:meth:`ParticleSystem.visual_spheres`). Every decision is a function of the world's state, so
+seeded episodes stay reproducible.
 """
 
 from __future__ import annotations
@@ -194,18 +195,19 @@ class ParticleSystem:
         free = self.active[name] & ~self.carried[name]
         if not free.any():
             return
+        if self._angle(up, _AXIS) > ps.rest.max_tilt:
+            self._still_steps[name] = 0
+            return
         idx = np.flatnonzero(free)
         world = self._positions([ids[k] for k in idx])
         local = (world - pos) @ rot  # rotᵀ (p − pos), row-wise
-        if not settled and not self._still(ps, ids, idx, world, local, up, com, lin, ang):
-            self._still_steps[name] = 0
-            return
         if not settled:
+            if not self._still(ps, ids, idx, world, local, com, lin, ang):
+                self._still_steps[name] = 0
+                return
             self._still_steps[name] += 1
             if self._still_steps[name] < ps.rest.still_steps:
                 return
-        elif self._angle(up, _AXIS) > ps.rest.max_tilt:
-            return
         full = np.zeros((ps.count, 3))
         full[idx] = local
         self._carry(ps, ids, free, full)
@@ -213,11 +215,11 @@ class ParticleSystem:
         self._still_steps[name] = 0
 
     def _still(self, ps: ParticleSet, ids: list[int], idx: np.ndarray, world: np.ndarray, local: np.ndarray,
-               up: np.ndarray, com: np.ndarray, lin: np.ndarray, ang: np.ndarray) -> bool:
+               com: np.ndarray, lin: np.ndarray, ang: np.ndarray) -> bool:
         """Whether the free particles ``idx`` (world and container-frame positions, m) are still in
-        their container this env step: its effective tilt within the limit, all inside it, and their
-        mean speed relative to it (m/s) at most ``rest.max_speed``."""
-        if self._angle(up, _AXIS) > ps.rest.max_tilt or not self._inside(ps.rest.container, local).all():
+        their container this env step: all inside it, and their mean speed relative to it (m/s) at
+        most ``rest.max_speed``."""
+        if not self._inside(ps.rest.container, local).all():
             return False
         c = self.world.client
         vel = np.array([pb.getBaseVelocity(ids[k], physicsClientId=c)[0] for k in idx], dtype=float)
