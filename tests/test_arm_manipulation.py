@@ -177,7 +177,7 @@ def test_scripted_right_replaces_the_main_script_on_two_arm_robots_only():
     two, one = resolve(loaded, "pr2").scripted, resolve(loaded, "jaco").scripted
     spec = loaded.spec.scripted
     assert len(two["waypoints"]) == len(spec.right.waypoints) and len(one["waypoints"]) == len(spec.waypoints)
-    assert two["waypoints"][-1]["to"]["link"] == "waist" and one["waypoints"][-1]["to"]["link"] == "stomach"
+    assert two["waypoints"][-1]["to"]["link"] == "waist" and one["waypoints"][-1]["to"]["link"] == "right_shoulder"
     assert "left" in two and "left" not in one
 
 
