@@ -219,12 +219,15 @@ class ParticleSet(_Model):
 
 
 class ParticleRest(_Model):
-    """Resting particles ride rigidly in their container while its effective tilt is below ``max_tilt``
-    (see the spec's RestInContainer and :mod:`assistive_compiler.runtime.particles`)."""
+    """Resting particles ride rigidly in their container until its apparent up turns more than
+    ``max_turn`` from where they came to rest or tilts more than ``max_tilt`` (see the spec's
+    RestInContainer and :mod:`assistive_compiler.runtime.particles`)."""
 
     container: Container = Field(description="The container that carries them.")
-    max_tilt: float = Field(description="Effective tilt above which they are simulated again, radians.")
-    max_speed: float = Field(description="Relative speed below which simulated particles count as at rest, m/s.")
+    max_tilt: float = Field(description="Effective tilt above which particles are never carried, radians.")
+    max_turn: float = Field(description="Turn of the apparent up (container frame) since they came to rest above which they are simulated again, radians.")
+    max_speed: float = Field(description="Mean speed relative to the container below which simulated particles are still, m/s.")
+    still_steps: int = Field(description="Env steps in a row they must be still before they are carried.")
 
 
 class MarkerSet(_Model):

@@ -19,12 +19,17 @@ and reports per setting (per-episode figures, then mean ± sd over the seeds):
   time); a kind of joint a task does not have is left out of its table;
 * env steps/s: the episodes' ``env.step`` time (the policy's IK excluded; noisy on a shared machine).
 
+With ``--without-rest`` the compared variant is instead the shipped spec with every particle set's
+``rest`` switched off (``rest: null`` in a spec that ``extends:`` it: the particles are simulated
+every step), at the shipped solver settings: does carrying resting particles change the outcome?
+
 Verdict per metric: the episodes are paired by seed, so the difference (reference − shipped) of
 the per-seed values is bootstrapped (2000 resamples); "within noise" when its 95% interval holds
 0, else "differs". Run e.g.::
 
     .venv/bin/python benchmarks/physics_settings.py specs/tasks/feeding.yaml --robot jaco --seeds 20 \\
         --json out/feeding.json --markdown out/feeding.md
+    .venv/bin/python benchmarks/physics_settings.py specs/tasks/drinking.yaml --robot jaco --without-rest
 """
 
 from __future__ import annotations
@@ -207,6 +212,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--solver", nargs="+", default=[], metavar="KEY=VALUE",
                     help="compare against the reference's settings with these sim.solver keys changed "
                          "(e.g. contact_breaking_threshold_m=0.002: which of the differences matters)")
+    ap.add_argument("--without-rest", action="store_true",
+                    help="compare against the shipped spec with particle sets' rest switched off (always simulated), "
+                         "at the shipped solver settings")
     ap.add_argument("--artifacts", help="where to compile (default: a temporary directory)")
     ap.add_argument("--json", help="write the full result (per-episode figures too) here")
     ap.add_argument("--markdown", help="write the table here")
@@ -241,23 +249,44 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
+def write_rest_off_variant(spec_path: str | Path, spec, out: Path) -> Path | None:
+    """Write the spec file ``out``: the spec at ``spec_path`` with every particle set's ``rest``
+    switched off; None when no set has one."""
+    names = [name for name, ps in spec.particles.items() if ps.rest is not None]
+    if not names:
+        return None
+    out.parent.mkdir(parents=True, exist_ok=True)
+    sets = "".join(f"  {name}:\n    rest: null\n" for name in names)
+    out.write_text(f"# {Path(spec_path).name} with its particles always simulated (benchmarks/physics_settings.py)\n"
+                   f"extends: {Path(spec_path).resolve()}\nparticles:\n{sets}")
+    return out
+
+
 def run(args: argparse.Namespace) -> dict | None:
     """Compile both settings and run the seeds on each; None when there is nothing to compare."""
     spec = load_spec(args.spec).spec
-    ref = reference_solver(spec.name)
-    if ref is None:
-        print(f"{spec.name}: the reference has no such task", file=sys.stderr)
-        return None
-    variant_solver = {**ref, **parse_solver(args.solver)}
-    if variant_solver == solver_settings(spec):
-        print(f"{spec.name}: the shipped solver settings are the compared ones; nothing to compare", file=sys.stderr)
-        return None
-    label = "reference" if not args.solver else "reference with " + ", ".join(args.solver)
-    tag = "reference" if not args.solver else "variant-" + "-".join(args.solver).replace("=", "")
     seeds = list(range(args.first_seed, args.first_seed + args.seeds))
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(args.artifacts or tmp)
-        variant = write_solver_variant(args.spec, variant_solver, root / "specs" / f"{spec.name}-{tag}.yaml")
+        if args.without_rest:
+            variant_solver = solver_settings(spec)
+            label, tag = "rest off (always simulated)", "rest-off"
+            variant = write_rest_off_variant(args.spec, spec, root / "specs" / f"{spec.name}-{tag}.yaml")
+            if variant is None:
+                print(f"{spec.name}: no particle set rests in a container; nothing to compare", file=sys.stderr)
+                return None
+        else:
+            ref = reference_solver(spec.name)
+            if ref is None:
+                print(f"{spec.name}: the reference has no such task", file=sys.stderr)
+                return None
+            variant_solver = {**ref, **parse_solver(args.solver)}
+            if variant_solver == solver_settings(spec):
+                print(f"{spec.name}: the shipped solver settings are the compared ones; nothing to compare", file=sys.stderr)
+                return None
+            label = "reference" if not args.solver else "reference with " + ", ".join(args.solver)
+            tag = "reference" if not args.solver else "variant-" + "-".join(args.solver).replace("=", "")
+            variant = write_solver_variant(args.spec, variant_solver, root / "specs" / f"{spec.name}-{tag}.yaml")
         t0 = time.perf_counter()
         shipped_dir = compile_task(args.spec, args.robot, root / f"{spec.name}-{args.robot}-shipped").out_dir
         variant_dir = compile_task(variant, args.robot, root / f"{spec.name}-{args.robot}-{tag}").out_dir

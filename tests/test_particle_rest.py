@@ -1,8 +1,10 @@
 """Particles resting in a container (``particles.<set>.rest``), on the shipped Drinking task for Jaco
 with real compiles and real pybullet: water in the held, upright cup is carried unsimulated and
-stays; tipping the cup past the limit puts it back into the physics, and past ~90° most of it
-pours out; a cup turned upright again carries what is left; seeded episodes that pour replay bit
-for bit; renders draw carried water where it is; a rest container must be a tool with one.
+stays; simulated water in a held, still cup comes to rest and is carried within a few steps at
+the shipped 4 solver sub-steps, upright or tilted, and a tilted cup keeps it carried until it
+turns further; tipping the cup past the limits puts it back into the physics, and past ~90° most
+of it pours out; a cup turned upright again carries what is left; seeded episodes that pour
+replay bit for bit; renders draw carried water where it is; a rest container must be a tool with one.
 """
 
 from __future__ import annotations
@@ -102,6 +104,45 @@ def test_parked_particles_are_put_back_up_before_they_reach_the_ground(env):
         lowest = min(lowest, min(z))
         assert not any(pb.getContactPoints(bodyA=pid, bodyB=w.ground, physicsClientId=c) for pid in ids)
     assert 1.0 < lowest < 40.0  # they did fall, tens of metres
+
+
+def steps_until_carried(env, limit: int) -> int | None:
+    """Zero-action env steps until all the water is carried (None: not within ``limit``)."""
+    for k in range(1, limit + 1):
+        env.step(np.zeros(env.action_space.shape))
+        if env.particles.carried["water"].all():
+            return k
+    return None
+
+
+def test_simulated_water_in_a_held_still_upright_cup_is_carried_within_a_few_steps(env):
+    """At the shipped 4 solver sub-steps a particle or two of a resting heap rattle at several cm/s;
+    the heap's mean speed still falls below the limit, so the water rests within a few steps."""
+    assert env.manifest.sim.sub_steps == 4
+    env.reset(seed=0)
+    ps, ids = env.particles.sets[0][:2]
+    env.particles._release(ps, ids)
+    assert not env.particles.carried["water"].any()
+    assert steps_until_carried(env, 10) is not None
+    assert inside_cup(env).all() and env.particles.remaining("water") == 64
+
+
+def test_water_at_rest_in_a_held_tilted_cup_is_carried_until_the_cup_turns_further(env):
+    """Tipped 30° (past the 20° turn: simulated again, below the 45° tilt limit) and held, the
+    water settles against the low side and is carried there; it stays carried while the cup is
+    held, and turning the cup 25° further puts it back into the physics."""
+    env.reset(seed=2)
+    tip_cup(env, 0, 30, 5)
+    assert steps_until_carried(env, 30) is not None
+    w = env.world
+    down = np.asarray(pb.getMatrixFromQuaternion(w.base_frame(w.bodies["cup"])[1])).reshape(3, 3)[2] * -1.0  # world −z in the cup frame
+    downhill = down[:2] / np.linalg.norm(down[:2])
+    assert water_in_cup_frame(env)[:, :2].mean(axis=0) @ downhill > 0.01  # the heap lies on the low side (it started centred)
+    for _ in range(20):
+        env.step(np.zeros(env.action_space.shape))
+        assert env.particles.carried["water"].all()
+    tip_cup(env, 30, 55, 3)
+    assert not env.particles.carried["water"].any()
 
 
 def test_tipping_past_the_limit_releases_the_water_and_past_90_degrees_pours_it(env):

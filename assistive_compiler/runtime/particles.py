@@ -13,18 +13,27 @@ filters re-inserts them in the broadphase, which reorders contact pairs, and Bul
 does not restore a multibody's velocity when it wakes — each would make an episode depend on the
 ones before it or change the physics. Events are evaluated once per env step, as in the reference.
 
-**Resting in a container** (a set's ``rest``, optional): while the container's effective tilt —
-the angle between its axis (+z) and the apparent "up" −(g − a), a its acceleration over the last
-env step — is at most ``rest.max_tilt``, particles at rest in it are *carried*: their positions in
-the container frame are kept and the bodies themselves are parked like removed ones, so the
-physics solves none of their contacts. At the start of an env step whose effective tilt exceeds
-the limit they are put back at their carried positions with the container's velocity (linear plus
-ω × r) and simulated. After an env step they are carried again when the tilt is within the limit,
-every active particle is inside the container and none moves faster than ``rest.max_speed``
-relative to it. A reset carries them at their settled start positions when the container starts
-within the limit. Carried particles are active and inside their container, so they produce no
-events; renders draw them where they are carried (:meth:`ParticleSystem.visual_spheres`). Every
-decision is a function of the world's state, so seeded episodes stay reproducible.
+**Resting in a container** (a set's ``rest``, optional): particles at rest in their container
+are *carried*: their positions in the container frame are kept and the bodies themselves are
+parked like removed ones, so the physics solves none of their contacts. The test uses the
+container's apparent "up" −(g − a), a its acceleration over the last env step, written in the
+container's frame. After an env step the free particles come to rest when the container's
+effective tilt (its +z against that up) is at most ``rest.max_tilt``, every active particle is
+inside it and their mean speed relative to it has stayed at most ``rest.max_speed`` for
+``rest.still_steps`` env steps in a row; they are then carried, and the up of that moment is
+remembered. A mean, not the fastest particle: under solver sub-steps a resting heap always has a
+particle or two rattling at several cm/s, while the heap itself creeps at millimetres per second
+(docs/physics.md). At the start of an env step carried particles are put back at their carried
+positions with the container's velocity (linear plus ω × r) and simulated when the last env
+step's up has turned more than ``rest.max_turn`` from the remembered one, or its effective tilt
+exceeds ``rest.max_tilt``: a heap that came to rest tilted stays carried while the cup is held
+at that tilt, and only a turn of the apparent gravity makes it flow. A reset carries them at
+their settled start positions (settled at compile time, so at rest) when the container starts
+within ``max_tilt``. While carried, their weight pushes on the container
+(:meth:`World.set_load`), as it would through their contacts. Carried particles are active and
+inside their container, so they produce no events; renders draw them where they are carried
+(:meth:`ParticleSystem.visual_spheres`). Every decision is a function of the world's state, so
+seeded episodes stay reproducible.
 """
 
 from __future__ import annotations
@@ -37,6 +46,8 @@ import pybullet as pb
 from ..artifact import Container, ParticleSet
 from .snapshot import ParticleEvents, PointHandle, Snapshot
 from .world import PARK, World, rotation_matrix
+
+_AXIS = np.array([0.0, 0.0, 1.0])  # a container's axis in its frame, towards its opening
 
 
 class ParticleSystem:
@@ -55,6 +66,11 @@ class ParticleSystem:
         self.carried: dict[str, np.ndarray] = {}
         self.carried_at: dict[str, np.ndarray] = {}
         self._container_velocity: dict[str, np.ndarray] = {}  # at the end of the last env step, world frame, m/s
+        #: Per set with ``rest``: the apparent up (unit, container frame) at the end of the last env
+        #: step, and when the carried particles came to rest; env steps in a row the free ones were still.
+        self._last_up: dict[str, np.ndarray] = {}
+        self._rest_up: dict[str, np.ndarray] = {}
+        self._still_steps: dict[str, int] = {}
         self._dt = world.m.sim.time_step * world.m.sim.frame_skip
         self._gravity = np.array([0.0, 0.0, world.m.sim.gravity])
         #: Env steps a parked particle may fall before it is put back at its parking spot: the free
@@ -80,15 +96,19 @@ class ParticleSystem:
             pos, orn, com, lin, ang = s[4], s[5], s[0], s[6], s[7]
         return np.asarray(pos), rotation_matrix(orn), np.asarray(com), np.asarray(lin), np.asarray(ang)
 
-    def _tilt(self, name: str, rot: np.ndarray, lin: np.ndarray) -> float:
-        """Effective tilt of a container (radians): its +z against −(g − a)."""
+    def _apparent_up(self, name: str, rot: np.ndarray, lin: np.ndarray) -> np.ndarray:
+        """The apparent up −(g − a) of a container, a its acceleration over the last env step, as a
+        unit vector in its frame (+z: the container's axis, towards its opening)."""
         prev = self._container_velocity.get(name)
         accel = np.zeros(3) if prev is None else (lin - prev) / self._dt
         up = accel - self._gravity
         norm = float(np.linalg.norm(up))
-        if norm < 1e-9:
-            return math.pi
-        return math.acos(max(-1.0, min(1.0, float(rot[:, 2] @ up) / norm)))
+        return np.array([0.0, 0.0, -1.0]) if norm < 1e-9 else rot.T @ (up / norm)
+
+    @staticmethod
+    def _angle(a: np.ndarray, b: np.ndarray) -> float:
+        """Angle between unit vectors (radians)."""
+        return math.acos(max(-1.0, min(1.0, float(a @ b))))
 
     @staticmethod
     def _inside(box: Container, local: np.ndarray) -> np.ndarray:
@@ -107,6 +127,14 @@ class ParticleSystem:
             at[k] = local[k]
             carried[k] = True
             self._park(ids[k], int(k))
+        self._carry_weight(ps)
+
+    def _carry_weight(self, ps: ParticleSet) -> None:
+        """The carried particles' weight (their gravity, N) pushes on the container's link, as it would
+        through their contacts if they were simulated (0 when none are carried)."""
+        w, box = self.world, ps.rest.container
+        holder = w.bodies[box.body]
+        w.set_load(holder.id, holder.links[box.link], float(self.carried[ps.name].sum()) * ps.mass * w.m.sim.gravity)
 
     def _release(self, ps: ParticleSet, ids: list[int]) -> None:
         """Put the carried particles back where they were carried, moving with the container."""
@@ -120,6 +148,8 @@ class ParticleSystem:
             pb.resetBasePositionAndOrientation(ids[k], p.tolist(), (0, 0, 0, 1), physicsClientId=c)
             pb.resetBaseVelocity(ids[k], v.tolist(), (0, 0, 0), physicsClientId=c)
         carried[:] = False
+        self._still_steps[ps.name] = 0
+        self._carry_weight(ps)
 
     # -- lifecycle -------------------------------------------------------------------------------
     def reset(self) -> None:
@@ -140,40 +170,61 @@ class ParticleSystem:
             if ps.rest is not None:
                 self.carried[ps.name] = np.zeros(ps.count, dtype=bool)
                 self.carried_at[ps.name] = np.zeros((ps.count, 3))
+                self._carry_weight(ps)
                 self._container_velocity.pop(ps.name, None)
-                self._maybe_carry(ps, ids)
+                self._still_steps[ps.name] = 0
+                self._maybe_carry(ps, ids, settled=True)
 
     def before_physics(self) -> None:
-        """At the start of an env step: simulate carried particles again if their container tilts too far."""
+        """At the start of an env step: simulate carried particles again if the last env step turned
+        their container's apparent up too far from where they came to rest, or tilted it too far."""
         for ps, ids, _ in self.sets:
             if ps.rest is None or not self.carried[ps.name].any():
                 continue
-            _, rot, _, lin, _ = self._container_state(ps.rest.container)
-            if self._tilt(ps.name, rot, lin) > ps.rest.max_tilt:
+            up = self._last_up[ps.name]
+            if self._angle(up, self._rest_up[ps.name]) > ps.rest.max_turn or self._angle(up, _AXIS) > ps.rest.max_tilt:
                 self._release(ps, ids)
 
-    def _maybe_carry(self, ps: ParticleSet, ids: list[int]) -> None:
-        """After an env step: carry the set's particles if they rest in a container within its tilt limit."""
-        box = ps.rest.container
+    def _maybe_carry(self, ps: ParticleSet, ids: list[int], settled: bool = False) -> None:
+        """After an env step: carry the set's free particles if they have rested in their container
+        (see the module's docstring); ``settled``: at a reset, at their settled start positions."""
+        box, name = ps.rest.container, ps.name
         pos, rot, com, lin, ang = self._container_state(box)
-        tilt = self._tilt(ps.name, rot, lin)
-        self._container_velocity[ps.name] = lin
-        free = self.active[ps.name] & ~self.carried[ps.name]
-        if tilt > ps.rest.max_tilt or not free.any():
+        up = self._last_up[name] = self._apparent_up(name, rot, lin)
+        self._container_velocity[name] = lin
+        free = self.active[name] & ~self.carried[name]
+        if not free.any():
             return
-        c = self.world.client
+        if self._angle(up, _AXIS) > ps.rest.max_tilt:
+            self._still_steps[name] = 0
+            return
         idx = np.flatnonzero(free)
         world = self._positions([ids[k] for k in idx])
         local = (world - pos) @ rot  # rotᵀ (p − pos), row-wise
-        if not self._inside(box, local).all():
-            return
-        vel = np.array([pb.getBaseVelocity(ids[k], physicsClientId=c)[0] for k in idx], dtype=float)
-        relative = vel - (lin + np.cross(ang, world - com))
-        if float(np.max(np.einsum("ij,ij->i", relative, relative))) > ps.rest.max_speed ** 2:
-            return
+        if not settled:
+            if not self._still(ps, ids, idx, world, local, com, lin, ang):
+                self._still_steps[name] = 0
+                return
+            self._still_steps[name] += 1
+            if self._still_steps[name] < ps.rest.still_steps:
+                return
         full = np.zeros((ps.count, 3))
         full[idx] = local
         self._carry(ps, ids, free, full)
+        self._rest_up[name] = up
+        self._still_steps[name] = 0
+
+    def _still(self, ps: ParticleSet, ids: list[int], idx: np.ndarray, world: np.ndarray, local: np.ndarray,
+               com: np.ndarray, lin: np.ndarray, ang: np.ndarray) -> bool:
+        """Whether the free particles ``idx`` (world and container-frame positions, m) are still in
+        their container this env step: all inside it, and their mean speed relative to it (m/s) at
+        most ``rest.max_speed``."""
+        if not self._inside(ps.rest.container, local).all():
+            return False
+        c = self.world.client
+        vel = np.array([pb.getBaseVelocity(ids[k], physicsClientId=c)[0] for k in idx], dtype=float)
+        relative = vel - (lin + np.cross(ang, world - com))
+        return float(np.mean(np.linalg.norm(relative, axis=1))) <= ps.rest.max_speed
 
     def _park(self, pid: int, k: int) -> None:
         """Put particle ``pid`` (index ``k`` in its set) at its parking spot, at rest."""

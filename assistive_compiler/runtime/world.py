@@ -323,7 +323,9 @@ class World:
             forces.append(fz)
         #: Per body: (id, links, z-forces) applied before every physics step; ids in ``parked`` are skipped.
         self.gravity_groups = [(bid, links, forces) for bid, (links, forces) in groups.items()]
-        self._gravity_plan = None  # gravity_groups rearranged for the per-step loop (see _apply_gravity_compensation)
+        self._gravity_plan = None  # gravity_groups and loads rearranged for the per-step loop (see _apply_gravity_compensation)
+        #: (body id, link) → a z-force (N, world frame) applied at the link's centre of mass with the gravity compensation.
+        self.loads: dict[tuple[int, int], float] = {}
         self.parked: set[int] = set()
         pb.setGravity(0, 0, self.world_gravity, physicsClientId=c)
 
@@ -378,17 +380,30 @@ class World:
             if after is not None:
                 after()
 
+    def set_load(self, bid: int, link: int, fz: float) -> None:
+        """Push link ``link`` of body ``bid`` with ``fz`` (N, world z, at its centre of mass) before every
+        physics step until changed; 0 removes it. E.g. the weight of particles a container carries
+        outside the physics (:mod:`.particles`)."""
+        if fz:
+            self.loads[(bid, link)] = fz
+        else:
+            self.loads.pop((bid, link), None)
+        self._gravity_plan = None
+
     def _apply_gravity_compensation(self) -> None:
         c = self.client
         apply, world = pb.applyExternalForce, pb.WORLD_FRAME
         base_pose, link_states = pb.getBasePositionAndOrientation, pb.getLinkStates
         parked = self.parked
         plan = self._gravity_plan
-        if plan is None or plan[0] is not self.gravity_groups:  # per body: base force, child links, their forces (built once)
+        if plan is None or plan[0] is not self.gravity_groups:  # per body: base force, child links, their forces (built on change)
+            per_body: dict[int, dict[int, float]] = {}
+            for (bid, link), fz in [((bid, l), f) for bid, links, forces in self.gravity_groups for l, f in zip(links, forces)] + list(self.loads.items()):
+                on_body = per_body.setdefault(bid, {})
+                on_body[link] = on_body.get(link, 0.0) + fz
             plan = self._gravity_plan = (self.gravity_groups, [
-                (bid, next(((0.0, 0.0, fz) for l, fz in zip(links, forces) if l == -1), None),
-                 [l for l in links if l >= 0], [(0.0, 0.0, fz) for l, fz in zip(links, forces) if l >= 0])
-                for bid, links, forces in self.gravity_groups])
+                (bid, (0.0, 0.0, f[-1]) if -1 in f else None, [l for l in f if l >= 0], [(0.0, 0.0, f[l]) for l in f if l >= 0])
+                for bid, f in per_body.items()])
         # Positional arguments: pybullet parses keywords slowly (0.5 µs per force here, up to 90 per env step).
         for bid, base_force, children, child_forces in plan[1]:
             if bid in parked:

@@ -45,8 +45,9 @@ def settle_particles(rt: ResolvedTask, pc: PlacementClient, name: str, ps, scene
                        lost_body=ps.lost_beyond.body if ps.lost_beyond else None, lost_link=lost_link,
                        lost_distance=ps.lost_beyond.distance_m if ps.lost_beyond else 0.0, lost_anchor=rounded(anchor),
                        hit_body=ps.hit_body, outside_of=_container(rt, ps.consumed_at.outside_of if ps.consumed_at else None),
-                       rest=None if ps.rest is None else ParticleRest(container=_container(rt, ps.rest.container),
-                                                                      max_tilt=math.radians(ps.rest.max_tilt_deg), max_speed=ps.rest.max_speed_mps))
+                       rest=None if ps.rest is None else ParticleRest(
+                           container=_container(rt, ps.rest.container), max_tilt=math.radians(ps.rest.max_tilt_deg),
+                           max_turn=math.radians(ps.rest.max_turn_deg), max_speed=ps.rest.max_speed_mps, still_steps=ps.rest.still_steps))
 
 
 def _drop_grid(pc: PlacementClient, ps, frame_pos, frame_orn) -> list[tuple]:

@@ -74,22 +74,33 @@ class LostBeyond(Strict):
 class RestInContainer(Strict):
     """A simulation shortcut: particles resting in their container ride with it instead of being simulated.
 
-    While the container's effective tilt — the angle between its axis (+z, towards the opening)
-    and the apparent "up" −(g − a), with a the container's acceleration — stays below
-    ``max_tilt_deg``, a heap of particles at rest in it does not flow, so the runtime carries them
-    rigidly in the container's frame and takes them out of the physics (no contacts to solve).
-    Once the tilt exceeds it they are put back where they were carried, with the container's
-    velocity, and simulated again; they rest again once the tilt is below the limit, every active
-    particle is inside the container and none moves faster than ``max_speed_mps`` relative to it.
-    What this trades: sloshing under accelerations below the limit is not simulated.
+    The test reads the container's apparent "up" −(g − a), a its acceleration over the last env
+    step. Simulated particles come to rest when the container's effective tilt (its axis, +z
+    towards the opening, against that up) is at most ``max_tilt_deg``, every active particle is
+    inside it and their mean speed relative to it has stayed at most ``max_speed_mps`` for
+    ``still_steps`` env steps in a row. The runtime then carries them rigidly in the container's
+    frame and takes them out of the physics (no contacts to solve). Once the apparent up has
+    turned more than ``max_turn_deg`` in the container's frame from where they came to rest, or
+    the tilt exceeds ``max_tilt_deg``, they are put back where they were carried, with the
+    container's velocity, and simulated again. What this trades: the heap's slow creep under a
+    turn below ``max_turn_deg`` (a few millimetres for Drinking's water, docs/physics.md) and
+    sloshing under accelerations that turn the apparent up less than that.
     """
 
     container: Ref = Field(description="A tool with a container (e.g. the cup) that carries the resting particles.")
     max_tilt_deg: float = Field(
-        20.0, gt=0, le=60, description="Effective tilt (degrees) above which resting particles are simulated again; keep it below the heap's angle of repose."
+        45.0, gt=0, le=90, description="Effective tilt (degrees) above which particles are never carried; keep a heap "
+        "resting at this tilt, turned by max_turn_deg more, well below the container's rim."
+    )
+    max_turn_deg: float = Field(
+        20.0, gt=0, le=60, description="Turn of the apparent up (degrees, in the container's frame) since the particles "
+        "came to rest above which they are simulated again."
     )
     max_speed_mps: float = Field(
-        0.02, gt=0, le=1, description="Speed relative to the container (m/s) below which simulated particles count as at rest."
+        0.02, gt=0, le=1, description="Mean speed relative to the container (m/s) at most which simulated particles are still."
+    )
+    still_steps: int = Field(
+        2, ge=1, le=100, description="Env steps in a row the particles must be still before they are carried."
     )
 
 
