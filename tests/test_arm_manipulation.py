@@ -168,17 +168,33 @@ def test_a_limited_range_leaves_the_static_limp_arm_where_it_started(jaco):
     assert checked == 4
 
 
-def test_scripted_right_replaces_the_main_script_on_two_arm_robots_only():
-    """scripted.right drives a two-arm robot's right arm; a one-arm robot keeps move/waypoints."""
+def test_scripted_right_replaces_the_main_script_on_two_arm_robots_only(tmp_path):
+    """scripted.right drives a two-arm robot's right arm (over its per_robot script); a one-arm
+    robot keeps move/waypoints."""
+    from assistive_compiler.resolve import resolve
+    from assistive_compiler.spec.load import load_spec
+
+    path = tmp_path / "spec.yaml"
+    path.write_text(f"extends: {SPEC}\nscripted:\n  right:\n    move: scooper_right\n    waypoints:\n"
+                    "      - {to: person.waist, offset_m: [-0.3, 0, 0.1]}\n")
+    loaded = load_spec(path)
+    two, one = resolve(loaded, "pr2").scripted, resolve(loaded, "jaco").scripted
+    assert [w["to"]["link"] for w in two["waypoints"]] == ["waist"]
+    assert len(one["waypoints"]) == len(loaded.spec.scripted.waypoints) and one["waypoints"][-1]["to"]["link"] == "right_shoulder"
+    assert "left" in two and "left" not in one
+
+
+def test_two_arm_robots_sweep_with_the_left_arm_and_their_own_right_arm_script():
+    """The shipped spec: the left arm of a two-arm robot follows the one-arm sweep (a YAML alias of
+    the same waypoints); each two-arm robot's right arm follows its per_robot script."""
     from assistive_compiler.resolve import resolve
     from assistive_compiler.spec.load import load_spec
 
     loaded = load_spec(SPEC)
-    two, one = resolve(loaded, "pr2").scripted, resolve(loaded, "jaco").scripted
-    spec = loaded.spec.scripted
-    assert len(two["waypoints"]) == len(spec.right.waypoints) and len(one["waypoints"]) == len(spec.waypoints)
-    assert two["waypoints"][-1]["to"]["link"] == "waist" and one["waypoints"][-1]["to"]["link"] == "stomach"
-    assert "left" in two and "left" not in one
+    one, pr2, baxter = (resolve(loaded, r).scripted for r in ("sawyer", "pr2", "baxter"))
+    assert pr2["left"]["waypoints"] == one["waypoints"] == baxter["left"]["waypoints"]
+    assert pr2["left"]["move"]["body"] == "scooper_left" and pr2["move"]["body"] == "scooper_right"
+    assert pr2["waypoints"][0]["to"]["link"] == "right_wrist" and baxter["waypoints"][0]["to"]["link"] == "waist"
 
 
 # --------------------------------------------------------------------------------------------

@@ -508,12 +508,13 @@ def test_scripted_per_robot_names_known_robots(tmp_path, capsys):
 
 
 def test_scripted_per_robot_waypoints_are_checked_where_written(tmp_path, capsys):
-    text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    jaco:\n      waypoints: [{{to: person.right_elbow}}]\n      repeat_from: 1\n"
+    # Panda: a robot without a script of its own in the shipped spec (an override merges with a shipped one).
+    text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    panda:\n      waypoints: [{{to: person.right_elbow}}]\n      repeat_from: 1\n"
     path = write(tmp_path, text)
     line, column = at(text, "repeat_from: 1").split(":")
-    check(capsys, path, f"{line}:{int(column) + len('repeat_from: ')}: scripted.per_robot.jaco.repeat_from: "
+    check(capsys, path, f"{line}:{int(column) + len('repeat_from: ')}: scripted.per_robot.panda.repeat_from: "
                         "repeat_from 1 is not a waypoint index (0..0)")
-    text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    jaco:\n      waypoints: [{{to: person.right_elbw}}]\n"
+    text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    panda:\n      waypoints: [{{to: person.right_elbw}}]\n"
     path = write(tmp_path, text)
     lines = problems(capsys, path)
     assert len(lines) == 1 and lines[0].startswith(f"{display(path)}:{at(text, 'person.right_elbw')}: ") \

@@ -73,6 +73,15 @@ def clip_transform(view_m, proj) -> np.ndarray:
     return np.asarray(proj, dtype=np.float64).reshape(4, 4).T @ np.asarray(view_m, dtype=np.float64).reshape(4, 4).T
 
 
+def to_pixels(points, to_clip: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    """Image coordinates (column, row; pixels, origin at the top-left corner) of world-frame
+    ``points`` (n × 3, m) under the world → clip matrix ``to_clip``, and each point's distance
+    along the view axis (m; the clip-space w)."""
+    clip = np.c_[np.asarray(points, dtype=np.float64).reshape(-1, 3), np.ones(len(points))] @ to_clip.T
+    w = clip[:, 3]
+    return np.stack([(clip[:, 0] / w + 1.0) / 2.0 * width, (1.0 - clip[:, 1] / w) / 2.0 * height], axis=1), w
+
+
 def _view_distance_m(depth: np.ndarray) -> np.ndarray:
     """Distance along the view axis, m, of pybullet's depth buffer values (in [0, 1])."""
     return FAR_M * NEAR_M / (FAR_M - (FAR_M - NEAR_M) * depth)
@@ -83,9 +92,7 @@ def draw_mesh(image: np.ndarray, depth: np.ndarray, vertices: np.ndarray, faces:
     in place, flat shaded from both sides and blended by ``rgba``'s alpha, where it is nearer
     than the depth buffer; ``depth`` is updated where it is drawn."""
     height, width = depth.shape
-    clip = np.c_[np.asarray(vertices, dtype=np.float64), np.ones(len(vertices))] @ clip_transform(view_m, proj).T
-    w = clip[:, 3]
-    px = np.stack([(clip[:, 0] / w + 1.0) / 2.0 * width, (1.0 - clip[:, 1] / w) / 2.0 * height], axis=1)
+    px, w = to_pixels(vertices, clip_transform(view_m, proj), width, height)
     scene_m = _view_distance_m(depth)
     light = np.asarray(LIGHT_DIRECTION, dtype=np.float64) / np.linalg.norm(LIGHT_DIRECTION)
     colour, alpha = np.asarray(rgba[:3], dtype=np.float64) * 255.0, float(rgba[3])
@@ -128,13 +135,12 @@ def draw_spheres(image: np.ndarray, depth: np.ndarray, spheres, view_m, proj) ->
     to_clip = clip_transform(view_m, proj)
     scene_m = _view_distance_m(depth)  # distance along the view axis, m
     rows, cols = np.mgrid[0:height, 0:width]
-    for pos, radius, rgba in spheres:
-        clip = to_clip @ np.array([*pos, 1.0])
-        w = clip[3]  # distance along the view axis, m
+    if not spheres:
+        return
+    centres_px, distances_m = to_pixels([pos for pos, _, _ in spheres], to_clip, width, height)
+    for (x, y), w, (_, radius, rgba) in zip(centres_px, distances_m, spheres):
         if w <= NEAR_M + radius:
             continue
-        x = (clip[0] / w + 1.0) / 2.0 * width
-        y = (1.0 - clip[1] / w) / 2.0 * height
         r_px = max(1.5, radius * to_clip[1, 1] * height / 2.0 / w)
         d2 = ((cols + 0.5 - x) ** 2 + (rows + 0.5 - y) ** 2) / r_px**2
         inside = (d2 <= 1.0) & (scene_m >= w - radius)
