@@ -1,15 +1,20 @@
 """pybullet IK options shared by the compile-time placement and the scripted policy: which joints
-IK may move (a mobile base's drive must not: reaching is the arm's job) and how limits apply."""
+IK may move (the placement's reach checks freeze a mobile base's drive: reaching there is the arm's
+job), how readily it moves a drive the scripted policy may drive, and how limits apply."""
 
 from __future__ import annotations
 
 FROZEN_DAMPING = 1e6  # IK damping of joints IK must not move (pybullet's default is 0.1)
+DRIVE_DAMPING = 0.1  # IK damping of a drive's planar joints that the scripted policy drives: pybullet's default
 
 
-def ik_damping(movable: list[int], frozen: list[int]) -> list[float] | None:
+def ik_damping(movable: list[int], frozen: list[int], driven: list[int] = ()) -> list[float] | None:
     """Per movable joint, pybullet's IK damping: huge for ``frozen`` joints (a mobile base's drive,
-    which reaching must not move), the default elsewhere; None when nothing is frozen."""
-    return [FROZEN_DAMPING if j in frozen else 0.1 for j in movable] if frozen else None
+    which reaching must not move), DRIVE_DAMPING for ``driven`` ones (a drive IK may move), the
+    default elsewhere; None when nothing is frozen or driven."""
+    if not frozen and not driven:
+        return None
+    return [FROZEN_DAMPING if j in frozen else DRIVE_DAMPING if j in driven else 0.1 for j in movable]
 
 
 def ik_limits(chain, rest) -> dict:

@@ -525,10 +525,26 @@ def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, 
     rc = main(["bench", str(SPEC), str(fewer), "--robot", "jaco", "--steps", "10", "--repeats", "1", "--resets", "2"])
     out = capsys.readouterr().out
     assert out.splitlines()[0].split() == ["task", "robot", "env_steps_per_s", "env_steps_per_s_reference_solver", "raw_physics_steps_per_s",
-                                           "reset_ms_median", "reference_env_steps_per_s", "vs_reference", "vs_reference_at_reference_solver"]
+                                           "env_over_raw", "reset_ms_median", "reference_env_steps_per_s", "vs_reference",
+                                           "vs_reference_at_reference_solver"]
     rows = [line.split() for line in out.splitlines() if line.split()[:1] == ["feeding"]]
-    assert len(rows) == 2 and all(r[1] == "jaco" and r[6] == "248" for r in rows)
+    assert len(rows) == 2 and all(r[1] == "jaco" and r[7] == "248" for r in rows)
     assert float(rows[0][2]) == float(rows[0][3])  # shipped = reference settings: the same figure in both columns
+
+
+@pytest.mark.slow
+def test_cli_bench_takes_several_robots_one_row_per_spec_and_robot(capsys):
+    """Issue 19: bench for Stretch in the same run as Jaco. --robot may be repeated and --robots
+    takes compare's comma list; each robot is measured once, one row per spec x robot, in order."""
+    from assistive_compiler.cli import main
+
+    rc = main(["bench", str(SPEC), "--robot", "jaco", "--robots", "stretch,jaco", "--steps", "5", "--repeats", "1", "--resets", "1", "--json"])
+    assert rc == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [(r["task"], r["robot"], r["action_size"]) for r in rows] == [("feeding", "jaco", 7), ("feeding", "stretch", 5)]
+    assert rows[0]["reference_env_steps_per_s"] == 248 and rows[1]["reference_env_steps_per_s"] is None  # not measured for Stretch
+    for r in rows:
+        assert r["env_over_raw"] == pytest.approx(r["env_steps_per_s"] / r["raw_physics_steps_per_s"], abs=2e-3)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -157,3 +157,51 @@ def test_base_search_ranks_poses_by_isotropy_for_a_three_joint_arm(scratch_env):
     placement = scratch_env.manifest.robot.placement
     poses = [p for variant in placement.values() for p in variant["base_poses"]] if isinstance(placement, dict) else []
     assert poses and all(0.0 < p["jlwki"] <= p["goals_reached"] + 1e-9 for p in poses)
+
+
+def test_wheel_actions_for_a_planar_change_invert_the_drive(scratch_env):
+    # BaseDriveControl.wheels_for is the inverse of motion: forward and turn come back, and a
+    # change too large for one step is shortened along the same arc (both wheels scaled alike).
+    drive = scratch_env.drive
+    wheels = drive.wheels_for(0.01, 0.05)
+    assert np.allclose(drive.motion(wheels), (0.01, 0.05))
+    big = drive.wheels_for(0.5, 0.2)
+    assert np.max(np.abs(big)) == pytest.approx(1.0)
+    forward, turn = drive.motion(big)
+    assert turn / forward == pytest.approx(0.2 / 0.5)
+
+
+def _drive_to_goal(env, ahead_m: float, steps: int) -> tuple[list[np.ndarray], float]:
+    """Scripted actions of ``steps`` steps towards a goal ``ahead_m`` along the base's heading from
+    where the scratcher's tip starts (the arm alone reaches about ±0.2 m that way, by the wrist's
+    swing), and the tip's final distance to it (m)."""
+    from assistive_compiler.policies.scripted import ScriptedPolicy
+
+    obs, _ = env.reset(seed=0)
+    policy = ScriptedPolicy(env)
+    actions = [policy(obs)]  # the first call reads the episode's start
+    track, snap = policy.tracks[0], env.snap
+    w = env.world
+    heading = pb.getMatrixFromQuaternion(pb.getLinkState(w.robot.id, env.drive.base_link, physicsClientId=w.client)[1])[0::3]
+    goal = snap.position(track.move) + ahead_m * np.asarray(heading)
+    # One fixed goal in the world instead of the task's waypoints, held to the end.
+    track.waypoints, track.orientations, track.face_normal, track.steps_m, track.repeat_from = [None], [None], [None], [None], None
+    policy._goal = lambda _track: (goal, 0.0)
+    for _ in range(steps):
+        obs, *_ = env.step(actions[-1])
+        actions.append(policy(obs))
+    return actions, float(np.linalg.norm(snap.position(track.move) - goal))
+
+
+def test_scripted_policy_drives_the_base_to_a_goal_beyond_the_arm(scratch_env):
+    # Issue 19: the scripted policy drives a mobile base. A goal 0.5 m ahead along the heading is
+    # out of the arm's reach (it extends sideways); the wheels take the tool there, and the
+    # actions are the same when the episode is replayed.
+    env = scratch_env
+    actions, miss = _drive_to_goal(env, 0.5, 60)
+    x, y, yaw = _drive_state(env)
+    assert miss < 0.03
+    assert x > 0.2  # it drove forward (and turned, the wrist yawing back: the IK's choice)
+    assert any(abs(a[0]) > 0.5 and abs(a[1]) > 0.5 for a in actions)
+    again, _ = _drive_to_goal(env, 0.5, 60)
+    assert all(np.array_equal(a, b) for a, b in zip(actions, again))

@@ -202,9 +202,9 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
     }
 
 
-BENCH_TABLE = ("task", "robot", "env_steps_per_s", "env_steps_per_s_reference_solver", "raw_physics_steps_per_s", "reset_ms_median",
+BENCH_TABLE = ("task", "robot", "env_steps_per_s", "env_steps_per_s_reference_solver", "raw_physics_steps_per_s", "env_over_raw", "reset_ms_median",
                "reference_env_steps_per_s", "vs_reference", "vs_reference_at_reference_solver")
-"""The columns of ``bench``'s table for several specs."""
+"""The columns of ``bench``'s table for several specs or robots."""
 
 BENCH_COOP_TABLE = ("task", "robot", "single_agent_env_steps_per_s", "multi_agent_env_steps_per_s", "multi_over_single")
 """The columns of ``bench --coop``'s table for several specs."""
@@ -222,18 +222,26 @@ def bench_coop_spec(spec: str, robot: str | None, steps: int, repeats: int, seed
         return bench_coop(compile_task(spec, robot, Path(tmp) / "coop").out_dir, steps=steps, repeats=repeats, seed=seed)
 
 
+def bench_robots(args: argparse.Namespace) -> list[str | None]:
+    """The robots ``bench`` measures: every ``--robot`` and the names in ``--robots`` (comma-separated,
+    as ``compare`` takes them), in order, each once; [None] (each spec's default robot) for none."""
+    names = list(args.robot or []) + [r.strip() for r in (args.robots or "").split(",") if r.strip()]
+    return list(dict.fromkeys(names)) or [None]
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
     from .output import cell, print_table, progress
 
     results = []
-    with progress("bench", len(args.specs)) as tracker:
-        for spec in args.specs:
+    pairs = [(spec, robot) for spec in args.specs for robot in bench_robots(args)]
+    with progress("bench", len(pairs)) as tracker:
+        for spec, robot in pairs:
             if args.coop:
-                r = bench_coop_spec(spec, args.robot, args.steps, args.repeats, args.seed)
+                r = bench_coop_spec(spec, robot, args.steps, args.repeats, args.seed)
                 tracker.done(f"{r['name']}: {r['multi_agent_env_steps_per_s']} multi-agent env steps/s, "
                              f"{r['multi_over_single']} x single-agent ({spec})")
             else:
-                r = bench(spec, args.robot, args.steps, args.resets, args.repeats, args.seed)
+                r = bench(spec, robot, args.steps, args.resets, args.repeats, args.seed)
                 tracker.done(f"{r['gym_id']}: {r['env_steps_per_s']} env steps/s ({spec})")
             results.append(r)
     if args.json:
@@ -244,7 +252,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         print_table(["figure", "value"], [[key, cell(value)] for key, value in figures.items()], left=["figure", "value"],
                     caption=f"notes: {results[0]['notes']}")
         return EXIT_OK
-    # Several tasks: one row each (taken one after the other in this run; medians over repeats).
+    # Several tasks or robots: one row per spec x robot (taken one after the other in this run; medians over repeats).
     columns = BENCH_COOP_TABLE if args.coop else BENCH_TABLE
     print_table(columns, [[cell(r[k]) for k in columns] for r in results], left=("task", "robot"))
     return EXIT_OK
@@ -254,7 +262,8 @@ def add_commands(sub) -> None:
     p = sub.add_parser("bench", help="speed figures taken in one run: steps/s vs raw physics and the reference, resets, compile, import, RSS")
     add_library_argument(p)
     p.add_argument("specs", nargs="+", metavar="spec", help="task spec file(s); several print one row each")
-    p.add_argument("--robot", help="robot (default: each spec's default)")
+    p.add_argument("--robot", action="append", help="robot (default: each spec's default); may be given several times: one row per spec x robot")
+    p.add_argument("--robots", help="comma-separated robot names, e.g. jaco,stretch (as compare takes them); with --robot, both count")
     p.add_argument("--seed", type=int, default=0, help="seed of the first repeat's episode and of the random actions")
     p.add_argument("--steps", type=int, default=400, help="env steps per repeat")
     p.add_argument("--repeats", type=int, default=5)

@@ -82,8 +82,10 @@ class ScriptedPolicy:
         self.lo_all = [pb.getJointInfo(robot.id, j, physicsClientId=c)[8] for j in movable]
         self.hi_all = [pb.getJointInfo(robot.id, j, physicsClientId=c)[9] for j in movable]
         self.ranges = [max(h - l, 1e-3) for l, h in zip(self.lo_all, self.hi_all)]
-        # A mobile base stays put: the script reaches with the arm (its wheel actions are 0).
-        self.damping = ik_damping(movable, env.drive.idx if env.drive else [])
+        # A mobile base drives: IK moves its planar joints with the arm, and the wheel actions head
+        # for the planar change it asks of the base (see :meth:`_wheels`).
+        self.damping = ik_damping(movable, [], env.drive.idx if env.drive else [])
+        self.drive_cols = [movable.index(j) for j in env.drive.idx] if env.drive else []
         self.arm_offset = 2 if env.drive else 0
 
     def _goal(self, track: _Track) -> tuple[np.ndarray, float]:
@@ -165,4 +167,13 @@ class ScriptedPolicy:
             step = np.array([np.mean([sol[k] - rest[k] for k in group]) for group in track.cols])
             cols = track.action_cols
             action[[self.arm_offset + k for k in cols]] = np.clip(step / env.delta_scale[cols], -1.0, 1.0)
+            if self.drive_cols and track is self.tracks[0]:
+                action[:2] = self._wheels(sol, rest)
         return action
+
+    def _wheels(self, sol, rest) -> np.ndarray:
+        """Wheel actions (right, left) towards the base's planar change in the IK solution ``sol``
+        from the joint positions ``rest``: forward along the heading and the turn, the sideways
+        part dropped (the base cannot move sideways; the arm and later steps' IK make it up)."""
+        dx, dy, dyaw = (sol[k] - rest[k] for k in self.drive_cols)
+        return self.env.drive.wheels_towards(dx, dy, dyaw)

@@ -71,10 +71,33 @@ class BaseDriveControl:
         r = self.d.wheel_radius
         return r * (right + left) / 2.0, r * (right - left) / self.d.wheel_separation
 
-    def targets(self, wheels: np.ndarray) -> list[float]:
-        """x, y, yaw targets: the measured pose moved as the wheels roll."""
+    def wheels_for(self, forward: float, turn: float) -> np.ndarray:
+        """Wheel actions (right, left) for one env step moving the base ``forward`` m along its
+        heading and turning it ``turn`` rad: the inverse of :meth:`motion`. Where a wheel would
+        need more than ±1, both are scaled down by the same factor, so the base follows the same
+        arc, only a shorter piece of it."""
+        r, half = self.d.wheel_radius, self.d.wheel_separation / 2.0
+        wheels = np.array([forward + turn * half, forward - turn * half]) / (r * self.wheel_turn)
+        return wheels / max(1.0, float(np.max(np.abs(wheels))))
+
+    def pose(self) -> tuple[float, float, float]:
+        """The base's planar pose in the placed root frame: x, y (m), yaw (rad)."""
         w = self.world
         x, y, yaw = (s[0] for s in pb.getJointStates(w.robot.id, self.idx, physicsClientId=w.client))
+        return x, y, yaw
+
+    def wheels_towards(self, dx: float, dy: float, dyaw: float) -> np.ndarray:
+        """Wheel actions (right, left) heading for a planar change of the base (dx, dy m in the
+        root frame, dyaw rad). The base cannot move sideways: the change is projected onto its
+        heading (the sideways part is dropped; a goal off to the side is reached by turning,
+        which the change's dyaw asks for, or by the arm)."""
+        yaw = self.pose()[2]
+        forward = dx * math.cos(yaw) + dy * math.sin(yaw)
+        return self.wheels_for(forward, dyaw)
+
+    def targets(self, wheels: np.ndarray) -> list[float]:
+        """x, y, yaw targets: the measured pose moved as the wheels roll."""
+        x, y, yaw = self.pose()
         forward, turn = self.motion(wheels)
         heading = yaw + turn / 2.0
         goal = (x + forward * math.cos(heading), y + forward * math.sin(heading), yaw + turn)
