@@ -349,36 +349,6 @@ def test_water_in_the_upright_cup_is_neither_drunk_nor_spilled(drinking):
     assert info["terms"]["cup_tilt"] < math.radians(10)
 
 
-def test_a_target_frame_waypoint_turns_with_the_head(drinking):
-    """frame: target: the pour waypoint's offset and rpy_deg are in the frame of the mouth's link
-    (person.head), so with the head turned the goal and the tipped cup turn with it."""
-    from assistive_compiler.policies.scripted import ScriptedPolicy
-
-    env = drinking
-    policy = ScriptedPolicy(env)
-    env.reset(seed=0)
-    policy._start_episode()
-    track = policy.tracks[0]
-    track.index = len(track.waypoints) - 1  # the pour
-    spec_offset = track.waypoints[track.index][1]
-    c = env.world.client
-    person = env.world.variant_bodies[env.world.active_variant.name]
-    mouth = env.snap.point({"target": "mouth"})
-    seen = []
-    for angles in ((0.0, 0.0, 0.0), (0.45, -0.2, 0.4)):  # head_x, head_y, head_z, rad
-        for name, angle in zip(("head_x", "head_y", "head_z"), angles):
-            pb.resetJointState(person.id, person.joints[name], angle, physicsClientId=c)
-        env.snap.refresh()
-        head_pos, head_orn = pb.getLinkState(person.id, person.links["head"], computeForwardKinematics=1, physicsClientId=c)[4:6]
-        world_to_head = np.asarray(pb.getMatrixFromQuaternion(head_orn)).reshape(3, 3).T
-        goal, _ = policy._goal(track)
-        np.testing.assert_allclose(world_to_head @ (goal - env.snap.position(mouth)), spec_offset, atol=1e-9)
-        cup_in_head = pb.multiplyTransforms(*pb.invertTransform(head_pos, head_orn), (0, 0, 0), policy._orientation(track))[1]
-        np.testing.assert_allclose(pb.getEulerFromQuaternion(cup_in_head), np.radians([-95, 0, 0]), atol=1e-6)
-        seen.append(goal - env.snap.position(mouth))
-    assert np.linalg.norm(seen[1] - seen[0]) > 0.01  # in the world the goal has moved with the head
-
-
 def test_tilt_is_the_angle_from_upright():
     tilt = terms("reward")["tilt"].fn
     p = SimpleNamespace(of=None, axis=(0.0, 0.0, 1.0), up=(0.0, 0.0, 1.0))

@@ -11,9 +11,7 @@ and may turn the tool towards that target's surface (``face_normal_within_rad``:
 rotation of the start orientation that brings the tool's pointing axis — end effector to moved
 point — within that angle of the inward normal, so a spot on the far side of a limb is met tip
 first rather than with the tool lying across the limb), and may be approached along a straight line
-(``step_m``: IK aims at most that far ahead of the moved point). A waypoint's offset and
-orientation are in the world frame, or (``frame: target``) in the frame of the link its target
-rides on, read every step, so they turn with that link (a cup tipped towards a turned face). Works for any task and robot whose
+(``step_m``: IK aims at most that far ahead of the moved point). Works for any task and robot whose
 manifest has a ``scripted`` section.
 """
 
@@ -44,7 +42,6 @@ class _Track:
         self.orientations = [pb.getQuaternionFromEuler(w["rpy_rad"]) if w.get("rpy_rad") else None for w in section["waypoints"]]
         self.face_normal = [w.get("face_normal_within_rad") for w in section["waypoints"]]
         self.steps_m = [w.get("step_m") for w in section["waypoints"]]
-        self.in_target_frame = [w.get("frame") == "target" for w in section["waypoints"]]
         self.repeat_from = section.get("repeat_from")
         robot = env.world.robot
         self.ee_link = robot.links[mount_link]
@@ -93,20 +90,7 @@ class ScriptedPolicy:
         """The track's current waypoint position (world, m) and tolerance."""
         to, offset, tol, along_normal, along_axis = track.waypoints[track.index]
         snap = self.env.snap
-        if track.in_target_frame[track.index]:  # the offset turns with the link the target rides on
-            offset = quat_rotate(snap.orientation(to), offset)
         return snap.position(to) + offset + along_normal * snap.normal(to) + along_axis * snap.axis(to), tol
-
-    def _orientation(self, track: _Track) -> list[float]:
-        """The moved point's link orientation (world quaternion) to hold at the track's current waypoint."""
-        to = track.waypoints[track.index][0]
-        orn = track.orientations[track.index]
-        if orn is not None and track.in_target_frame[track.index]:  # rpy_deg in the target's link frame
-            orn = quat_mul(self.env.snap.orientation(to), orn).tolist()
-        orn = orn or track.keep_orn
-        if track.face_normal[track.index] is not None:
-            orn = self._facing(track, orn, -self.env.snap.normal(to), track.face_normal[track.index])
-        return orn
 
     def _start_episode(self) -> None:
         snap = self.env.snap
@@ -172,7 +156,9 @@ class ScriptedPolicy:
                     goal = here + ahead * (step / distance)
             # End-effector pose that puts the moved point at the goal with the kept orientation.
             inv_pos, inv_orn = pb.invertTransform(*track.point_in_ee)
-            orn = self._orientation(track)
+            orn = track.orientations[track.index] or track.keep_orn
+            if track.face_normal[track.index] is not None:
+                orn = self._facing(track, orn, -env.snap.normal(track.waypoints[track.index][0]), track.face_normal[track.index])
             ee_pos, ee_orn = pb.multiplyTransforms(goal.tolist(), orn, inv_pos, inv_orn)
             sol = pb.calculateInverseKinematics(robot, track.ee_link, ee_pos, ee_orn, maxNumIterations=50, physicsClientId=c,
                                                 **ik_limits(self, rest))

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from typing import Literal
-
 from pydantic import Field, model_validator
 
 from .common import Name, Ref, Strict, Vec3
@@ -13,12 +11,7 @@ class Waypoint(Strict):
     """A goal for the scripted controller: a point near a target, reached within a tolerance."""
 
     to: Ref = Field(description="Target or link the goal is relative to, e.g. mouth.")
-    offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Goal offset from that point, metres, in the frame named by frame.")
-    frame: Literal["world", "target"] = Field(
-        "world", description="Frame of offset_m and rpy_deg: world, or target — the frame of the link the to: point rides on "
-        "(a target's link, e.g. person.head for mouth; the named link itself), read every step, so the goal and the tool's "
-        "orientation turn with that link (e.g. with a head turned away, a cup still tips towards the face)."
-    )
+    offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Goal offset from that point, world frame, metres.")
     tolerance_m: float = Field(0.02, ge=0, le=1, description="Distance at which the next waypoint starts, metres.")
     normal_offset_m: float = Field(
         0.0, ge=-0.5, le=0.5, description="Offset along the target's outward surface normal (targets drawn on a surface), metres."
@@ -27,7 +20,7 @@ class Waypoint(Strict):
         0.0, ge=-0.5, le=0.5, description="Offset along the limb's axis, away from its joint (targets drawn on a surface), metres."
     )
     rpy_deg: Vec3 | None = Field(
-        None, description="Orientation of the moved point's link at this waypoint (roll, pitch, yaw; degrees; in the frame named by frame), e.g. "
+        None, description="Orientation of the moved point's link at this waypoint (roll, pitch, yaw; world, degrees), e.g. "
         "to tilt a cup; None keeps the tool's start orientation."
     )
     face_normal_within_deg: float | None = Field(
