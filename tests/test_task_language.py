@@ -114,13 +114,13 @@ def test_scripted_per_robot_replaces_the_waypoints_for_that_robot_only(tmp_path)
                     "      repeat_from: 0\n    panda:\n      move: wiper.pad\n      waypoints: [{to: person.right_shoulder}]\n")
     loaded = load_spec(path)
     task = loaded.spec.scripted
-    # Baxter has no script of its own in the shipped spec (Sawyer and Jaco do; the override replaces Sawyer's).
-    sawyer, panda, baxter = (resolve(loaded, r).scripted for r in ("sawyer", "panda", "baxter"))
+    # PR2 has no script of its own in the shipped spec (Sawyer, Jaco and Baxter do; the override replaces Sawyer's).
+    sawyer, panda, pr2 = (resolve(loaded, r).scripted for r in ("sawyer", "panda", "pr2"))
     assert [w["to"]["link"] for w in sawyer["waypoints"]] == ["right_elbow", "right_wrist"]
     assert sawyer["repeat_from"] == 0 and sawyer["waypoints"][1]["rpy_rad"] == pytest.approx([math.radians(-30), 0.0, math.radians(90)])
-    assert sawyer["move"] == baxter["move"] and panda["move"] != baxter["move"]
+    assert sawyer["move"] == pr2["move"] and panda["move"] != pr2["move"]
     assert len(panda["waypoints"]) == 1 and panda["repeat_from"] is None
-    assert len(baxter["waypoints"]) == len(task.waypoints) and baxter["repeat_from"] == task.repeat_from
+    assert len(pr2["waypoints"]) == len(task.waypoints) and pr2["repeat_from"] == task.repeat_from
 
 
 class _capture:

@@ -248,7 +248,7 @@ def test_robot_grips_and_finger_positions(robot, library, out_dir, cid):
 APPROACH_AXIS = {"pr2": 0}  # the tool-mount axis pointing out of the hand; z for the others
 CLOSING_AXIS = 1            # the fingers close along the tool mount's y on every robot
 ACROSS_AXIS = {"pr2": 2}    # the third axis (the PR2 palm's up); x for the others
-WIPES_FROM_ABOVE = {"jaco", "panda", "sawyer", "baxter"}  # these hold the cloth out along the approach (wiping from above)
+WIPES_FROM_ABOVE = {"pr2", "jaco", "panda", "sawyer", "baxter"}  # these hold the cloth out along the approach (wiping from above)
 
 
 @pytest.mark.parametrize("tool", NEW_TOOLS)
@@ -259,8 +259,8 @@ def test_grip_holds_tool_without_overlap(robot, tool, library, out_dir, cid):
     (getClosestPoints at distance 0 is empty), fingers on both sides are within 1 cm of it, and
     the tool points as intended: scratcher tip and scooper blade out along the approach axis, on
     the hand's centre line; the cup's axis across both the approach and the closing axis (an
-    upright cup means a horizontal hand); the wiper's cloth across them too on PR2
-    (as in the reference), out along the approach on Jaco, Panda, Sawyer and Baxter (PR2 only holds it across)."""
+    upright cup means a horizontal hand); the wiper's cloth out along the approach on every robot
+    that has it (the reference holds it across on PR2; there the forearm lay on the mattress)."""
     part = library.get("robots", robot).part
     tpart = library.get("tools", tool).part
     grip = part.grips[tool]
