@@ -39,6 +39,7 @@ def _script(s: Scope, script, base: tuple) -> dict[str, Any]:
     """One arm's script (``move``, ``waypoints``, ``repeat_from``) with its references resolved."""
     spec = s.spec
     waypoints = []
+    step_m = getattr(script, "step_m", None)  # a robot's own script may set every straight-line waypoint's look-ahead
     for i, w in enumerate(script.waypoints):
         to = s.point(w.to, base + ("waypoints", i, "to"))
         used = {"normal_offset_m": w.normal_offset_m != 0.0, "axis_offset_m": w.axis_offset_m != 0.0,
@@ -50,6 +51,6 @@ def _script(s: Scope, script, base: tuple) -> dict[str, Any]:
                           "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
                           "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
                           "face_normal_within_rad": math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None}
-                         | ({"step_m": w.step_m} if w.step_m is not None else {}))  # absent when unset: other artifacts unchanged
+                         | ({"step_m": step_m or w.step_m} if w.step_m is not None else {}))  # absent when unset: other artifacts unchanged
     move, where = (script.move, base + ("move",)) if script.move is not None else (spec.scripted.move, ("scripted", "move"))  # a robot's own script may keep the task's point
     return {"move": s.point(move, where), "waypoints": waypoints, "repeat_from": script.repeat_from}

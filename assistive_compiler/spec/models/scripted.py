@@ -61,6 +61,11 @@ class ScriptedRobot(_WaypointScript):
     move: Ref | None = Field(None, description="The point moved; None: the task's scripted.move.")
     waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order, replacing scripted.waypoints for this robot; the last is held unless repeat_from is given.")
     repeat_from: int | None = Field(None, ge=0, description="After the last waypoint, go on from this index (replacing scripted.repeat_from); None holds the last.")
+    step_m: float | None = Field(
+        None, gt=0, le=0.5, description="Replaces the step_m of each of these waypoints that has one: how far ahead of the moved "
+        "point IK aims along a straight line, metres (robots differ in how far their tool lags behind that goal, so two robots "
+        "can share waypoints and differ in this). None: each waypoint's own."
+    )
 
 
 class Scripted(_WaypointScript):
