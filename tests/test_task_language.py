@@ -123,19 +123,24 @@ def test_scripted_per_robot_replaces_the_waypoints_for_that_robot_only(tmp_path)
     assert len(pr2["waypoints"]) == len(task.waypoints) and pr2["repeat_from"] == task.repeat_from
 
 
-def test_scripted_per_robot_step_m_replaces_the_look_ahead_of_straight_line_waypoints_only():
+def test_scripted_per_robot_step_m_replaces_the_look_ahead_of_straight_line_waypoints_only(tmp_path):
     """A robot's own script's step_m replaces each waypoint's step_m where it has one, and adds none
-    where it has not: the shipped Bed Bathing Jaco follows Sawyer's lanes (a YAML alias) with IK
-    aiming 12 cm ahead instead of 7."""
+    where it has not (two robots can share waypoints, e.g. through a YAML alias, and differ in how far
+    ahead IK aims)."""
     from assistive_compiler.resolve import resolve
     from assistive_compiler.spec.load import load_spec
 
-    loaded = load_spec(TASKS / "bed_bathing.yaml")
-    jaco, sawyer = (resolve(loaded, r).scripted for r in ("jaco", "sawyer"))
-    assert [{k: v for k, v in w.items() if k != "step_m"} for w in jaco["waypoints"]] == \
+    lanes = ("        - {to: person.right_shoulder, offset_m: [0, 0, 0.1]}\n"
+             "        - {to: person.right_elbow, offset_m: [0, 0, 0.02], step_m: 0.07}\n")
+    path = tmp_path / "ahead.yaml"
+    path.write_text(f"extends: {TASKS / 'bed_bathing.yaml'}\nscripted:\n  per_robot:\n    sawyer:\n      waypoints:\n{lanes}"
+                    f"    panda:\n      step_m: 0.12\n      waypoints:\n{lanes}")
+    loaded = load_spec(path)
+    sawyer, panda = (resolve(loaded, r).scripted for r in ("sawyer", "panda"))
+    assert [{k: v for k, v in w.items() if k != "step_m"} for w in panda["waypoints"]] == \
         [{k: v for k, v in w.items() if k != "step_m"} for w in sawyer["waypoints"]]
-    assert [w.get("step_m") for w in sawyer["waypoints"]] == [None, 0.07, 0.07, 0.07, None, 0.07, 0.07, None, 0.07, 0.07]
-    assert [w.get("step_m") for w in jaco["waypoints"]] == [None, 0.12, 0.12, 0.12, None, 0.12, 0.12, None, 0.12, 0.12]
+    assert [w.get("step_m") for w in sawyer["waypoints"]] == [None, 0.07]
+    assert [w.get("step_m") for w in panda["waypoints"]] == [None, 0.12]
 
 
 class _capture:
