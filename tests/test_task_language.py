@@ -102,6 +102,19 @@ def test_facing_a_normal_needs_a_surface_target(tmp_path):
     assert "face_normal_within_deg needs a target drawn on a surface (surface_of); 'person.right_wrist' is not one" in err.text
 
 
+def test_level_facing_needs_an_angle(tmp_path):
+    spec = (TASKS / "scratch_itch.yaml").read_text()
+    first = next(l for l in spec.splitlines() if l.strip().startswith("- {to: itch, normal_offset_m: 0.08"))
+    spec = spec.replace(first, "    - {to: itch, normal_offset_m: 0.08, face_normal_level: true}")
+    path = tmp_path / "bad.yaml"
+    path.write_text(spec)
+    with _capture() as err:
+        assert main(["validate", str(path)]) == 2
+    line = next(i for i, l in enumerate(spec.splitlines(), 1) if "0.08, face_normal_level" in l)
+    assert f"{path}:{line}:" in err.text
+    assert "face_normal_level turns the tool to face the surface only with face_normal_within_deg" in err.text
+
+
 def test_scripted_per_robot_replaces_the_waypoints_for_that_robot_only(tmp_path):
     """scripted.per_robot.<robot> gives that robot its own waypoints (and repeat_from); it keeps the
     task's moved point unless it names one; other robots follow the task's waypoints."""
@@ -227,6 +240,35 @@ def test_scripted_tool_turns_no_further_than_needed_to_face_the_itch(scratch):
             assert after == pytest.approx(within, abs=1e-6)
             assert rotation == pytest.approx(before - within, abs=1e-6)  # no more than needed
     assert turned > 0  # the inner and front-inner spots of these seeds need a turn
+
+
+def test_level_facing_turns_the_tool_about_the_vertical_only(scratch):
+    """face_normal_level (a wrist that only yaws): the level scratcher turns about the vertical
+    towards the skin's inward normal and stays level; a spot facing more up or down than sideways
+    leaves it unturned."""
+    from assistive_compiler.policies.scripted import ScriptedPolicy
+    from assistive_compiler.quat import quat_rotate
+
+    policy = ScriptedPolicy(scratch)
+    scratch.reset(seed=0)
+    policy._start_episode()
+    track = policy.tracks[0]
+    start = np.asarray(track.keep_orn)
+    d0 = quat_rotate(start, track.axis_in_point)
+    assert abs(d0[2]) < 0.01 and d0[0] > 0.99  # the task's start: the scratcher level, pointing +x (IK's 2 mm off)
+    top = np.array([0.3, 0.0, -0.9])  # the forearm's top: no yaw meets it tip first
+    assert policy._yawing(track, start, top / np.linalg.norm(top), math.radians(90)) == list(start)
+    inward = np.array([-math.cos(math.radians(30)), 0.0, math.sin(math.radians(30))])  # the upper arm's inner side
+    orn = np.asarray(policy._yawing(track, start, inward, math.radians(90)))
+    d = quat_rotate(orn, track.axis_in_point)
+    assert d[2] == pytest.approx(d0[2], abs=1e-9)  # as level as it was
+    assert abs(d[0]) < 0.01  # turned 90 degrees: along the limb's side, not into the arm from the torso's side
+    front = np.array([0.0, 1.0, 0.0])  # a spot on the arm's front: 90 degrees from the axis already
+    assert policy._yawing(track, start, front, math.radians(90)) == pytest.approx(list(start))
+    turned = quat_rotate(np.asarray(policy._yawing(track, start, front, math.radians(60))), track.axis_in_point)
+    assert math.degrees(math.atan2(turned[1], turned[0])) == pytest.approx(30, abs=0.5)  # the smallest turn, towards +y
+    for axis in np.eye(3):  # turned about the vertical only: every tool axis keeps its height
+        assert quat_rotate(orn, axis)[2] == pytest.approx(quat_rotate(start, axis)[2], abs=1e-9)
 
 
 @pytest.mark.slow

@@ -1,8 +1,9 @@
 """The ``scripted`` section: waypoints of the built-in IK baseline policy.
 
 Checks that ``per_robot`` keys name known robots, that every ``move`` and waypoint ``to`` is a
-known point, and that surface offsets (``normal_offset_m``, ``axis_offset_m``,
-``face_normal_within_deg``) are used only with targets drawn on a surface. Produces this robot's
+known point, that surface offsets (``normal_offset_m``, ``axis_offset_m``,
+``face_normal_within_deg``) are used only with targets drawn on a surface, and that
+``face_normal_level`` comes with ``face_normal_within_deg``. Produces this robot's
 script (its own ``per_robot`` one if it has it, else the task's; a two-arm robot's ``left`` part
 under ``"left"``), with points resolved and angles in radians.
 """
@@ -44,6 +45,9 @@ def _script(s: Scope, script, base: tuple) -> dict[str, Any]:
         to = s.point(w.to, base + ("waypoints", i, "to"))
         used = {"normal_offset_m": w.normal_offset_m != 0.0, "axis_offset_m": w.axis_offset_m != 0.0,
                 "face_normal_within_deg": w.face_normal_within_deg is not None}
+        if w.face_normal_level and w.face_normal_within_deg is None:
+            s.problem(base + ("waypoints", i, "face_normal_level"), "face_normal_level turns the tool to face the surface only "
+                      "with face_normal_within_deg (how far to turn); add it or drop face_normal_level")
         for key in used:
             if used[key] and not (w.to in spec.targets and spec.targets[w.to].surface_of):
                 s.problem(base + ("waypoints", i, key), f"{key} needs a target drawn on a surface (surface_of); '{w.to}' is not one")
@@ -51,6 +55,7 @@ def _script(s: Scope, script, base: tuple) -> dict[str, Any]:
                           "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
                           "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
                           "face_normal_within_rad": math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None}
-                         | ({"step_m": step_m or w.step_m} if w.step_m is not None else {}))  # absent when unset: other artifacts unchanged
+                         | ({"step_m": step_m or w.step_m} if w.step_m is not None else {})  # absent when unset: other artifacts unchanged
+                         | ({"face_normal_level": True} if w.face_normal_level else {}))
     move, where = (script.move, base + ("move",)) if script.move is not None else (spec.scripted.move, ("scripted", "move"))  # a robot's own script may keep the task's point
     return {"move": s.point(move, where), "waypoints": waypoints, "repeat_from": script.repeat_from}

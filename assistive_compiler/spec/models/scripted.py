@@ -29,6 +29,11 @@ class Waypoint(Strict):
         "normal (targets drawn on a surface), so the tool meets the surface tip first instead of lying across the limb; "
         "degrees. None keeps the start orientation (or rpy_deg's)."
     )
+    face_normal_level: bool = Field(
+        False, description="With face_normal_within_deg: turn the tool about the vertical only, towards the inward normal's "
+        "horizontal part, so it stays level (a wrist that only yaws, e.g. Stretch's); a spot facing more up or down than "
+        "sideways (its normal over 45 degrees from the horizontal) is left unturned, since no yaw meets it tip first."
+    )
     step_m: float | None = Field(
         None, gt=0, le=0.5, description="Largest distance, metres, between the moved point and the goal handed to IK while heading "
         "for this waypoint: the point then follows the straight line from where it is (e.g. wiping along a limb) instead of the "
