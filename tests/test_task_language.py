@@ -115,6 +115,36 @@ def test_level_facing_needs_an_angle(tmp_path):
     assert "face_normal_level turns the tool to face the surface only with face_normal_within_deg" in err.text
 
 
+def test_ik_damping_names_arm_joints_of_the_robot(tmp_path):
+    spec = (TASKS / "scratch_itch.yaml").read_text()
+    shipped = "ik_damping: {l_shoulder_pan_joint: 1.0, l_shoulder_lift_joint: 1.0}"
+    assert shipped in spec
+    path = tmp_path / "bad.yaml"
+    path.write_text(spec.replace(shipped, "ik_damping: {r_shoulder_pan_joint: 1.0, l_shoulder_lift_joint: 1.0}"))  # the other arm
+    with _capture() as err:
+        assert main(["validate", str(path)]) == 2
+    line = next(i for i, l in enumerate(path.read_text().splitlines(), 1) if "r_shoulder_pan_joint: 1.0" in l)
+    assert f"{path}:{line}:" in err.text
+    assert "'r_shoulder_pan_joint' is not an acting arm joint of robot 'pr2'" in err.text
+
+
+def test_scripted_ik_damping_damps_the_named_joints_only(tmp_path, scratch):
+    """Scratch Itch PR2's own script damps its slow shoulder pan and lift in the IK; the policy's
+    IK then moves them less than the other joints, and robots without ik_damping keep null-space IK."""
+    from assistive_compiler.policies.scripted import ScriptedPolicy
+
+    env = AssistiveEnv(compile_task(TASKS / "scratch_itch.yaml", "pr2", tmp_path / "pr2", force=True).out_dir)
+    try:
+        policy = ScriptedPolicy(env)
+        robot = env.world.robot
+        named = {policy.movable.index(robot.joints[j]): v for j, v in env.manifest.scripted["ik_damping"].items()}
+        assert set(named.values()) == {1.0} and len(named) == 2
+        assert all(d == (named[k] if k in named else 0.1) for k, d in enumerate(policy.damping))
+    finally:
+        env.close()
+    assert ScriptedPolicy(scratch).damping is None  # Jaco: no ik_damping, pybullet's null-space IK
+
+
 def test_scripted_per_robot_replaces_the_waypoints_for_that_robot_only(tmp_path):
     """scripted.per_robot.<robot> gives that robot its own waypoints (and repeat_from); it keeps the
     task's moved point unless it names one; other robots follow the task's waypoints."""

@@ -12,8 +12,9 @@ rotation of the start orientation that brings the tool's pointing axis — end e
 point — within that angle of the inward normal, so a spot on the far side of a limb is met tip
 first rather than with the tool lying across the limb; with ``face_normal_level`` only about the
 vertical, for a wrist that only yaws), and may be approached along a straight line
-(``step_m``: IK aims at most that far ahead of the moved point). Works for any task and robot whose
-manifest has a ``scripted`` section.
+(``step_m``: IK aims at most that far ahead of the moved point). A robot's own script may damp
+some arm joints in the IK (``ik_damping``, e.g. a slow shoulder). Works for any task and robot
+whose manifest has a ``scripted`` section.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ import math
 import numpy as np
 import pybullet as pb
 
-from ..ik_options import ik_damping, ik_limits
+from ..ik_options import PYBULLET_DAMPING, ik_damping, ik_limits
 from ..quat import quat_conj, quat_mul, quat_rotate
 
 
@@ -90,6 +91,11 @@ class ScriptedPolicy:
         # A mobile base drives: IK moves its planar joints with the arm, and the wheel actions head
         # for the planar change it asks of the base (see :meth:`_wheels`).
         self.damping = ik_damping(movable, [], env.drive.idx if env.drive else [])
+        named = m.scripted.get("ik_damping")  # the robot's own script damps some arm joints (e.g. a slow shoulder)
+        if named:
+            self.damping = self.damping or [PYBULLET_DAMPING] * len(movable)
+            for name, value in named.items():
+                self.damping[movable.index(robot.joints[name])] = value
         self.drive_cols = [movable.index(j) for j in env.drive.idx] if env.drive else []
         self.arm_offset = 2 if env.drive else 0
 

@@ -3,7 +3,8 @@
 Checks that ``per_robot`` keys name known robots, that every ``move`` and waypoint ``to`` is a
 known point, that surface offsets (``normal_offset_m``, ``axis_offset_m``,
 ``face_normal_within_deg``) are used only with targets drawn on a surface, and that
-``face_normal_level`` comes with ``face_normal_within_deg``. Produces this robot's
+``face_normal_level`` comes with ``face_normal_within_deg``, and that a robot's ``ik_damping`` names
+its acting arm joints. Produces this robot's
 script (its own ``per_robot`` one if it has it, else the task's; a two-arm robot's ``left`` part
 under ``"left"``), with points resolved and angles in radians.
 """
@@ -24,6 +25,8 @@ def scripted(s: Scope) -> dict[str, Any] | None:
     check_per_robot_keys(s, ("scripted", "per_robot"), spec.scripted.per_robot)
     own = spec.scripted.per_robot.get(s.robot_name)
     out = _script(s, own, ("scripted", "per_robot", s.robot_name)) if own is not None else _script(s, spec.scripted, ("scripted",))
+    if own is not None and own.ik_damping:
+        out["ik_damping"] = _ik_damping(s, own.ik_damping)
     for side in ("left", "right"):  # a two-arm robot: the left arm's part, and the right arm's own (replacing the main one)
         arm = getattr(spec.scripted, side)
         if arm is None or len(s.sides) < 2:
@@ -34,6 +37,19 @@ def scripted(s: Scope) -> dict[str, Any] | None:
         else:
             out.update(resolved)
     return out
+
+
+def _ik_damping(s: Scope, damping: dict[str, float]) -> dict[str, float]:
+    """A robot's own script's IK damping by arm joint name; a problem for a name that is not one of
+    the acting arm joints, or a damping that is not positive."""
+    arm = s.joint_groups["robot.arm"]["joints"]
+    for name, value in damping.items():
+        where = ("scripted", "per_robot", s.robot_name, "ik_damping", name)
+        if name not in arm:
+            s.problem(where, f"'{name}' is not an acting arm joint of robot '{s.robot_name}' ({', '.join(arm)})")
+        elif value <= 0:
+            s.problem(where, f"ik_damping must be positive (pybullet's default is 0.1), not {value}")
+    return dict(damping)
 
 
 def _script(s: Scope, script, base: tuple) -> dict[str, Any]:
