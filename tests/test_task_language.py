@@ -77,60 +77,53 @@ def test_itch_is_drawn_on_the_arm_capsules_every_reset(scratch):
     assert np.linalg.norm(np.mean(normals, axis=0)) < 0.15  # azimuths spread all round
 
 
+def _rejected_at(tmp_path, spec: str, marker: str) -> str:
+    """``validate`` of the spec text ``spec`` fails, naming the first line holding ``marker``; its stderr."""
+    path = tmp_path / "bad.yaml"
+    path.write_text(spec)
+    with _capture() as err:
+        assert main(["validate", str(path)]) == 2
+    line = next(i for i, l in enumerate(spec.splitlines(), 1) if marker in l)
+    assert f"{path}:{line}:" in err.text
+    return err.text
+
+
+def _first_scratch_waypoint_replaced(by: str) -> str:
+    """The shipped Scratch Itch spec with its first task waypoint replaced by the line ``by``."""
+    spec = (TASKS / "scratch_itch.yaml").read_text()
+    first = next(l for l in spec.splitlines() if l.strip().startswith("- {to: itch, normal_offset_m: 0.08"))
+    return spec.replace(first, by)
+
+
 def test_surface_target_specs_are_checked(tmp_path):
     spec = (TASKS / "scratch_itch.yaml").read_text().replace(
         "surface_of: [person.right_shoulder, person.right_elbow]", "surface_of: [person.right_shoulder, person.head]")
-    path = tmp_path / "bad.yaml"
-    path.write_text(spec)
-    with _capture() as err:
-        assert main(["validate", str(path)]) == 2
-    line = next(i for i, l in enumerate(spec.splitlines(), 1) if "person.head]" in l and "surface_of" in l)
-    assert f"{path}:{line}:" in err.text
-    assert "'person.head' is not a person limb with a capsule" in err.text
+    assert "'person.head' is not a person limb with a capsule" in _rejected_at(tmp_path, spec, "surface_of: [person.right_shoulder, person.head]")
 
 
 def test_facing_a_normal_needs_a_surface_target(tmp_path):
-    spec = (TASKS / "scratch_itch.yaml").read_text()
-    first = next(l for l in spec.splitlines() if l.strip().startswith("- {to: itch, normal_offset_m: 0.08"))
-    spec = spec.replace(first, "    - {to: person.right_wrist, face_normal_within_deg: 90}")
-    path = tmp_path / "bad.yaml"
-    path.write_text(spec)
-    with _capture() as err:
-        assert main(["validate", str(path)]) == 2
-    line = next(i for i, l in enumerate(spec.splitlines(), 1) if "person.right_wrist, face_normal" in l)
-    assert f"{path}:{line}:" in err.text
-    assert "face_normal_within_deg needs a target drawn on a surface (surface_of); 'person.right_wrist' is not one" in err.text
+    spec = _first_scratch_waypoint_replaced("    - {to: person.right_wrist, face_normal_within_deg: 90}")
+    err = _rejected_at(tmp_path, spec, "person.right_wrist, face_normal")
+    assert "face_normal_within_deg needs a target drawn on a surface (surface_of); 'person.right_wrist' is not one" in err
 
 
 def test_level_facing_needs_an_angle(tmp_path):
-    spec = (TASKS / "scratch_itch.yaml").read_text()
-    first = next(l for l in spec.splitlines() if l.strip().startswith("- {to: itch, normal_offset_m: 0.08"))
-    spec = spec.replace(first, "    - {to: itch, normal_offset_m: 0.08, face_normal_level: true}")
-    path = tmp_path / "bad.yaml"
-    path.write_text(spec)
-    with _capture() as err:
-        assert main(["validate", str(path)]) == 2
-    line = next(i for i, l in enumerate(spec.splitlines(), 1) if "0.08, face_normal_level" in l)
-    assert f"{path}:{line}:" in err.text
-    assert "face_normal_level turns the tool to face the surface only with face_normal_within_deg" in err.text
+    spec = _first_scratch_waypoint_replaced("    - {to: itch, normal_offset_m: 0.08, face_normal_level: true}")
+    err = _rejected_at(tmp_path, spec, "0.08, face_normal_level")
+    assert "face_normal_level turns the tool to face the surface only with face_normal_within_deg" in err
 
 
 def test_ik_damping_names_arm_joints_of_the_robot(tmp_path):
     spec = (TASKS / "scratch_itch.yaml").read_text()
     shipped = "ik_damping: {l_shoulder_pan_joint: 1.0, l_shoulder_lift_joint: 1.0}"
     assert shipped in spec
-    path = tmp_path / "bad.yaml"
-    path.write_text(spec.replace(shipped, "ik_damping: {r_shoulder_pan_joint: 1.0, l_shoulder_lift_joint: 1.0}"))  # the other arm
-    with _capture() as err:
-        assert main(["validate", str(path)]) == 2
-    line = next(i for i, l in enumerate(path.read_text().splitlines(), 1) if "r_shoulder_pan_joint: 1.0" in l)
-    assert f"{path}:{line}:" in err.text
-    assert "'r_shoulder_pan_joint' is not an acting arm joint of robot 'pr2'" in err.text
+    spec = spec.replace(shipped, "ik_damping: {r_shoulder_pan_joint: 1.0, l_shoulder_lift_joint: 1.0}")  # the other arm
+    assert "'r_shoulder_pan_joint' is not an acting arm joint of robot 'pr2'" in _rejected_at(tmp_path, spec, "r_shoulder_pan_joint: 1.0")
 
 
 def test_scripted_ik_damping_damps_the_named_joints_only(tmp_path, scratch):
-    """Scratch Itch PR2's own script damps its slow shoulder pan and lift in the IK; the policy's
-    IK then moves them less than the other joints, and robots without ik_damping keep null-space IK."""
+    """Scratch Itch PR2's own script damps its slow shoulder pan and lift in the IK: the policy's IK
+    damping is 1.0 there and pybullet's 0.1 elsewhere; a robot without ik_damping keeps null-space IK."""
     from assistive_compiler.policies.scripted import ScriptedPolicy
 
     env = AssistiveEnv(compile_task(TASKS / "scratch_itch.yaml", "pr2", tmp_path / "pr2", force=True).out_dir)

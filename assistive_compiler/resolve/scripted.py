@@ -2,10 +2,9 @@
 
 Checks that ``per_robot`` keys name known robots, that every ``move`` and waypoint ``to`` is a
 known point, that surface offsets (``normal_offset_m``, ``axis_offset_m``,
-``face_normal_within_deg``) are used only with targets drawn on a surface, and that
-``face_normal_level`` comes with ``face_normal_within_deg``, and that a robot's ``ik_damping`` names
-its acting arm joints. Produces this robot's
-script (its own ``per_robot`` one if it has it, else the task's; a two-arm robot's ``left`` part
+``face_normal_within_deg``) are used only with targets drawn on a surface, that
+``face_normal_level`` comes with ``face_normal_within_deg`` and that a robot's ``ik_damping``
+names its acting arm joints. Produces this robot's script (its own ``per_robot`` one if it has it, else the task's; a two-arm robot's ``left`` part
 under ``"left"``), with points resolved and angles in radians.
 """
 
@@ -41,14 +40,12 @@ def scripted(s: Scope) -> dict[str, Any] | None:
 
 def _ik_damping(s: Scope, damping: dict[str, float]) -> dict[str, float]:
     """A robot's own script's IK damping by arm joint name; a problem for a name that is not one of
-    the acting arm joints, or a damping that is not positive."""
+    the acting arm joints."""
     arm = s.joint_groups["robot.arm"]["joints"]
-    for name, value in damping.items():
-        where = ("scripted", "per_robot", s.robot_name, "ik_damping", name)
+    for name in damping:
         if name not in arm:
-            s.problem(where, f"'{name}' is not an acting arm joint of robot '{s.robot_name}' ({', '.join(arm)})")
-        elif value <= 0:
-            s.problem(where, f"ik_damping must be positive (pybullet's default is 0.1), not {value}")
+            s.problem(("scripted", "per_robot", s.robot_name, "ik_damping", name),
+                      f"'{name}' is not an acting arm joint of robot '{s.robot_name}' ({', '.join(arm)})")
     return dict(damping)
 
 

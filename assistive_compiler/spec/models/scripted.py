@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Annotated
+
 from pydantic import Field, model_validator
 
 from .common import Name, Ref, Strict, Vec3
@@ -71,10 +73,11 @@ class ScriptedRobot(_WaypointScript):
         "point IK aims along a straight line, metres (robots differ in how far their tool lags behind that goal, so two robots "
         "can share waypoints and differ in this). None: each waypoint's own."
     )
-    ik_damping: dict[Name, float] = Field(
+    ik_damping: dict[Name, Annotated[float, Field(gt=0)]] = Field(
         default_factory=dict, description="pybullet IK damping of some of this robot's arm joints by joint name (the others "
-        "keep pybullet's 0.1): a joint damped more moves less in each IK step, so the script leans on the other joints, e.g. "
-        "an arm whose shoulder turns much more slowly than its elbow and wrist. Empty: pybullet's null-space IK."
+        "keep pybullet's 0.1; the IK is then damped least squares): a joint damped more moves less in each IK step, so the "
+        "script leans on the other joints, e.g. an arm whose shoulder turns much more slowly than its elbow and wrist. Empty: "
+        "pybullet's null-space IK towards the current pose."
     )
 
 
