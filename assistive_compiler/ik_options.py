@@ -4,8 +4,9 @@ job), how readily it moves a drive the scripted policy may drive, and how limits
 
 from __future__ import annotations
 
-FROZEN_DAMPING = 1e6  # IK damping of joints IK must not move (pybullet's default is 0.1)
-DRIVE_DAMPING = 0.1  # IK damping of a drive's planar joints that the scripted policy drives: pybullet's default
+PYBULLET_DAMPING = 0.1  # pybullet's default IK damping of a joint
+FROZEN_DAMPING = 1e6  # IK damping of joints IK must not move
+DRIVE_DAMPING = PYBULLET_DAMPING  # IK damping of a drive's planar joints that the scripted policy drives
 
 
 def ik_damping(movable: list[int], frozen: list[int], driven: list[int] = ()) -> list[float] | None:
@@ -14,7 +15,7 @@ def ik_damping(movable: list[int], frozen: list[int], driven: list[int] = ()) ->
     default elsewhere; None when nothing is frozen or driven."""
     if not frozen and not driven:
         return None
-    return [FROZEN_DAMPING if j in frozen else DRIVE_DAMPING if j in driven else 0.1 for j in movable]
+    return [FROZEN_DAMPING if j in frozen else DRIVE_DAMPING if j in driven else PYBULLET_DAMPING for j in movable]
 
 
 def ik_limits(chain, rest) -> dict:

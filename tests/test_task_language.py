@@ -77,29 +77,65 @@ def test_itch_is_drawn_on_the_arm_capsules_every_reset(scratch):
     assert np.linalg.norm(np.mean(normals, axis=0)) < 0.15  # azimuths spread all round
 
 
+def _rejected_at(tmp_path, spec: str, marker: str) -> str:
+    """``validate`` of the spec text ``spec`` fails, naming the first line holding ``marker``; its stderr."""
+    path = tmp_path / "bad.yaml"
+    path.write_text(spec)
+    with _capture() as err:
+        assert main(["validate", str(path)]) == 2
+    line = next(i for i, l in enumerate(spec.splitlines(), 1) if marker in l)
+    assert f"{path}:{line}:" in err.text
+    return err.text
+
+
+def _first_scratch_waypoint_replaced(by: str) -> str:
+    """The shipped Scratch Itch spec with its first task waypoint replaced by the line ``by``."""
+    spec = (TASKS / "scratch_itch.yaml").read_text()
+    first = next(l for l in spec.splitlines() if l.strip().startswith("- {to: itch, normal_offset_m: 0.08"))
+    return spec.replace(first, by)
+
+
 def test_surface_target_specs_are_checked(tmp_path):
     spec = (TASKS / "scratch_itch.yaml").read_text().replace(
         "surface_of: [person.right_shoulder, person.right_elbow]", "surface_of: [person.right_shoulder, person.head]")
-    path = tmp_path / "bad.yaml"
-    path.write_text(spec)
-    with _capture() as err:
-        assert main(["validate", str(path)]) == 2
-    line = next(i for i, l in enumerate(spec.splitlines(), 1) if "person.head]" in l and "surface_of" in l)
-    assert f"{path}:{line}:" in err.text
-    assert "'person.head' is not a person limb with a capsule" in err.text
+    assert "'person.head' is not a person limb with a capsule" in _rejected_at(tmp_path, spec, "surface_of: [person.right_shoulder, person.head]")
 
 
 def test_facing_a_normal_needs_a_surface_target(tmp_path):
+    spec = _first_scratch_waypoint_replaced("    - {to: person.right_wrist, face_normal_within_deg: 90}")
+    err = _rejected_at(tmp_path, spec, "person.right_wrist, face_normal")
+    assert "face_normal_within_deg needs a target drawn on a surface (surface_of); 'person.right_wrist' is not one" in err
+
+
+def test_level_facing_needs_an_angle(tmp_path):
+    spec = _first_scratch_waypoint_replaced("    - {to: itch, normal_offset_m: 0.08, face_normal_level: true}")
+    err = _rejected_at(tmp_path, spec, "0.08, face_normal_level")
+    assert "face_normal_level turns the tool to face the surface only with face_normal_within_deg" in err
+
+
+def test_ik_damping_names_arm_joints_of_the_robot(tmp_path):
     spec = (TASKS / "scratch_itch.yaml").read_text()
-    first = next(l for l in spec.splitlines() if l.strip().startswith("- {to: itch, normal_offset_m: 0.08"))
-    spec = spec.replace(first, "    - {to: person.right_wrist, face_normal_within_deg: 90}")
-    path = tmp_path / "bad.yaml"
-    path.write_text(spec)
-    with _capture() as err:
-        assert main(["validate", str(path)]) == 2
-    line = next(i for i, l in enumerate(spec.splitlines(), 1) if "person.right_wrist, face_normal" in l)
-    assert f"{path}:{line}:" in err.text
-    assert "face_normal_within_deg needs a target drawn on a surface (surface_of); 'person.right_wrist' is not one" in err.text
+    shipped = "ik_damping: {l_shoulder_pan_joint: 1.0, l_shoulder_lift_joint: 1.0}"
+    assert shipped in spec
+    spec = spec.replace(shipped, "ik_damping: {r_shoulder_pan_joint: 1.0, l_shoulder_lift_joint: 1.0}")  # the other arm
+    assert "'r_shoulder_pan_joint' is not an acting arm joint of robot 'pr2'" in _rejected_at(tmp_path, spec, "r_shoulder_pan_joint: 1.0")
+
+
+def test_scripted_ik_damping_damps_the_named_joints_only(tmp_path, scratch):
+    """Scratch Itch PR2's own script damps its slow shoulder pan and lift in the IK: the policy's IK
+    damping is 1.0 there and pybullet's 0.1 elsewhere; a robot without ik_damping keeps null-space IK."""
+    from assistive_compiler.policies.scripted import ScriptedPolicy
+
+    env = AssistiveEnv(compile_task(TASKS / "scratch_itch.yaml", "pr2", tmp_path / "pr2", force=True).out_dir)
+    try:
+        policy = ScriptedPolicy(env)
+        robot = env.world.robot
+        named = {policy.movable.index(robot.joints[j]): v for j, v in env.manifest.scripted["ik_damping"].items()}
+        assert set(named.values()) == {1.0} and len(named) == 2
+        assert all(d == (named[k] if k in named else 0.1) for k, d in enumerate(policy.damping))
+    finally:
+        env.close()
+    assert ScriptedPolicy(scratch).damping is None  # Jaco: no ik_damping, pybullet's null-space IK
 
 
 def test_scripted_per_robot_replaces_the_waypoints_for_that_robot_only(tmp_path):
@@ -124,19 +160,24 @@ def test_scripted_per_robot_replaces_the_waypoints_for_that_robot_only(tmp_path)
     assert len(pr2["waypoints"]) == len(task.waypoints) and pr2["repeat_from"] == task.repeat_from
 
 
-def test_scripted_per_robot_step_m_replaces_the_look_ahead_of_straight_line_waypoints_only():
+def test_scripted_per_robot_step_m_replaces_the_look_ahead_of_straight_line_waypoints_only(tmp_path):
     """A robot's own script's step_m replaces each waypoint's step_m where it has one, and adds none
-    where it has not: the shipped Bed Bathing Jaco follows Sawyer's lanes (a YAML alias) with IK
-    aiming 12 cm ahead instead of 7."""
+    where it has not (two robots can share waypoints, e.g. through a YAML alias, and differ in how far
+    ahead IK aims)."""
     from assistive_compiler.resolve import resolve
     from assistive_compiler.spec.load import load_spec
 
-    loaded = load_spec(TASKS / "bed_bathing.yaml")
-    jaco, sawyer = (resolve(loaded, r).scripted for r in ("jaco", "sawyer"))
-    assert [{k: v for k, v in w.items() if k != "step_m"} for w in jaco["waypoints"]] == \
+    lanes = ("        - {to: person.right_shoulder, offset_m: [0, 0, 0.1]}\n"
+             "        - {to: person.right_elbow, offset_m: [0, 0, 0.02], step_m: 0.07}\n")
+    path = tmp_path / "ahead.yaml"
+    path.write_text(f"extends: {TASKS / 'bed_bathing.yaml'}\nscripted:\n  per_robot:\n    sawyer:\n      waypoints:\n{lanes}"
+                    f"    panda:\n      step_m: 0.12\n      waypoints:\n{lanes}")
+    loaded = load_spec(path)
+    sawyer, panda = (resolve(loaded, r).scripted for r in ("sawyer", "panda"))
+    assert [{k: v for k, v in w.items() if k != "step_m"} for w in panda["waypoints"]] == \
         [{k: v for k, v in w.items() if k != "step_m"} for w in sawyer["waypoints"]]
-    assert [w.get("step_m") for w in sawyer["waypoints"]] == [None, 0.07, 0.07, 0.07, None, 0.07, 0.07, None, 0.07, 0.07]
-    assert [w.get("step_m") for w in jaco["waypoints"]] == [None, 0.12, 0.12, 0.12, None, 0.12, 0.12, None, 0.12, 0.12]
+    assert [w.get("step_m") for w in sawyer["waypoints"]] == [None, 0.07]
+    assert [w.get("step_m") for w in panda["waypoints"]] == [None, 0.12]
 
 
 class _capture:
@@ -228,6 +269,35 @@ def test_scripted_tool_turns_no_further_than_needed_to_face_the_itch(scratch):
             assert after == pytest.approx(within, abs=1e-6)
             assert rotation == pytest.approx(before - within, abs=1e-6)  # no more than needed
     assert turned > 0  # the inner and front-inner spots of these seeds need a turn
+
+
+def test_level_facing_turns_the_tool_about_the_vertical_only(scratch):
+    """face_normal_level (a wrist that only yaws): the level scratcher turns about the vertical
+    towards the skin's inward normal and stays level; a spot facing more up or down than sideways
+    leaves it unturned."""
+    from assistive_compiler.policies.scripted import ScriptedPolicy
+    from assistive_compiler.quat import quat_rotate
+
+    policy = ScriptedPolicy(scratch)
+    scratch.reset(seed=0)
+    policy._start_episode()
+    track = policy.tracks[0]
+    start = np.asarray(track.keep_orn)
+    d0 = quat_rotate(start, track.axis_in_point)
+    assert abs(d0[2]) < 0.01 and d0[0] > 0.99  # the task's start: the scratcher level, pointing +x (IK's 2 mm off)
+    top = np.array([0.3, 0.0, -0.9])  # the forearm's top: no yaw meets it tip first
+    assert policy._yawing(track, start, top / np.linalg.norm(top), math.radians(90)) == list(start)
+    inward = np.array([-math.cos(math.radians(30)), 0.0, math.sin(math.radians(30))])  # the upper arm's inner side
+    orn = np.asarray(policy._yawing(track, start, inward, math.radians(90)))
+    d = quat_rotate(orn, track.axis_in_point)
+    assert d[2] == pytest.approx(d0[2], abs=1e-9)  # as level as it was
+    assert abs(d[0]) < 0.01  # turned 90 degrees: along the limb's side, not into the arm from the torso's side
+    front = np.array([0.0, 1.0, 0.0])  # a spot on the arm's front: 90 degrees from the axis already
+    assert policy._yawing(track, start, front, math.radians(90)) == pytest.approx(list(start))
+    turned = quat_rotate(np.asarray(policy._yawing(track, start, front, math.radians(60))), track.axis_in_point)
+    assert math.degrees(math.atan2(turned[1], turned[0])) == pytest.approx(30, abs=0.5)  # the smallest turn, towards +y
+    for axis in np.eye(3):  # turned about the vertical only: every tool axis keeps its height
+        assert quat_rotate(orn, axis)[2] == pytest.approx(quat_rotate(start, axis)[2], abs=1e-9)
 
 
 @pytest.mark.slow

@@ -10,9 +10,11 @@ forth). A waypoint may sit off a surface-drawn target along its outward normal a
 and may turn the tool towards that target's surface (``face_normal_within_rad``: the smallest
 rotation of the start orientation that brings the tool's pointing axis — end effector to moved
 point — within that angle of the inward normal, so a spot on the far side of a limb is met tip
-first rather than with the tool lying across the limb), and may be approached along a straight line
-(``step_m``: IK aims at most that far ahead of the moved point). Works for any task and robot whose
-manifest has a ``scripted`` section.
+first rather than with the tool lying across the limb; with ``face_normal_level`` only about the
+vertical, for a wrist that only yaws), and may be approached along a straight line
+(``step_m``: IK aims at most that far ahead of the moved point). A robot's own script may damp
+some arm joints in the IK (``ik_damping``, e.g. a slow shoulder). Works for any task and robot
+whose manifest has a ``scripted`` section.
 """
 
 from __future__ import annotations
@@ -22,12 +24,15 @@ import math
 import numpy as np
 import pybullet as pb
 
-from ..ik_options import ik_damping, ik_limits
+from ..ik_options import PYBULLET_DAMPING, ik_damping, ik_limits
 from ..quat import quat_conj, quat_mul, quat_rotate
 
 
 STALL_STEPS = 10  # steps without getting STALL_GAIN_M closer before moving on to the next waypoint
 STALL_GAIN_M = 0.002
+# face_normal_level: a level tool's pointing axis is at least the normal's elevation from the inward
+# normal whatever its yaw, so past 45° it meets the surface side first anyway and is not turned.
+LEVEL_FACING_MAX_ELEVATION_RAD = math.radians(45)
 
 
 class _Track:
@@ -41,6 +46,7 @@ class _Track:
                            w.get("axis_offset_m", 0.0)) for w in section["waypoints"]]
         self.orientations = [pb.getQuaternionFromEuler(w["rpy_rad"]) if w.get("rpy_rad") else None for w in section["waypoints"]]
         self.face_normal = [w.get("face_normal_within_rad") for w in section["waypoints"]]
+        self.face_level = [w.get("face_normal_level", False) for w in section["waypoints"]]
         self.steps_m = [w.get("step_m") for w in section["waypoints"]]
         self.repeat_from = section.get("repeat_from")
         robot = env.world.robot
@@ -85,6 +91,11 @@ class ScriptedPolicy:
         # A mobile base drives: IK moves its planar joints with the arm, and the wheel actions head
         # for the planar change it asks of the base (see :meth:`_wheels`).
         self.damping = ik_damping(movable, [], env.drive.idx if env.drive else [])
+        named = m.scripted.get("ik_damping")  # the robot's own script damps some arm joints (e.g. a slow shoulder)
+        if named:
+            self.damping = self.damping or [PYBULLET_DAMPING] * len(movable)
+            for name, value in named.items():
+                self.damping[movable.index(robot.joints[name])] = value
         self.drive_cols = [movable.index(j) for j in env.drive.idx] if env.drive else []
         self.arm_offset = 2 if env.drive else 0
 
@@ -129,6 +140,23 @@ class ScriptedPolicy:
         q = np.concatenate([k * math.sin(turn / 2), [math.cos(turn / 2)]])
         return quat_mul(q, np.asarray(orn)).tolist()
 
+    @staticmethod
+    def _yawing(track: _Track, orn, inward: np.ndarray, within: float) -> list[float]:
+        """``orn`` turned about the vertical (world z) by the smallest angle that brings the
+        horizontal part of the track's pointing axis within ``within`` (rad) of the horizontal part
+        of ``inward`` (world); unchanged when it already is, or when ``inward`` is more than
+        ``LEVEL_FACING_MAX_ELEVATION_RAD`` from the horizontal (no yaw meets that surface tip first)."""
+        if math.hypot(inward[0], inward[1]) < math.cos(LEVEL_FACING_MAX_ELEVATION_RAD):
+            return list(orn)
+        d = quat_rotate(np.asarray(orn), track.axis_in_point)
+        angle = math.atan2(inward[1], inward[0]) - math.atan2(d[1], d[0])
+        angle = (angle + math.pi) % (2 * math.pi) - math.pi  # signed, in [-pi, pi): from the axis to the normal
+        if abs(angle) <= within:
+            return list(orn)
+        turn = math.copysign(abs(angle) - within, angle if angle != -math.pi else 1.0)
+        q = [0.0, 0.0, math.sin(turn / 2), math.cos(turn / 2)]
+        return quat_mul(np.asarray(q), np.asarray(orn)).tolist()
+
     def __call__(self, obs) -> np.ndarray:
         env = self.env
         if env.steps == 0:  # first action of an episode
@@ -160,7 +188,8 @@ class ScriptedPolicy:
             inv_pos, inv_orn = pb.invertTransform(*track.point_in_ee)
             orn = track.orientations[track.index] or track.keep_orn
             if track.face_normal[track.index] is not None:
-                orn = self._facing(track, orn, -env.snap.normal(track.waypoints[track.index][0]), track.face_normal[track.index])
+                turn = self._yawing if track.face_level[track.index] else self._facing
+                orn = turn(track, orn, -env.snap.normal(track.waypoints[track.index][0]), track.face_normal[track.index])
             ee_pos, ee_orn = pb.multiplyTransforms(goal.tolist(), orn, inv_pos, inv_orn)
             sol = pb.calculateInverseKinematics(robot, track.ee_link, ee_pos, ee_orn, maxNumIterations=50, physicsClientId=c,
                                                 **ik_limits(self, rest))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Annotated
+
 from pydantic import Field, model_validator
 
 from .common import Name, Ref, Strict, Vec3
@@ -28,6 +30,11 @@ class Waypoint(Strict):
         "pointing axis (from the end effector to the moved point) lies within this angle of the target's inward surface "
         "normal (targets drawn on a surface), so the tool meets the surface tip first instead of lying across the limb; "
         "degrees. None keeps the start orientation (or rpy_deg's)."
+    )
+    face_normal_level: bool = Field(
+        False, description="With face_normal_within_deg: turn the tool about the vertical only, towards the inward normal's "
+        "horizontal part, so it stays level (a wrist that only yaws, e.g. Stretch's); a spot facing more up or down than "
+        "sideways (its normal over 45 degrees from the horizontal) is left unturned, since no yaw meets it tip first."
     )
     step_m: float | None = Field(
         None, gt=0, le=0.5, description="Largest distance, metres, between the moved point and the goal handed to IK while heading "
@@ -65,6 +72,12 @@ class ScriptedRobot(_WaypointScript):
         None, gt=0, le=0.5, description="Replaces the step_m of each of these waypoints that has one: how far ahead of the moved "
         "point IK aims along a straight line, metres (robots differ in how far their tool lags behind that goal, so two robots "
         "can share waypoints and differ in this). None: each waypoint's own."
+    )
+    ik_damping: dict[Name, Annotated[float, Field(gt=0)]] = Field(
+        default_factory=dict, description="pybullet IK damping of some of this robot's arm joints by joint name (the others "
+        "keep pybullet's 0.1; the IK is then damped least squares): a joint damped more moves less in each IK step, so the "
+        "script leans on the other joints, e.g. an arm whose shoulder turns much more slowly than its elbow and wrist. Empty: "
+        "pybullet's null-space IK towards the current pose."
     )
 
 
