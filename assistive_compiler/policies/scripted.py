@@ -44,6 +44,7 @@ class _Track:
         self.orientations = [pb.getQuaternionFromEuler(w["rpy_rad"]) if w.get("rpy_rad") else None for w in section["waypoints"]]
         self.face_normal = [w.get("face_normal_within_rad") for w in section["waypoints"]]
         self.steps_m = [w.get("step_m") for w in section["waypoints"]]
+        self.hold_within = [w.get("hold_within_m") for w in section["waypoints"]]
         self.repeat_from = section.get("repeat_from")
         robot = env.world.robot
         self.ee_link = robot.links[mount_link]
