@@ -138,39 +138,6 @@ def test_scripted_per_robot_step_m_replaces_the_look_ahead_of_straight_line_wayp
     assert [w.get("step_m") for w in jaco["waypoints"]] == [None, 0.12, 0.12, 0.12, None, 0.12, 0.12, None, 0.12, 0.12]
 
 
-def test_scripted_waypoint_with_hold_within_is_left_when_blocked_and_kept_once_reached(tmp_path):
-    """hold_within_m: the reach example's spoon, aimed 5 cm inside the face, stalls against it and
-    goes on to the next waypoint; that one, 5 cm before the lips, is kept once the spoon came within
-    3 cm of it, though the spoon then stops getting closer and a third waypoint follows."""
-    from assistive_compiler.policies.scripted import ScriptedPolicy
-
-    spec = tmp_path / "reach_fallback.yaml"
-    spec.write_text(f"extends: {specs_dir() / 'examples' / 'reach.yaml'}\n"
-                    "sim: {episode_steps: 80}\n"
-                    "scripted:\n"
-                    "  move: spoon\n"
-                    "  waypoints:\n"
-                    "    - {to: mouth, offset_m: [0.0, 0.05, 0.0], hold_within_m: 0.01}\n"
-                    "    - {to: mouth, offset_m: [0.0, -0.05, 0.0], hold_within_m: 0.03}\n"
-                    "    - {to: mouth, offset_m: [0.0, -0.30, 0.2]}\n")
-    env = AssistiveEnv(compile_task(spec, "jaco", tmp_path / "out").out_dir)
-    try:
-        policy = ScriptedPolicy(env)
-        spoon, mouth = env.snap.point({"body": "spoon", "link": "spoon"}), env.snap.point({"target": "mouth"})
-        obs, _ = env.reset(seed=0)
-        indices, closest = [], float("inf")
-        for _ in range(env.manifest.sim.episode_steps):
-            obs, *_ = env.step(policy(obs))
-            indices.append(policy.tracks[0].index)
-            if indices[-1] == 0:
-                closest = min(closest, float(np.linalg.norm(env.snap.position(spoon) - env.snap.position(mouth))))
-    finally:
-        env.close()
-    assert closest > 0.01  # the face is in the way of the first goal, 5 cm behind the lips
-    assert 1 in indices and indices[-1] == 1 and 2 not in indices
-    assert indices.index(1) < len(indices) - 20  # kept for the rest of the episode, not merely reached late
-
-
 class _capture:
     """Collect what the CLI prints on stderr."""
 

@@ -11,10 +11,8 @@ and may turn the tool towards that target's surface (``face_normal_within_rad``:
 rotation of the start orientation that brings the tool's pointing axis — end effector to moved
 point — within that angle of the inward normal, so a spot on the far side of a limb is met tip
 first rather than with the tool lying across the limb), and may be approached along a straight line
-(``step_m``: IK aims at most that far ahead of the moved point). A waypoint with ``hold_within_m`` is
-kept for good once the moved point has come that close to it, and left for the next one only if the
-point stalls short of that (a fallback for a goal that something may block, e.g. a face in the cup's
-way). Works for any task and robot whose manifest has a ``scripted`` section.
+(``step_m``: IK aims at most that far ahead of the moved point). Works for any task and robot whose
+manifest has a ``scripted`` section.
 """
 
 from __future__ import annotations
@@ -44,7 +42,6 @@ class _Track:
         self.orientations = [pb.getQuaternionFromEuler(w["rpy_rad"]) if w.get("rpy_rad") else None for w in section["waypoints"]]
         self.face_normal = [w.get("face_normal_within_rad") for w in section["waypoints"]]
         self.steps_m = [w.get("step_m") for w in section["waypoints"]]
-        self.hold_within = [w.get("hold_within_m") for w in section["waypoints"]]
         self.repeat_from = section.get("repeat_from")
         robot = env.world.robot
         self.ee_link = robot.links[mount_link]
@@ -148,13 +145,7 @@ class ScriptedPolicy:
             else:
                 track.since_best += 1
             last = track.index == len(track.waypoints) - 1
-            stalled = track.since_best >= STALL_STEPS
-            hold = track.hold_within[track.index]
-            if hold is not None:  # kept once the point came within hold_within_m; left only if it stalled short of that
-                leave = stalled and track.best > hold
-            else:
-                leave = error <= tol or stalled
-            if (not last or track.repeat_from is not None) and leave:
+            if (not last or track.repeat_from is not None) and (error <= tol or track.since_best >= STALL_STEPS):
                 track.index = track.index + 1 if not last else track.repeat_from
                 track.best, track.since_best = float("inf"), 0
                 goal, tol = self._goal(track)

@@ -51,7 +51,6 @@ def _script(s: Scope, script, base: tuple) -> dict[str, Any]:
                           "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
                           "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
                           "face_normal_within_rad": math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None}
-                         | ({"step_m": step_m or w.step_m} if w.step_m is not None else {})  # absent when unset: other artifacts unchanged
-                         | ({"hold_within_m": w.hold_within_m} if w.hold_within_m is not None else {}))
+                         | ({"step_m": step_m or w.step_m} if w.step_m is not None else {}))  # absent when unset: other artifacts unchanged
     move, where = (script.move, base + ("move",)) if script.move is not None else (spec.scripted.move, ("scripted", "move"))  # a robot's own script may keep the task's point
     return {"move": s.point(move, where), "waypoints": waypoints, "repeat_from": script.repeat_from}

@@ -34,12 +34,6 @@ class Waypoint(Strict):
         "for this waypoint: the point then follows the straight line from where it is (e.g. wiping along a limb) instead of the "
         "joint-space path one IK jump takes. None: IK aims at the waypoint itself."
     )
-    hold_within_m: float | None = Field(
-        None, gt=0, le=0.5, description="Once the moved point has come this close to the waypoint (metres), the script stays "
-        "at it as if it were the last; if the point stops getting closer before that (the goal is blocked, e.g. by a face "
-        "turned into the tool's way), the script goes on to the next waypoint, a fallback. tolerance_m is not used then. "
-        "None: the script goes on within tolerance_m or when the point stops getting closer."
-    )
 
 
 class _WaypointScript(Strict):
