@@ -507,14 +507,24 @@ def test_scripted_per_robot_names_known_robots(tmp_path, capsys):
     check(capsys, path, f"{at(text, 'jacco')}: per_robot names unknown robot 'jacco'; expected one of {one_of(robots)} (did you mean 'jaco'?)")
 
 
+def test_per_robot_arm_rest_has_one_value_per_arm_joint(tmp_path, capsys):
+    text = f"extends: {BATHING}\nrobot:\n  per_robot:\n    jaco:\n      arm_rest_rad: [0.0, 1.0]\n"
+    path = write(tmp_path, text)
+    lines = problems(capsys, path)
+    assert lines == [f"{display(path)}:{at(text, '[0.0, 1.0]')}: arm_rest_rad has 2 values "
+                     "but the arm of 'jaco' has 7 joints (j2s7s300_joint_1, j2s7s300_joint_2, j2s7s300_joint_3, j2s7s300_joint_4, "
+                     "j2s7s300_joint_5, j2s7s300_joint_6, j2s7s300_joint_7)"]
+
+
 def test_scripted_per_robot_waypoints_are_checked_where_written(tmp_path, capsys):
-    # Panda: a robot without a script of its own in the shipped spec (an override merges with a shipped one).
+    # Panda has a script of its own in the shipped spec: an override merges with it (the waypoint list is replaced,
+    # repeat_from kept unless given, so the second case gives its own).
     text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    panda:\n      waypoints: [{{to: person.right_elbow}}]\n      repeat_from: 1\n"
     path = write(tmp_path, text)
     line, column = at(text, "repeat_from: 1").split(":")
     check(capsys, path, f"{line}:{int(column) + len('repeat_from: ')}: scripted.per_robot.panda.repeat_from: "
                         "repeat_from 1 is not a waypoint index (0..0)")
-    text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    panda:\n      waypoints: [{{to: person.right_elbw}}]\n"
+    text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    panda:\n      waypoints: [{{to: person.right_elbw}}]\n      repeat_from: 0\n"
     path = write(tmp_path, text)
     lines = problems(capsys, path)
     assert len(lines) == 1 and lines[0].startswith(f"{display(path)}:{at(text, 'person.right_elbw')}: ") \

@@ -147,10 +147,11 @@ def test_scripted_per_robot_replaces_the_waypoints_for_that_robot_only(tmp_path)
     path = tmp_path / "own.yaml"
     path.write_text(f"extends: {TASKS / 'bed_bathing.yaml'}\nscripted:\n  per_robot:\n    sawyer:\n      waypoints:\n"
                     "        - {to: person.right_elbow, offset_m: [0, 0, 0.1]}\n        - {to: person.right_wrist, rpy_deg: [-30, 0, 90]}\n"
-                    "      repeat_from: 0\n    panda:\n      move: wiper.pad\n      waypoints: [{to: person.right_shoulder}]\n")
+                    "      repeat_from: 0\n    panda:\n      $replace: {move: wiper.pad, waypoints: [{to: person.right_shoulder}]}\n"
+                    "    $delete: [pr2]\n")
     loaded = load_spec(path)
     task = loaded.spec.scripted
-    # PR2 has no script of its own in the shipped spec (Sawyer, Jaco and Baxter do; the override replaces Sawyer's).
+    # Every shipped robot has a script of its own; the override replaces Sawyer's and Panda's and deletes PR2's.
     sawyer, panda, pr2 = (resolve(loaded, r).scripted for r in ("sawyer", "panda", "pr2"))
     assert [w["to"]["link"] for w in sawyer["waypoints"]] == ["right_elbow", "right_wrist"]
     assert sawyer["repeat_from"] == 0 and sawyer["waypoints"][1]["rpy_rad"] == pytest.approx([math.radians(-30), 0.0, math.radians(90)])
@@ -418,6 +419,20 @@ def test_free_standing_robot_has_no_nightstand(tmp_path):
         assert np.isfinite(obs).all()
     finally:
         env.close()
+
+
+@pytest.mark.slow
+def test_per_robot_arm_rest_starts_the_panda_inside_its_joint_limits(tmp_path):
+    """robot.per_robot.panda.arm_rest_rad (Panda's ready pose) is where Bed Bathing's start IK begins:
+    every start keeps each joint at least 0.2 rad inside its limits (from the part's all-zero rest,
+    joint 4 on its limit, some starts sat on joint 2's or joint 7's limit and jammed in the first lane)."""
+    manifest = compile_task(TASKS / "bed_bathing.yaml", "panda", tmp_path / "bathing-panda").manifest
+    lower, upper = np.asarray(manifest.robot.joint_lower), np.asarray(manifest.robot.joint_upper)
+    starts = [s for v in manifest.person.variants for s in v.starts]
+    assert starts
+    for start in starts:
+        q = np.asarray(start.joints)
+        assert np.minimum(q - lower, upper - q).min() >= 0.2, start.joints
 
 
 # --------------------------------------------------------------------------------------------

@@ -54,6 +54,7 @@ def resolve(loaded: LoadedSpec, robot: str | None = None, library: Library | Non
     s.joint_groups = robot_section.joint_groups(s)
     person.check_person(s)
     robot_section.check_mount(s)
+    robot_section.check_arm_rest(s)
     points = bodies.targets(s)
     markers = bodies.markers(s)
     bodies.check_particles(s)

@@ -138,6 +138,22 @@ def check_mount(s: Scope) -> None:
                              f"or set tools.{name}.grip to one of its grips: {one_of(grips)}){did_you_mean(grip, grips)}")
 
 
+def check_arm_rest(s: Scope) -> None:
+    """``per_robot.<robot>.arm_rest_rad``: one value per joint of the one acting arm."""
+    own = s.spec.robot.per_robot.get(s.robot_name)
+    if own is None or own.arm_rest_rad is None:
+        return
+    where = ("robot", "per_robot", s.robot_name, "arm_rest_rad")
+    if len(s.sides) > 1:
+        s.problem(where, "arm_rest_rad is the acting arm's rest in a task acting with one arm; this task acts with both "
+                         f"arms of '{s.robot_name}' (set rest_rad per arm in {s.robot.shown})")
+        return
+    joints = s.robot.part.arm_for(s.sides[0])[1].joints
+    if len(own.arm_rest_rad) != len(joints):
+        s.problem(where, f"arm_rest_rad has {len(own.arm_rest_rad)} values but the arm of '{s.robot_name}' has {len(joints)} "
+                         f"joints ({', '.join(joints)})")
+
+
 def _check_searched_mount(s: Scope, mount: str | None) -> None:
     """``mount_base: search`` carries the mount furniture under the searched base: it needs one,
     only_when_mounted, and without a placement of its own."""

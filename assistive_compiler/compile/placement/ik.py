@@ -139,8 +139,10 @@ def arm_chains(rt: ResolvedTask, pc: PlacementClient, scene) -> list[tuple[ArmKi
     robot_part = rt.robot.part
     arms: list[tuple[ArmKinematics, object, tuple]] = []
     offset_in_action = 0
+    own = rt.spec.robot.per_robot.get(rt.robot_name)
     for side in rt.sides:
         real_side, arm = robot_part.arm_for(side)
+        rest = own.arm_rest_rad if own is not None and own.arm_rest_rad is not None else arm.rest_rad
         n = len(arm.joints)
         side_start = start_for(rt, side)
         side_orn = quat_from_rpy_deg(side_start.tool_rpy_deg)
@@ -157,7 +159,7 @@ def arm_chains(rt: ResolvedTask, pc: PlacementClient, scene) -> list[tuple[ArmKi
         drive = robot_part.base_drive
         kin = ArmKinematics(pc, scene.robot, pc.link_index(scene.robot, arm.tool_mount), [scene.robot_joints[j] for j in arm.joints],
                             scene.lower[offset_in_action:offset_in_action + n], scene.upper[offset_in_action:offset_in_action + n],
-                            inv, side_tools, list(scene.furniture.values()), arm.rest_rad,
+                            inv, side_tools, list(scene.furniture.values()), rest,
                             followers={scene.robot_joints[f]: arm.joints.index(lead) for f, lead in arm.follow.items()},
                             frozen=[scene.robot_joints[j] for j in drive.joints] if drive else None)
         arms.append((kin, side_start, side_orn))

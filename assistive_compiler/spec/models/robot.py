@@ -74,6 +74,11 @@ class PerRobot(Strict):
         None, description="This robot's base search, replacing robot.base_search (e.g. a robot that reaches a goal only "
         "part of the time, where the task requires it of the others)."
     )
+    arm_rest_rad: list[float] | None = Field(
+        None, description="The acting arm's configuration (rad or m, in the arm's joint order) that the compile-time IK "
+        "(base search, start states) starts from, replacing the robot part's rest_rad in this task (e.g. Panda's default "
+        "all-zero rest, a straight-up arm on joint 4's limit, led its bed-bathing starts into configurations at the limits)."
+    )
 
 
 class RobotRole(Strict):
