@@ -87,7 +87,9 @@ def test_robot_control_defaults_apply_unless_the_task_sets_them(tmp_path):
     text = FEEDING.read_text()
     assert control_line in text
     text = text.replace(control_line, "").replace("supported: [", "supported: [kuka_iiwa, ")
-    text = text.replace("  per_robot:", "  per_robot:\n    kuka_iiwa: {base_offset_m: [0.3, 0.1, 0.0]}")
+    robot_per_robot = "  per_robot:                              # the reference's base offsets for feeding (x, y; height is each robot's own)\n"
+    assert robot_per_robot in text  # robot.per_robot (scripted: has a per_robot of its own)
+    text = text.replace(robot_per_robot, robot_per_robot + "    kuka_iiwa: {base_offset_m: [0.3, 0.1, 0.0]}\n")
     loose = tmp_path / "loose.yaml"
     loose.write_text(text)  # Feeding without its control line: the robot's defaults apply
     robot = compile_task(loose, "kuka_iiwa", tmp_path / "b", library=library).manifest.robot
