@@ -140,8 +140,8 @@ def check_mount(s: Scope) -> None:
 
 def check_arm_rest(s: Scope) -> None:
     """``per_robot.<robot>.arm_rest_rad``: one value per joint of the one acting arm."""
-    own = s.spec.robot.per_robot.get(s.robot_name)
-    if own is None or own.arm_rest_rad is None:
+    rest = s.spec.robot.arm_rest_for(s.robot_name)
+    if rest is None:
         return
     where = ("robot", "per_robot", s.robot_name, "arm_rest_rad")
     if len(s.sides) > 1:
@@ -149,8 +149,8 @@ def check_arm_rest(s: Scope) -> None:
                          f"arms of '{s.robot_name}' (set rest_rad per arm in {s.robot.shown})")
         return
     joints = s.robot.part.arm_for(s.sides[0])[1].joints
-    if len(own.arm_rest_rad) != len(joints):
-        s.problem(where, f"arm_rest_rad has {len(own.arm_rest_rad)} values but the arm of '{s.robot_name}' has {len(joints)} "
+    if len(rest) != len(joints):
+        s.problem(where, f"arm_rest_rad has {len(rest)} values but the arm of '{s.robot_name}' has {len(joints)} "
                          f"joints ({', '.join(joints)})")
 
 

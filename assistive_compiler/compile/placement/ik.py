@@ -139,10 +139,10 @@ def arm_chains(rt: ResolvedTask, pc: PlacementClient, scene) -> list[tuple[ArmKi
     robot_part = rt.robot.part
     arms: list[tuple[ArmKinematics, object, tuple]] = []
     offset_in_action = 0
-    own = rt.spec.robot.per_robot.get(rt.robot_name)
+    own_rest = rt.spec.robot.arm_rest_for(rt.robot_name)  # this task's rest for the acting arm, if it sets one
     for side in rt.sides:
         real_side, arm = robot_part.arm_for(side)
-        rest = own.arm_rest_rad if own is not None and own.arm_rest_rad is not None else arm.rest_rad
+        rest = own_rest if own_rest is not None else arm.rest_rad
         n = len(arm.joints)
         side_start = start_for(rt, side)
         side_orn = quat_from_rpy_deg(side_start.tool_rpy_deg)

@@ -112,6 +112,12 @@ class RobotRole(Strict):
         own = self.per_robot.get(robot)
         return own.base_search if own is not None and own.base_search is not None else self.base_search
 
+    def arm_rest_for(self, robot: str) -> list[float] | None:
+        """The acting arm's rest pose (rad) where ``robot``'s IK begins in this task: its
+        per_robot ``arm_rest_rad``, or None (the robot part's own ``rest_rad``)."""
+        own = self.per_robot.get(robot)
+        return own.arm_rest_rad if own is not None else None
+
     @model_validator(mode="after")
     def _default_supported(self) -> "RobotRole":
         if self.default not in self.supported:
