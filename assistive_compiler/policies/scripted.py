@@ -24,7 +24,7 @@ import math
 import numpy as np
 import pybullet as pb
 
-from ..ik_options import PYBULLET_DAMPING, ik_damping, ik_limits
+from ..ik_options import ik_damping, ik_limits
 from ..quat import quat_conj, quat_mul, quat_rotate
 
 
@@ -90,12 +90,9 @@ class ScriptedPolicy:
         self.ranges = [max(h - l, 1e-3) for l, h in zip(self.lo_all, self.hi_all)]
         # A mobile base drives: IK moves its planar joints with the arm, and the wheel actions head
         # for the planar change it asks of the base (see :meth:`_wheels`).
-        self.damping = ik_damping(movable, [], env.drive.idx if env.drive else [])
-        named = m.scripted.get("ik_damping")  # the robot's own script damps some arm joints (e.g. a slow shoulder)
-        if named:
-            self.damping = self.damping or [PYBULLET_DAMPING] * len(movable)
-            for name, value in named.items():
-                self.damping[movable.index(robot.joints[name])] = value
+        # The robot's own script may damp some arm joints (e.g. a slow shoulder).
+        own = {robot.joints[name]: value for name, value in (m.scripted.get("ik_damping") or {}).items()}
+        self.damping = ik_damping(movable, [], env.drive.idx if env.drive else [], own)
         self.drive_cols = [movable.index(j) for j in env.drive.idx] if env.drive else []
         self.arm_offset = 2 if env.drive else 0
 
