@@ -468,8 +468,10 @@ def test_scripted_cup_tips_no_faster_than_its_turn_step(tmp_path):
                     "        - {to: mouth, offset_m: [0.0, -0.10, 0.03], tolerance_m: 0.03}\n"
                     "        - {to: mouth, offset_m: [0.0, -0.06, 0.04], tolerance_m: 0.01}\n"
                     "        - {to: mouth, offset_m: [0.0, -0.005, 0.045], rpy_deg: [-95, 0, 0], tolerance_m: 0.0, turn_step_deg: 1}\n")
+    task = tmp_path / "task.yaml"  # Jaco on the task's own pour
+    task.write_text(f"extends: {TASKS / 'drinking.yaml'}\nscripted:\n  per_robot:\n    $delete: [jaco]\n")
     tilts = {}
-    for name, spec in (("slow", path), ("task", TASKS / "drinking.yaml")):
+    for name, spec in (("slow", path), ("task", task)):
         env = AssistiveEnv(compile_task(spec, "jaco", tmp_path / name).out_dir)
         try:
             assert [w.get("turn_step_rad") for w in env.manifest.scripted["waypoints"]] == \
