@@ -531,6 +531,57 @@ def test_scripted_per_robot_waypoints_are_checked_where_written(tmp_path, capsys
         and "unknown link 'right_elbw' of person" in lines[0] and lines[0].endswith("(did you mean 'right_elbow'?)")
 
 
+SHIPPED_SEGMENTS = "'lane_40', 'onto_forearm', 'side_lanes'"  # the shipped bed-bathing spec's scripted.segments
+
+
+def test_segment_uses_name_a_segment_and_segments_splice_none(tmp_path, capsys):
+    """{segment: NAME} names a segment of scripted.segments (with a "did you mean"), takes no other
+    key, and a segment holds waypoints only (one level: a reader looks a name up once)."""
+    text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    panda:\n      waypoints: [{{segment: side_lane}}]\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, 'side_lane}')}: unknown segment 'side_lane'; expected one of {SHIPPED_SEGMENTS} "
+                        "(did you mean 'side_lanes'?)")
+    text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    panda:\n      waypoints: [{{segment: lane_40, step_m: 0.1}}]\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, 'step_m')}: unknown key 'step_m' in scripted.per_robot.panda.waypoints[0]; expected one of 'segment'")
+    text = (f"extends: {BATHING}\nscripted:\n  segments:\n    both: [{{segment: lane_40}}, {{to: person.right_elbow}}]\n"
+            "  per_robot:\n    panda:\n      waypoints: [{segment: both}]\n")
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, 'lane_40')}: segment 'both' uses segment 'lane_40'; a segment holds waypoints only: "
+                        "write them here, or splice both segments into the script one after the other")
+
+
+def test_segments_are_not_empty_and_each_one_a_spec_defines_is_used(tmp_path, capsys):
+    """An empty segment and one the spec file defines but no script uses are errors (a dead segment
+    drifts from the scripts a reader thinks use it); one inherited through extends may go unused."""
+    text = (f"extends: {BATHING}\nscripted:\n  segments:\n    none: []\n    spare: [{{to: person.right_elbow}}]\n"
+            "  per_robot:\n    panda:\n      waypoints: [{segment: none}, {to: person.right_wrist}]\n")
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, '[]')}: segment 'none' has no waypoints; give it at least one, or delete it",
+          f"{at(text, 'spare')}: segment 'spare' is never used; splice it into a script with {{segment: spare}}, or delete it")
+    # Scripts of their own for every robot: the shipped spec's segments, inherited, are used by none.
+    text = (f"extends: {BATHING}\nscripted:\n  waypoints: [{{to: person.right_elbow}}, {{to: person.right_wrist}}]\n"
+            "  per_robot: {$replace: {}}\n")
+    path = write(tmp_path, text)
+    rc, out, err = run_cli(capsys, "validate", str(path))
+    assert (rc, err) == (0, "")
+
+
+def test_segment_waypoints_are_checked_where_the_segment_writes_them(tmp_path, capsys):
+    """A mistake in a segment's waypoint is reported once, at the segment, however often it is
+    spliced in; repeat_from counts the spliced waypoints."""
+    text = (f"extends: {BATHING}\nscripted:\n  segments:\n    bad: [{{to: person.right_elbw}}]\n"
+            "  per_robot:\n    panda:\n      waypoints: [{segment: bad}, {segment: bad}]\n")
+    path = write(tmp_path, text)
+    lines = problems(capsys, path)
+    assert len(lines) == 1 and lines[0].startswith(f"{display(path)}:{at(text, 'person.right_elbw')}: unknown link 'right_elbw' of person")
+    text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    panda:\n      waypoints: [{{segment: lane_40}}]\n      repeat_from: 4\n"
+    path = write(tmp_path, text)
+    line, column = at(text, "repeat_from: 4").split(":")
+    check(capsys, path, f"{line}:{int(column) + len('repeat_from: ')}: scripted.per_robot.panda.repeat_from: "
+                        "repeat_from 4 is not a waypoint index (0..3)")
+
+
 def test_searched_mount_needs_furniture_present_only_when_mounted(tmp_path, capsys):
     text = f"extends: {BATHING}\nscene:\n  furniture:\n    nightstand: {{part: nightstand, only_when_mounted: false}}\n"
     path = write(tmp_path, text)

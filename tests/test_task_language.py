@@ -157,7 +157,52 @@ def test_scripted_per_robot_replaces_the_waypoints_for_that_robot_only(tmp_path)
     assert sawyer["repeat_from"] == 0 and sawyer["waypoints"][1]["rpy_rad"] == pytest.approx([math.radians(-30), 0.0, math.radians(90)])
     assert sawyer["move"] == pr2["move"] and panda["move"] != pr2["move"]
     assert len(panda["waypoints"]) == 1 and panda["repeat_from"] is None
-    assert len(pr2["waypoints"]) == len(task.waypoints) and pr2["repeat_from"] == task.repeat_from
+    assert len(pr2["waypoints"]) == len(task.spliced(task.waypoints, ())) and pr2["repeat_from"] == task.repeat_from
+
+
+# Jaco's bed-bathing script as written out before scripted.segments (a robot's step_m of 0.12 now replaces the
+# segments' 0.07): the spliced script must be this list, so the conversion changed nothing Jaco does.
+JACO_BATHING_WRITTEN_OUT = """\
+- {to: person.right_shoulder, offset_m: [-0.05, -0.08, 0.10], rpy_deg: [-40, 0, 90], tolerance_m: 0.03}
+- {to: person.right_shoulder, offset_m: [-0.0174, -0.08, 0.0207], rpy_deg: [-40, 0, 90], tolerance_m: 0.02, step_m: 0.12}
+- {to: person.right_elbow, offset_m: [-0.0180, 0.0, 0.0214], rpy_deg: [-40, 0, 90], tolerance_m: 0.05, step_m: 0.12}
+- {to: person.right_wrist, offset_m: [-0.0109, 0.04, 0.0130], rpy_deg: [-40, 0, 90], tolerance_m: 0.03, step_m: 0.12}
+- {to: person.right_wrist, offset_m: [-0.045, 0.04, 0.027], rpy_deg: [-80, 0, 90], tolerance_m: 0.03}
+- {to: person.right_wrist, offset_m: [-0.0166, 0.04, 0.0212], rpy_deg: [-80, 0, 90], tolerance_m: 0.02, step_m: 0.12}
+- {to: person.right_elbow, offset_m: [-0.022, -0.04, 0.022], rpy_deg: [-80, 0, 90], tolerance_m: 0.03, step_m: 0.12}
+- {to: person.right_elbow, offset_m: [-0.065, 0.06, 0.03], rpy_deg: [-85, 0, 90], tolerance_m: 0.03}
+- {to: person.right_elbow, offset_m: [-0.0253, 0.06, 0.0203], rpy_deg: [-85, 0, 90], tolerance_m: 0.02, step_m: 0.12}
+- {to: person.right_shoulder, offset_m: [-0.0253, -0.08, 0.0203], rpy_deg: [-85, 0, 90], tolerance_m: 0.02, step_m: 0.12}
+- {to: person.right_shoulder, offset_m: [-0.06, -0.06, 0.06], rpy_deg: [-55, 0, 90], tolerance_m: 0.03}
+- {to: person.right_shoulder, offset_m: [-0.03, -0.06, 0.07], rpy_deg: [-25, 0, 90], tolerance_m: 0.03}
+- {to: person.right_shoulder, offset_m: [-0.0047, -0.06, 0.0266], rpy_deg: [-10, 0, 90], tolerance_m: 0.02, step_m: 0.12}
+- {to: person.right_elbow, offset_m: [-0.0049, 0.0, 0.0276], rpy_deg: [-10, 0, 90], tolerance_m: 0.05, step_m: 0.12}
+"""
+
+
+def test_segments_splice_into_the_script_they_replaced(tmp_path):
+    """Segments are spliced at resolve time: Jaco's shipped bed-bathing script (its own lane, two of
+    the task's segments, its own lanes; step_m 0.12 over the segments' 0.07) resolves to exactly the
+    waypoint list it was written as before, and so does a task-level use (repeat_from counting the
+    spliced waypoints)."""
+    from assistive_compiler.resolve import resolve
+    from assistive_compiler.spec.load import load_spec
+    from assistive_compiler.spec.models import SegmentUse
+
+    shipped = load_spec(TASKS / "bed_bathing.yaml")
+    assert any(isinstance(item, SegmentUse) for item in shipped.spec.scripted.per_robot["jaco"].waypoints)
+    listed = tmp_path / "listed.yaml"
+    items = "".join(f"        {line}\n" for line in JACO_BATHING_WRITTEN_OUT.splitlines())
+    listed.write_text(f"extends: {TASKS / 'bed_bathing.yaml'}\nscripted:\n  per_robot:\n    jaco:\n"
+                      f"      $replace:\n        waypoints:\n{items}        repeat_from: 1\n")
+    assert resolve(shipped, "jaco").scripted == resolve(load_spec(listed), "jaco").scripted
+    # The task's script on a robot without its own: the same splice, read through per_robot's absence.
+    bare = tmp_path / "bare.yaml"
+    bare.write_text(f"extends: {TASKS / 'bed_bathing.yaml'}\nscripted:\n  per_robot: {{$replace: {{}}}}\n")
+    task = resolve(load_spec(bare), "jaco").scripted
+    segments = shipped.spec.scripted.segments
+    assert len(task["waypoints"]) == len(segments["lane_40"]) + len(segments["onto_forearm"]) + 2 and task["repeat_from"] == 1
+    assert [w["offset_m"] for w in task["waypoints"][:4]] == [list(w.offset_m) for w in segments["lane_40"]]
 
 
 def test_scripted_per_robot_step_m_replaces_the_look_ahead_of_straight_line_waypoints_only(tmp_path):

@@ -30,7 +30,10 @@ class Collector:
         return self.loaded.smap.key(tuple(path))
 
     def problem(self, path: tuple, message: str, key: bool = False) -> None:
-        self.problems.append(Problem(self.key_at(*path) if key else self.at(*path), message))
+        """Report ``message`` at ``path`` (once: a segment's waypoint is checked wherever it is spliced in)."""
+        problem = Problem(self.key_at(*path) if key else self.at(*path), message)
+        if problem not in self.problems:
+            self.problems.append(problem)
 
     def fail_if_any(self) -> None:
         """Raise every problem collected so far, if there is one."""

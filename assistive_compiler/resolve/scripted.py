@@ -1,11 +1,14 @@
 """The ``scripted`` section: waypoints of the built-in IK baseline policy.
 
-Checks that ``per_robot`` keys name known robots, that every ``move`` and waypoint ``to`` is a
-known point, that surface offsets (``normal_offset_m``, ``axis_offset_m``,
-``face_normal_within_deg``) are used only with targets drawn on a surface, that
-``face_normal_level`` comes with ``face_normal_within_deg`` and that a robot's ``ik_damping``
-names its acting arm joints. Produces this robot's script (its own ``per_robot`` one if it has it, else the task's; a two-arm robot's ``left`` part
-under ``"left"``), with points resolved and angles in radians.
+Checks that ``per_robot`` keys name known robots, that every ``{segment: NAME}`` names a segment
+of ``scripted.segments`` (and none stands inside a segment), that no segment is empty and that each
+segment the spec file itself defines is used, that every ``move`` and waypoint ``to`` is a known
+point, that surface offsets (``normal_offset_m``, ``axis_offset_m``, ``face_normal_within_deg``) are
+used only with targets drawn on a surface, that ``face_normal_level`` comes with
+``face_normal_within_deg`` and that a robot's ``ik_damping`` names its acting arm joints. Produces
+this robot's script (its own ``per_robot`` one if it has it, else the task's; a two-arm robot's
+``left`` part under ``"left"``), segments spliced in, with points resolved and angles in radians; a
+problem in a segment's waypoint is reported where the segment writes it.
 """
 
 from __future__ import annotations
@@ -13,6 +16,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from ..spec.models import SegmentUse
+from .located import expected
 from .robot import check_per_robot_keys
 from .scope import Scope
 
@@ -22,6 +27,7 @@ def scripted(s: Scope) -> dict[str, Any] | None:
     if spec.scripted is None:
         return None
     check_per_robot_keys(s, ("scripted", "per_robot"), spec.scripted.per_robot)
+    check_segments(s)
     own = spec.scripted.per_robot.get(s.robot_name)
     out = _script(s, own, ("scripted", "per_robot", s.robot_name)) if own is not None else _script(s, spec.scripted, ("scripted",))
     if own is not None and own.ik_damping:
@@ -38,6 +44,34 @@ def scripted(s: Scope) -> dict[str, Any] | None:
     return out
 
 
+def check_segments(s: Scope) -> None:
+    """Every segment use names a segment and stands in a script (not in a segment); every segment
+    holds a waypoint and, when this spec file defines it, is used by a script (one a spec extends
+    may be left unused by the extension's scripts)."""
+    section = s.spec.scripted
+    names = section.segments
+    used: set[str] = set()
+    for where, script in section.scripts():
+        for i, item in enumerate(script.waypoints):
+            if not isinstance(item, SegmentUse):
+                continue
+            used.add(item.segment)
+            if item.segment not in names:
+                s.problem(("scripted",) + where + ("waypoints", i, "segment"), f"unknown segment '{item.segment}'; "
+                          f"{expected(names, item.segment, empty='none (declare one under scripted.segments:)')}")
+    this_file = s.at().path
+    for name, items in names.items():
+        path = ("scripted", "segments", name)
+        for j, item in enumerate(items):
+            if isinstance(item, SegmentUse):
+                s.problem(path + (j, "segment"), f"segment '{name}' uses segment '{item.segment}'; a segment holds waypoints "
+                          "only: write them here, or splice both segments into the script one after the other")
+        if not items:
+            s.problem(path, f"segment '{name}' has no waypoints; give it at least one, or delete it")
+        elif name not in used and s.at(*path).path == this_file:
+            s.problem(path, f"segment '{name}' is never used; splice it into a script with {{segment: {name}}}, or delete it", key=True)
+
+
 def _ik_damping(s: Scope, damping: dict[str, float]) -> dict[str, float]:
     """A robot's own script's IK damping by arm joint name; a problem for a name that is not one of
     the acting arm joints."""
@@ -50,20 +84,21 @@ def _ik_damping(s: Scope, damping: dict[str, float]) -> dict[str, float]:
 
 
 def _script(s: Scope, script, base: tuple) -> dict[str, Any]:
-    """One arm's script (``move``, ``waypoints``, ``repeat_from``) with its references resolved."""
+    """One arm's script (``move``, ``waypoints``, ``repeat_from``) with segments spliced in and
+    its references resolved (each problem located where its waypoint is written)."""
     spec = s.spec
     waypoints = []
     step_m = getattr(script, "step_m", None)  # a robot's own script may set every straight-line waypoint's look-ahead
-    for i, w in enumerate(script.waypoints):
-        to = s.point(w.to, base + ("waypoints", i, "to"))
+    for w, at in spec.scripted.spliced(script.waypoints, base + ("waypoints",)):
+        to = s.point(w.to, at + ("to",))
         used = {"normal_offset_m": w.normal_offset_m != 0.0, "axis_offset_m": w.axis_offset_m != 0.0,
                 "face_normal_within_deg": w.face_normal_within_deg is not None}
         if w.face_normal_level and w.face_normal_within_deg is None:
-            s.problem(base + ("waypoints", i, "face_normal_level"), "face_normal_level turns the tool to face the surface only "
+            s.problem(at + ("face_normal_level",), "face_normal_level turns the tool to face the surface only "
                       "with face_normal_within_deg (how far to turn); add it or drop face_normal_level")
         for key in used:
             if used[key] and not (w.to in spec.targets and spec.targets[w.to].surface_of):
-                s.problem(base + ("waypoints", i, key), f"{key} needs a target drawn on a surface (surface_of); '{w.to}' is not one")
+                s.problem(at + (key,), f"{key} needs a target drawn on a surface (surface_of); '{w.to}' is not one")
         waypoints.append({"to": to, "offset_m": list(w.offset_m), "tolerance_m": w.tolerance_m,
                           "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
                           "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,

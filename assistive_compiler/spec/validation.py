@@ -111,6 +111,10 @@ def model_at(root: type[BaseModel], path: DataPath, data: Any) -> type[BaseModel
             kind_field = m.model_fields.get("kind")
             if kind_field is not None and node["kind"] in typing.get_args(kind_field.annotation):
                 return m
+    if len(models) > 1 and isinstance(node, dict):  # e.g. a waypoint or {segment: NAME}: the model whose required keys are all there
+        for m in models:
+            if all(name in node for name, f in m.model_fields.items() if f.is_required()):
+                return m
     return models[0] if models else None
 
 

@@ -12,7 +12,8 @@ References between parts are plain strings checked by :mod:`assistive_compiler.r
 * a **link** of a body: ``body.semantic_link`` (``person.head``, ``robot.end_effector``,
   ``spoon.tip``); a bare body name means the body's reference link;
 * a **target**: a name declared under ``targets:`` (``mouth``);
-* a **joint group**: ``robot.arm`` or ``person.<group>`` (``person.head``, ``person.right_arm``).
+* a **joint group**: ``robot.arm`` or ``person.<group>`` (``person.head``, ``person.right_arm``);
+* a **segment** of waypoints: a name declared under ``scripted.segments:`` (``{segment: side_lanes}``).
 
 One module per spec section, in the order a spec reads: :mod:`.sim`, :mod:`.scene`,
 :mod:`.person`, :mod:`.robot` (robot role and tools), :mod:`.bodies` (targets, markers, particles,
@@ -29,7 +30,7 @@ from .person import Tremor, Weakness, LimitedRange, NoImpairment, Impairment, Im
 from .robot import RobotControl, StartGoal, Goal, BaseSearch, PerRobot, RobotRole, ToolUse
 from .bodies import Target, ClearedBy, Markers, ConsumedAt, LostBeyond, RestInContainer, Particles, SleeveShape, SoftBodyPhysics, GarmentHold, GarmentSettle, Garment
 from .terms import TermUse, RewardTerm, Observations, PREFERENCE_NAMES, PAPER_PREFERENCE_WEIGHTS, Preference, Preferences, Success
-from .scripted import Waypoint, ScriptedArm, ScriptedRobot, Scripted
+from .scripted import Waypoint, SegmentUse, WaypointItem, ScriptedArm, ScriptedRobot, Scripted
 from .task import CameraView, Camera, TaskSpec
 
 __all__ = [
@@ -88,6 +89,8 @@ __all__ = [
     "Preferences",
     "Success",
     "Waypoint",
+    "SegmentUse",
+    "WaypointItem",
     "ScriptedArm",
     "ScriptedRobot",
     "Scripted",

@@ -1,10 +1,15 @@
-"""``scripted``: waypoints of the built-in IK baseline, per arm and per robot."""
+"""``scripted``: waypoints of the built-in IK baseline, per arm and per robot.
+
+A waypoint list holds waypoints and ``{segment: NAME}`` items; the latter stand for the waypoints
+of ``scripted.segments.NAME``, spliced in at resolve time (:mod:`assistive_compiler.resolve.scripted`),
+so scripts that share lanes write them once. ``repeat_from`` counts the spliced waypoints.
+"""
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Any, Iterator, Union
 
-from pydantic import Field, model_validator
+from pydantic import Discriminator, Field, Tag, model_validator
 
 from .common import Name, Ref, Strict, Vec3
 
@@ -49,35 +54,48 @@ class Waypoint(Strict):
     )
 
 
-class _WaypointScript(Strict):
-    """A list of waypoints with an optional repeat_from (ScriptedArm, ScriptedRobot, Scripted)."""
+class SegmentUse(Strict):
+    """``{segment: NAME}`` in a waypoint list: the waypoints of ``scripted.segments.NAME``, in order, in its place."""
 
-    @model_validator(mode="after")
-    def _repeat_in_range(self) -> "_WaypointScript":
-        if self.repeat_from is not None and self.repeat_from >= len(self.waypoints):  # type: ignore[attr-defined]
-            raise ValueError(f"@repeat_from: repeat_from {self.repeat_from} is not a waypoint index (0..{len(self.waypoints) - 1})")  # type: ignore[attr-defined]
-        return self
+    segment: Name = Field(description="The name of a segment under scripted.segments, e.g. side_lanes; its waypoints "
+                          "go here, in order, as if written here.")
 
 
-class ScriptedArm(_WaypointScript):
+def _item_kind(value: Any) -> str:
+    """Which model a waypoint-list item is: ``{segment: ...}`` is a segment use, anything else a waypoint."""
+    if isinstance(value, dict):
+        return "SegmentUse" if "segment" in value else "Waypoint"
+    return "SegmentUse" if isinstance(value, SegmentUse) else "Waypoint"
+
+
+WaypointItem = Annotated[
+    Union[Annotated[Waypoint, Tag("Waypoint")], Annotated[SegmentUse, Tag("SegmentUse")]], Discriminator(_item_kind)
+]
+"""An item of a waypoint list: a waypoint, or ``{segment: NAME}`` splicing a named segment in."""
+
+
+class ScriptedArm(Strict):
     """The left arm's part of a scripted baseline when the robot acts with both arms."""
 
     move: Ref = Field(description="The point the left arm moves, e.g. scooper_left.blade.")
-    waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order; the last is held unless repeat_from is given.")
+    waypoints: list[WaypointItem] = Field(min_length=1, description="Goals in order, each a waypoint or {segment: NAME} (that "
+                                          "segment's waypoints); the last is held unless repeat_from is given.")
     repeat_from: int | None = Field(None, ge=0, description="After the last waypoint, go on from this index; None holds the last.")
 
 
-class ScriptedRobot(_WaypointScript):
+class ScriptedRobot(Strict):
     """One robot's own script: its waypoints replace the task's for that robot (robots differ in
     reach and in the wrist orientations they can hold, so one set of waypoints rarely suits all)."""
 
     move: Ref | None = Field(None, description="The point moved; None: the task's scripted.move.")
-    waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order, replacing scripted.waypoints for this robot; the last is held unless repeat_from is given.")
+    waypoints: list[WaypointItem] = Field(min_length=1, description="Goals in order, each a waypoint or {segment: NAME} (that "
+                                          "segment's waypoints), replacing scripted.waypoints for this robot; the last is held "
+                                          "unless repeat_from is given.")
     repeat_from: int | None = Field(None, ge=0, description="After the last waypoint, go on from this index (replacing scripted.repeat_from); None holds the last.")
     step_m: float | None = Field(
-        None, gt=0, le=0.5, description="Replaces the step_m of each of these waypoints that has one: how far ahead of the moved "
-        "point IK aims along a straight line, metres (robots differ in how far their tool lags behind that goal, so two robots "
-        "can share waypoints and differ in this). None: each waypoint's own."
+        None, gt=0, le=0.5, description="Replaces the step_m of each of these waypoints that has one (those spliced in from "
+        "segments too): how far ahead of the moved point IK aims along a straight line, metres (robots differ in how far their "
+        "tool lags behind that goal, so two robots can share waypoints and differ in this). None: each waypoint's own."
     )
     ik_damping: dict[Name, Annotated[float, Field(gt=0)]] = Field(
         default_factory=dict, description="pybullet IK damping of some of this robot's arm joints by joint name (the others "
@@ -87,13 +105,20 @@ class ScriptedRobot(_WaypointScript):
     )
 
 
-class Scripted(_WaypointScript):
+class Scripted(Strict):
     """A privileged baseline controller (IK each step) that moves a point of the tool through
     waypoints, keeping the tool's start orientation. It shows the task is solvable and checks the
     reward wiring; it is not a learned policy."""
 
     move: Ref = Field(description="The point moved, e.g. spoon (its reference link) or spoon.tip.")
-    waypoints: list[Waypoint] = Field(min_length=1, description="Goals in order; the last is held unless repeat_from is given.")
+    segments: dict[Name, list[WaypointItem]] = Field(
+        default_factory=dict, description="Named runs of waypoints (e.g. one lane along a limb), written once and spliced into "
+        "any waypoint list of this section (waypoints, left, right, per_robot.<robot>) by the item {segment: NAME}, so scripts "
+        "that share lanes do not copy them. A segment holds at least one waypoint and no {segment: ...} of its own, and each "
+        "segment a spec file defines is used."
+    )
+    waypoints: list[WaypointItem] = Field(min_length=1, description="Goals in order, each a waypoint or {segment: NAME} (that "
+                                          "segment's waypoints); the last is held unless repeat_from is given.")
     repeat_from: int | None = Field(
         None, ge=0, description="After the last waypoint, go on from this index (e.g. to rub back and forth); None holds the last."
     )
@@ -110,3 +135,41 @@ class Scripted(_WaypointScript):
         default_factory=dict, description="Scripts by robot name: the named robot follows its own move/waypoints/repeat_from "
         "instead of the ones above (left/right still apply to two-arm robots acting with both arms)."
     )
+
+    def scripts(self) -> Iterator[tuple[tuple[str, ...], "Scripted | ScriptedArm | ScriptedRobot"]]:
+        """Every waypoint script of this section with its path below ``scripted`` (``()`` for this one)."""
+        yield (), self
+        for side in ("left", "right"):
+            if getattr(self, side) is not None:
+                yield (side,), getattr(self, side)
+        for name, own in self.per_robot.items():
+            yield ("per_robot", name), own
+
+    def spliced(self, items: list[Waypoint | SegmentUse], path: tuple) -> list[tuple[Waypoint, tuple]]:
+        """``items`` (a waypoint list at data path ``path`` of the spec) with each ``{segment: NAME}``
+        replaced by that segment's waypoints, each waypoint paired with the data path it is written
+        at (for located problems). An unknown name, and a segment use inside a segment, splice
+        nothing (resolve reports them)."""
+        out: list[tuple[Waypoint, tuple]] = []
+        for i, item in enumerate(items):
+            if isinstance(item, Waypoint):
+                out.append((item, path + (i,)))
+            elif item.segment in self.segments:
+                where = ("scripted", "segments", item.segment)
+                out.extend((w, where + (j,)) for j, w in enumerate(self.segments[item.segment]) if isinstance(w, Waypoint))
+        return out
+
+    @model_validator(mode="after")
+    def _repeat_in_range(self) -> "Scripted":
+        """Each script's repeat_from is an index of its waypoints, segments spliced in."""
+        def plain(name: str) -> bool:  # a segment to count: known, not empty, no segment use in it (resolve reports the others)
+            return bool(self.segments.get(name)) and all(isinstance(w, Waypoint) for w in self.segments[name])
+
+        for where, script in self.scripts():
+            if not all(plain(i.segment) for i in script.waypoints if isinstance(i, SegmentUse)):
+                continue
+            count = len(self.spliced(script.waypoints, ()))
+            if script.repeat_from is not None and script.repeat_from >= count:
+                field = ".".join(where + ("repeat_from",))
+                raise ValueError(f"@{field}: repeat_from {script.repeat_from} is not a waypoint index (0..{count - 1})")
+        return self
