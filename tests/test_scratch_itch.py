@@ -29,3 +29,25 @@ def test_sawyer_reaches_an_itch_on_the_front_of_the_upper_arm_and_scratches_it(t
             obs, reward, terminated, truncated, info = env.step(policy(obs))
             done = terminated or truncated
         assert info["task_success"] == 1 and info["success_metric"] >= 25
+
+
+@pytest.mark.slow
+def test_pr2_stands_in_front_of_the_person_and_scratches_the_back_of_the_upper_arm(tmp_path_factory):
+    """PR2's base search keeps to the box in front of the person (robot.per_robot.pr2.base_search):
+    from the whole box it kept a base beside the arm, whose start left the slow shoulder 1.4 rad
+    from what seed 13's spot on the back of the upper arm (normal towards +y) needs, and the tip
+    ended 22 cm off with 0 scratches. From the front it reaches the spot and scratches 25 times."""
+    from assistive_compiler.policies.scripted import ScriptedPolicy
+
+    for env in compiled_env(tmp_path_factory, SCRATCH_ITCH, "pr2"):
+        for variant in env.manifest.person.variants:
+            assert all(start.base_position[1] < -0.55 for start in variant.starts)  # in front of the arm (y ~0)
+        policy = ScriptedPolicy(env)
+        obs, _ = env.reset(seed=13)
+        normal = env.snap.normal(policy.tracks[0].waypoints[0][0])
+        assert int(np.argmax(np.abs(normal))) == 1 and normal[1] > 0  # the back (+y) of the arm
+        done, info = False, {}
+        while not done:
+            obs, reward, terminated, truncated, info = env.step(policy(obs))
+            done = terminated or truncated
+        assert info["task_success"] == 1 and info["success_metric"] >= 25
