@@ -43,6 +43,21 @@ def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     ])
 
 
+def quat_towards(a, b, max_angle: float) -> np.ndarray:
+    """Unit quaternion on the shortest rotation from ``a`` to ``b`` (x, y, z, w), at most
+    ``max_angle`` (rad) from ``a``: ``b`` itself when it is that close already."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    d = quat_mul(b, quat_conj(a))  # the turn a -> b, in the world frame
+    if d[3] < 0:
+        d = -d
+    angle = 2 * math.acos(min(1.0, d[3]))
+    if angle <= max_angle:
+        return b
+    axis = d[:3] / max(float(np.linalg.norm(d[:3])), 1e-12)
+    h = max_angle / 2
+    return quat_mul(np.concatenate([axis * math.sin(h), [math.cos(h)]]), a)
+
+
 def quat_from_rpy(rpy: tuple[float, float, float]) -> tuple[float, float, float, float]:
     """Quaternion (x, y, z, w) of fixed-axis roll, pitch, yaw (rad; URDF convention R = Rz·Ry·Rx)."""
     r, p, y = (a / 2 for a in rpy)

@@ -494,6 +494,54 @@ def test_water_in_the_upright_cup_is_neither_drunk_nor_spilled(drinking):
     assert info["terms"]["cup_tilt"] < math.radians(10)
 
 
+def test_a_slow_turn_needs_a_positive_angle(tmp_path):
+    spec = (TASKS / "drinking.yaml").read_text()
+    assert "rpy_deg: [-95, 0, 0], turn_step_deg: 3}" in spec
+    spec = spec.replace("rpy_deg: [-95, 0, 0], turn_step_deg: 3}", "rpy_deg: [-95, 0, 0], turn_step_deg: 0}")
+    assert "turn_step_deg" in _rejected_at(tmp_path, spec, "turn_step_deg: 0}")
+
+
+@pytest.mark.slow
+def test_scripted_cup_tips_no_faster_than_its_turn_step(tmp_path):
+    """turn_step_deg (the pour speed): on the pour waypoint the orientation handed to IK turns 1 degree a
+    step from the cup's own, so the cup tips about that fast and reaches the waypoint's tilt in the end;
+    without it (the task's pour, the same Jaco episode) the cup is tipped further 70 steps in."""
+    from assistive_compiler.policies.scripted import ScriptedPolicy
+
+    path = tmp_path / "slow.yaml"
+    path.write_text(f"extends: {TASKS / 'drinking.yaml'}\nscripted:\n  per_robot:\n    jaco:\n      waypoints:\n"
+                    "        - {to: mouth, offset_m: [0.0, -0.10, 0.03], tolerance_m: 0.03}\n"
+                    "        - {to: mouth, offset_m: [0.0, -0.06, 0.04], tolerance_m: 0.01}\n"
+                    "        - {to: mouth, offset_m: [0.0, -0.005, 0.045], rpy_deg: [-95, 0, 0], tolerance_m: 0.0, turn_step_deg: 1}\n")
+    task = tmp_path / "task.yaml"  # Jaco on the task's own pour
+    task.write_text(f"extends: {TASKS / 'drinking.yaml'}\nscripted:\n  per_robot:\n    $delete: [jaco]\n")
+    tilts = {}
+    for name, spec in (("slow", path), ("task", task)):
+        env = AssistiveEnv(compile_task(spec, "jaco", tmp_path / name).out_dir)
+        try:
+            assert [w.get("turn_step_rad") for w in env.manifest.scripted["waypoints"]] == \
+                ([None, None, pytest.approx(math.radians(1))] if name == "slow" else [None, None, None])
+            policy = ScriptedPolicy(env)
+            obs, _ = env.reset(seed=0)
+            track, aimed, tilt = policy.tracks[0], [], []
+            for _ in range(200):
+                obs, _, terminated, truncated, info = env.step(policy(obs))
+                if track.index == 2:
+                    aimed.append(track.aimed_orn)
+                    tilt.append(math.degrees(info["terms"]["cup_tilt"]))
+            tilts[name] = tilt
+        finally:
+            env.close()
+        if name == "slow":
+            turns = [math.degrees(2 * math.acos(min(1.0, abs(float(np.dot(a, b)))))) for a, b in zip(aimed, aimed[1:])]
+            assert max(turns) == pytest.approx(1.0, abs=0.01)  # (acos near 1: ~1e-3 degrees of rounding)
+            assert max(b - a for a, b in zip(tilt, tilt[1:])) < 1.5  # the cup follows about as fast, no faster
+            assert 85 < tilt[-1] < 100  # and still tips to the waypoint's 95 degrees
+        else:
+            assert all(a is None for a in aimed)
+    assert tilts["task"][70] > tilts["slow"][70] + 15  # Jaco's own pace: ~1.3 degrees a step (84 vs 62 degrees here)
+
+
 def test_tilt_is_the_angle_from_upright():
     tilt = terms("reward")["tilt"].fn
     p = SimpleNamespace(of=None, axis=(0.0, 0.0, 1.0), up=(0.0, 0.0, 1.0))

@@ -12,7 +12,8 @@ rotation of the start orientation that brings the tool's pointing axis — end e
 point — within that angle of the inward normal, so a spot on the far side of a limb is met tip
 first rather than with the tool lying across the limb; with ``face_normal_level`` only about the
 vertical, for a wrist that only yaws), and may be approached along a straight line
-(``step_m``: IK aims at most that far ahead of the moved point). A robot's own script may damp
+(``step_m``: IK aims at most that far ahead of the moved point) and turned slowly (``turn_step_rad``:
+the orientation IK aims at turns at most that far each step). A robot's own script may damp
 some arm joints in the IK (``ik_damping``, e.g. a slow shoulder). Works for any task and robot
 whose manifest has a ``scripted`` section.
 """
@@ -25,7 +26,7 @@ import numpy as np
 import pybullet as pb
 
 from ..ik_options import ik_damping, ik_limits
-from ..quat import quat_conj, quat_mul, quat_rotate
+from ..quat import quat_conj, quat_mul, quat_rotate, quat_towards
 
 
 STALL_STEPS = 10  # steps without getting STALL_GAIN_M closer before moving on to the next waypoint
@@ -48,6 +49,7 @@ class _Track:
         self.face_normal = [w.get("face_normal_within_rad") for w in section["waypoints"]]
         self.face_level = [w.get("face_normal_level", False) for w in section["waypoints"]]
         self.steps_m = [w.get("step_m") for w in section["waypoints"]]
+        self.turn_steps = [w.get("turn_step_rad") for w in section["waypoints"]]
         self.repeat_from = section.get("repeat_from")
         robot = env.world.robot
         self.ee_link = robot.links[mount_link]
@@ -118,6 +120,7 @@ class ScriptedPolicy:
             track.axis_in_point = np.asarray(quat_rotate(quat_conj(pt_orn), d))
             track.index = 0
             track.best, track.since_best = float("inf"), 0
+            track.aimed_orn = None  # the orientation last handed to IK on a slow turn (turn_step_rad)
 
     @staticmethod
     def _facing(track: _Track, orn, inward: np.ndarray, within: float) -> list[float]:
@@ -173,6 +176,7 @@ class ScriptedPolicy:
             if (not last or track.repeat_from is not None) and (error <= tol or track.since_best >= STALL_STEPS):
                 track.index = track.index + 1 if not last else track.repeat_from
                 track.best, track.since_best = float("inf"), 0
+                track.aimed_orn = None
                 goal, tol = self._goal(track)
             step = track.steps_m[track.index]
             if step is not None:  # a straight line from where the point is: IK aims at most step_m ahead
@@ -187,6 +191,11 @@ class ScriptedPolicy:
             if track.face_normal[track.index] is not None:
                 turn = self._yawing if track.face_level[track.index] else self._facing
                 orn = turn(track, orn, -env.snap.normal(track.waypoints[track.index][0]), track.face_normal[track.index])
+            turn_step = track.turn_steps[track.index]
+            if turn_step is not None:  # a slow turn: the orientation handed to IK moves at most turn_step_rad a step,
+                # from the tool's own orientation when the waypoint began (not from the lagging tool's, which a contact can stop)
+                start = track.aimed_orn if track.aimed_orn is not None else env.snap.orientation(track.move)
+                orn = track.aimed_orn = quat_towards(start, orn, turn_step).tolist()
             ee_pos, ee_orn = pb.multiplyTransforms(goal.tolist(), orn, inv_pos, inv_orn)
             sol = pb.calculateInverseKinematics(robot, track.ee_link, ee_pos, ee_orn, maxNumIterations=50, physicsClientId=c,
                                                 **ik_limits(self, rest))

@@ -104,6 +104,7 @@ def _script(s: Scope, script, base: tuple) -> dict[str, Any]:
                           "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
                           "face_normal_within_rad": math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None}
                          | ({"step_m": step_m or w.step_m} if w.step_m is not None else {})  # absent when unset: other artifacts unchanged
-                         | ({"face_normal_level": True} if w.face_normal_level else {}))
+                         | ({"face_normal_level": True} if w.face_normal_level else {})
+                         | ({"turn_step_rad": math.radians(w.turn_step_deg)} if w.turn_step_deg is not None else {}))
     move, where = (script.move, base + ("move",)) if script.move is not None else (spec.scripted.move, ("scripted", "move"))  # a robot's own script may keep the task's point
     return {"move": s.point(move, where), "waypoints": waypoints, "repeat_from": script.repeat_from}

@@ -46,6 +46,12 @@ class Waypoint(Strict):
         "for this waypoint: the point then follows the straight line from where it is (e.g. wiping along a limb) instead of the "
         "joint-space path one IK jump takes. None: IK aims at the waypoint itself."
     )
+    turn_step_deg: float | None = Field(
+        None, gt=0, le=180, description="Pour speed: the orientation handed to IK while heading for this waypoint turns "
+        "at most this many degrees per step, from the moved point's orientation when the waypoint begins towards rpy_deg's "
+        "(or the kept one), so the tool turns at about that rate (e.g. a cup tipped slowly enough to reach the lips before "
+        "its water runs out) instead of as fast as the joints follow one IK jump. None: IK aims at the waypoint's orientation itself."
+    )
 
 
 class SegmentUse(Strict):
