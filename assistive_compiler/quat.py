@@ -43,6 +43,12 @@ def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     ])
 
 
+def quat_about(axis, angle: float) -> np.ndarray:
+    """Unit quaternion (x, y, z, w) turning by ``angle`` (rad) about the unit vector ``axis``."""
+    h = angle / 2
+    return np.concatenate([np.asarray(axis, dtype=float) * math.sin(h), [math.cos(h)]])
+
+
 def quat_towards(a, b, max_angle: float) -> np.ndarray:
     """Unit quaternion on the shortest rotation from ``a`` to ``b`` (x, y, z, w), at most
     ``max_angle`` (rad) from ``a``: ``b`` itself when it is that close already."""
@@ -54,8 +60,7 @@ def quat_towards(a, b, max_angle: float) -> np.ndarray:
     if angle <= max_angle:
         return b
     axis = d[:3] / max(float(np.linalg.norm(d[:3])), 1e-12)
-    h = max_angle / 2
-    return quat_mul(np.concatenate([axis * math.sin(h), [math.cos(h)]]), a)
+    return quat_mul(quat_about(axis, max_angle), a)
 
 
 def quat_from_rpy(rpy: tuple[float, float, float]) -> tuple[float, float, float, float]:

@@ -26,7 +26,7 @@ import numpy as np
 import pybullet as pb
 
 from ..ik_options import ik_damping, ik_limits
-from ..quat import quat_conj, quat_mul, quat_rotate, quat_towards
+from ..quat import quat_about, quat_conj, quat_mul, quat_rotate, quat_towards
 
 
 STALL_STEPS = 10  # steps without getting STALL_GAIN_M closer before moving on to the next waypoint
@@ -136,9 +136,7 @@ class ScriptedPolicy:
             if np.linalg.norm(k) < 1e-6:
                 k = np.cross(d, np.array([1.0, 0.0, 0.0]))
         k = k / np.linalg.norm(k)
-        turn = angle - within
-        q = np.concatenate([k * math.sin(turn / 2), [math.cos(turn / 2)]])
-        return quat_mul(q, np.asarray(orn)).tolist()
+        return quat_mul(quat_about(k, angle - within), np.asarray(orn)).tolist()
 
     @staticmethod
     def _yawing(track: _Track, orn, inward: np.ndarray, within: float) -> list[float]:
@@ -154,8 +152,7 @@ class ScriptedPolicy:
         if abs(angle) <= within:
             return list(orn)
         turn = math.copysign(abs(angle) - within, angle if angle != -math.pi else 1.0)
-        q = [0.0, 0.0, math.sin(turn / 2), math.cos(turn / 2)]
-        return quat_mul(np.asarray(q), np.asarray(orn)).tolist()
+        return quat_mul(quat_about((0.0, 0.0, 1.0), turn), np.asarray(orn)).tolist()
 
     def __call__(self, obs) -> np.ndarray:
         env = self.env
