@@ -49,16 +49,28 @@ def quat_about(axis, angle: float) -> np.ndarray:
     return np.concatenate([np.asarray(axis, dtype=float) * math.sin(h), [math.cos(h)]])
 
 
+def quat_angle(a, b) -> float:
+    """Angle (rad, 0 … π) of the smallest rotation between unit quaternions ``a`` and ``b``
+    (x, y, z, w); q and −q are the same orientation."""
+    return 2 * math.acos(min(1.0, abs(float(np.dot(a, b)))))
+
+
+def vec_angle(a, b) -> float:
+    """Angle (rad, 0 … π) between two nonzero vectors (any lengths)."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    cos = float(np.dot(a, b)) / (float(np.linalg.norm(a)) * float(np.linalg.norm(b)))
+    return math.acos(max(-1.0, min(1.0, cos)))
+
+
 def quat_towards(a, b, max_angle: float) -> np.ndarray:
     """Unit quaternion on the shortest rotation from ``a`` to ``b`` (x, y, z, w), at most
     ``max_angle`` (rad) from ``a``: ``b`` itself when it is that close already."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    if quat_angle(a, b) <= max_angle:
+        return b
     d = quat_mul(b, quat_conj(a))  # the turn a -> b, in the world frame
     if d[3] < 0:
         d = -d
-    angle = 2 * math.acos(min(1.0, d[3]))
-    if angle <= max_angle:
-        return b
     axis = d[:3] / max(float(np.linalg.norm(d[:3])), 1e-12)
     return quat_mul(quat_about(axis, max_angle), a)
 

@@ -26,7 +26,7 @@ import numpy as np
 import pybullet as pb
 
 from ..ik_options import ik_damping, ik_limits
-from ..quat import quat_about, quat_conj, quat_mul, quat_rotate, quat_towards
+from ..quat import quat_about, quat_conj, quat_mul, quat_rotate, quat_towards, vec_angle
 
 
 STALL_STEPS = 10  # steps without getting STALL_GAIN_M closer before moving on to the next waypoint
@@ -127,7 +127,7 @@ class ScriptedPolicy:
         """``orn`` turned by the smallest rotation that brings the track's pointing axis within
         ``within`` (rad) of the unit vector ``inward`` (world); unchanged when it already is."""
         d = quat_rotate(np.asarray(orn), track.axis_in_point)
-        angle = math.acos(max(-1.0, min(1.0, float(np.dot(d, inward)))))
+        angle = vec_angle(d, inward)
         if angle <= within:
             return list(orn)
         k = np.cross(d, inward)

@@ -106,11 +106,13 @@ class AssistiveEnv(gym.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
 
     def __init__(self, artifact_dir: str | Path, render_mode: str | None = None, render_size: tuple[int, int] = (480, 360),
-                 camera: dict | None = None):
-        """``camera``: eye / target (world m) / fov_deg overriding the task's camera in renders."""
+                 camera: dict | None = None, manifest: Manifest | None = None):
+        """``camera``: eye / target (world m) / fov_deg overriding the task's camera in renders.
+        ``manifest``: the artifact's manifest when the caller has just compiled or checked it
+        (``compile_task``'s result); otherwise it is read and every file checked against it."""
         self.camera = camera
         self.artifact_dir = Path(artifact_dir)
-        self.manifest = m = Manifest.read(self.artifact_dir, verify=True)
+        self.manifest = m = manifest if manifest is not None else Manifest.read(self.artifact_dir, verify=True)
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         self.render_mode = render_mode
@@ -163,7 +165,7 @@ class AssistiveEnv(gym.Env):
         from ..compile.compiler import compile_task
 
         result = compile_task(spec, robot, out_dir, library=library)
-        return cls(result.out_dir, **kwargs)
+        return cls(result.out_dir, manifest=result.manifest, **kwargs)
 
     # -- Gymnasium API ------------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):

@@ -44,6 +44,7 @@ import numpy as np
 import pybullet as pb
 
 from ..artifact import Container, ParticleSet
+from ..quat import vec_angle
 from .snapshot import ParticleEvents, PointHandle, Snapshot
 from .world import PARK, World, rotation_matrix
 
@@ -104,11 +105,6 @@ class ParticleSystem:
         up = accel - self._gravity
         norm = float(np.linalg.norm(up))
         return np.array([0.0, 0.0, -1.0]) if norm < 1e-9 else rot.T @ (up / norm)
-
-    @staticmethod
-    def _angle(a: np.ndarray, b: np.ndarray) -> float:
-        """Angle between unit vectors (radians)."""
-        return math.acos(max(-1.0, min(1.0, float(a @ b))))
 
     @staticmethod
     def _inside(box: Container, local: np.ndarray) -> np.ndarray:
@@ -182,7 +178,7 @@ class ParticleSystem:
             if ps.rest is None or not self.carried[ps.name].any():
                 continue
             up = self._last_up[ps.name]
-            if self._angle(up, self._rest_up[ps.name]) > ps.rest.max_turn or self._angle(up, _AXIS) > ps.rest.max_tilt:
+            if vec_angle(up, self._rest_up[ps.name]) > ps.rest.max_turn or vec_angle(up, _AXIS) > ps.rest.max_tilt:
                 self._release(ps, ids)
 
     def _maybe_carry(self, ps: ParticleSet, ids: list[int], settled: bool = False) -> None:
@@ -195,7 +191,7 @@ class ParticleSystem:
         free = self.active[name] & ~self.carried[name]
         if not free.any():
             return
-        if self._angle(up, _AXIS) > ps.rest.max_tilt:
+        if vec_angle(up, _AXIS) > ps.rest.max_tilt:
             self._still_steps[name] = 0
             return
         idx = np.flatnonzero(free)

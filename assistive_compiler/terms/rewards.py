@@ -7,10 +7,9 @@ from __future__ import annotations
 import math
 from typing import Literal
 
-import numpy as np
 from pydantic import Field, model_validator
 
-from ..quat import quat_rotate
+from ..quat import quat_rotate, vec_angle
 from .registry import BodiesRef, BodyRef, MarkersRef, NodesRef, Params, ParticlesRef, PointRef, term
 
 
@@ -129,10 +128,7 @@ class Tilt(Params):
 @term("tilt", "reward", Tilt)
 def tilt(snap, p) -> float:
     """Angle between a link axis and a world direction (rad): 0 when a cup stands upright."""
-    a = quat_rotate(snap.orientation(p.of), p.axis)
-    up = np.asarray(p.up, dtype=float)
-    cos = float(np.dot(a, up) / (np.linalg.norm(a) * np.linalg.norm(up)))
-    return math.acos(min(1.0, max(-1.0, cos)))
+    return vec_angle(quat_rotate(snap.orientation(p.of), p.axis), p.up)
 
 
 class ClosestDistance(Params):

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from ...ik_options import ik_damping, ik_limits
-from ...quat import quat_from_rpy_deg
+from ...quat import quat_angle, quat_from_rpy_deg
 from ...resolve import ResolvedTask
 from ..task import start_for
 from .client import PlacementClient
@@ -75,7 +75,7 @@ class ArmKinematics:
             got_pos, got_orn = self.pc.link_pose(self.robot, self.ee_link)
             if np.linalg.norm(np.subtract(got_pos, ee_pos)) >= 0.01:
                 continue
-            if tool_orn is not None and 2 * math.acos(min(1.0, abs(float(np.dot(got_orn, ee_orn))))) >= math.radians(3):
+            if tool_orn is not None and quat_angle(got_orn, ee_orn) >= math.radians(3):
                 continue
             if self.collides(tool_pos, orn, check_tool=not tool_may_touch):
                 continue
