@@ -123,6 +123,12 @@ def test_recompile_unchanged_is_a_cache_hit_and_force_recompiles(compiled):
     assert (rc, err) == (0, "")
     assert out.startswith(f"compiled: feeding for jaco -> {a}/ (7 bodies, id assistive_compiler/FeedingJaco-v1, content ")
     assert snapshot(a) == compiled["files_a"]  # recompiled, to the same bytes
+
+    # A fresh compile hands back the manifest exactly as a cache hit loads it, dict order included
+    # (the runtime walks some dicts in order: a fresh compile's own order once changed a Dressing episode).
+    fresh = compile_task(FEEDING, "jaco", a, force=True)
+    assert fresh.cache_hit is False
+    assert json.dumps(fresh.manifest.model_dump(mode="json")) == json.dumps(hit.manifest.model_dump(mode="json"))
     assert hidden_entries(a.parent) == []
 
 

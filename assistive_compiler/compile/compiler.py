@@ -122,7 +122,9 @@ def compile_task(
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
-    return CompileResult(out, manifest, False, time.perf_counter() - t0)
+    # The manifest as every later load sees it: the file sorts its keys, and the runtime walks some of
+    # its dicts in order (a fresh compile's in-memory order gave Dressing a different episode).
+    return CompileResult(out, Manifest.read(out), False, time.perf_counter() - t0)
 
 
 def _replace_dir(new: Path, out: Path) -> None:
