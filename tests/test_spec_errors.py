@@ -531,7 +531,7 @@ def test_scripted_per_robot_waypoints_are_checked_where_written(tmp_path, capsys
         and "unknown link 'right_elbw' of person" in lines[0] and lines[0].endswith("(did you mean 'right_elbow'?)")
 
 
-SHIPPED_SEGMENTS = "'lane_40', 'onto_forearm', 'side_lanes'"  # the shipped bed-bathing spec's scripted.segments
+SHIPPED_SEGMENTS = "'forearm_level', 'lane_40', 'onto_forearm', 'side_lanes'"  # the shipped bed-bathing spec's scripted.segments
 
 
 def test_segment_uses_name_a_segment_and_segments_splice_none(tmp_path, capsys):
