@@ -117,14 +117,16 @@ def compile_task(
     try:
         manifest = build(rt, tmp, library).model_copy(update={"input_hash": ihash})
         manifest = manifest.model_copy(update={"content_hash": manifest.hash_of(tmp)})
-        (tmp / "manifest.json").write_text(manifest.to_json())
+        text = manifest.to_json()
+        (tmp / "manifest.json").write_text(text)
         _replace_dir(tmp, out)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
-    # The manifest as every later load sees it: the file sorts its keys, and the runtime walks some of
-    # its dicts in order (a fresh compile's in-memory order gave Dressing a different episode).
-    return CompileResult(out, Manifest.read(out), False, time.perf_counter() - t0)
+    # The manifest as every later load sees it, parsed from the text just written: the file sorts its
+    # keys, and the runtime walks some of its dicts in order (a fresh compile's in-memory order gave
+    # Dressing a different episode).
+    return CompileResult(out, Manifest.model_validate_json(text), False, time.perf_counter() - t0)
 
 
 def _replace_dir(new: Path, out: Path) -> None:
