@@ -160,13 +160,14 @@ def test_scripted_per_robot_replaces_the_waypoints_for_that_robot_only(tmp_path)
     assert len(pr2["waypoints"]) == len(task.spliced(task.waypoints, ())) and pr2["repeat_from"] == task.repeat_from
 
 
-# Jaco's bed-bathing script as written out before scripted.segments (a robot's step_m of 0.12 now replaces the
-# segments' 0.07): the spliced script must be this list, so the conversion changed nothing Jaco does.
+# Jaco's bed-bathing script written out (a robot's step_m of 0.12 replaces the segments' 0.07): the spliced script
+# must be this list. As it was before scripted.segments, but for its first lane, now the shared lane_40 (it was a
+# copy 0.1 mm lower at the elbow and wrist).
 JACO_BATHING_WRITTEN_OUT = """\
 - {to: person.right_shoulder, offset_m: [-0.05, -0.08, 0.10], rpy_deg: [-40, 0, 90], tolerance_m: 0.03}
 - {to: person.right_shoulder, offset_m: [-0.0174, -0.08, 0.0207], rpy_deg: [-40, 0, 90], tolerance_m: 0.02, step_m: 0.12}
-- {to: person.right_elbow, offset_m: [-0.0180, 0.0, 0.0214], rpy_deg: [-40, 0, 90], tolerance_m: 0.05, step_m: 0.12}
-- {to: person.right_wrist, offset_m: [-0.0109, 0.04, 0.0130], rpy_deg: [-40, 0, 90], tolerance_m: 0.03, step_m: 0.12}
+- {to: person.right_elbow, offset_m: [-0.0180, 0.0, 0.0215], rpy_deg: [-40, 0, 90], tolerance_m: 0.05, step_m: 0.12}
+- {to: person.right_wrist, offset_m: [-0.0109, 0.04, 0.0131], rpy_deg: [-40, 0, 90], tolerance_m: 0.03, step_m: 0.12}
 - {to: person.right_wrist, offset_m: [-0.045, 0.04, 0.027], rpy_deg: [-80, 0, 90], tolerance_m: 0.03}
 - {to: person.right_wrist, offset_m: [-0.0166, 0.04, 0.0212], rpy_deg: [-80, 0, 90], tolerance_m: 0.02, step_m: 0.12}
 - {to: person.right_elbow, offset_m: [-0.022, -0.04, 0.022], rpy_deg: [-80, 0, 90], tolerance_m: 0.03, step_m: 0.12}
@@ -181,8 +182,8 @@ JACO_BATHING_WRITTEN_OUT = """\
 
 
 def test_segments_splice_into_the_script_they_replaced(tmp_path):
-    """Segments are spliced at resolve time: Jaco's shipped bed-bathing script (its own lane, two of
-    the task's segments, its own lanes; step_m 0.12 over the segments' 0.07) resolves to exactly the
+    """Segments are spliced at resolve time: Jaco's shipped bed-bathing script (three of the
+    task's segments, then its own lanes; step_m 0.12 over the segments' 0.07) resolves to exactly the
     waypoint list it was written as before, and so does a task-level use (repeat_from counting the
     spliced waypoints)."""
     from assistive_compiler.resolve import resolve
