@@ -18,6 +18,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
@@ -130,6 +131,19 @@ def test_recompile_unchanged_is_a_cache_hit_and_force_recompiles(compiled):
     assert fresh.cache_hit is False
     assert json.dumps(fresh.manifest.model_dump(mode="json")) == json.dumps(hit.manifest.model_dump(mode="json"))
     assert hidden_entries(a.parent) == []
+    # The env on the carried manifest runs the same episode as one that reads and checks the artifact.
+    from assistive_compiler.runtime.env import AssistiveEnv
+
+    carried, read = AssistiveEnv.from_compiled(fresh), AssistiveEnv(a)
+    assert carried.manifest is fresh.manifest
+    action = np.full(carried.action_space.shape, 0.5, dtype=np.float32)
+    for env in (carried, read):
+        env.reset(seed=3)
+    for _ in range(5):
+        (obs_c, rew_c, *_), (obs_r, rew_r, *_) = carried.step(action), read.step(action)
+        assert np.array_equal(obs_c, obs_r) and rew_c == rew_r
+    for env in (carried, read):
+        env.close()
 
 
 # --------------------------------------------------------------------------------------------

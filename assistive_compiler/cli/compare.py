@@ -47,7 +47,7 @@ def compare_robot(spec: str, robot: str, episodes: int, seed: int, out: Path | N
         row["placement"] = "base search"
         row["goals_reached"] = f"{min(b['goals_reached'] for b in best)}/{best[0]['goals']}"
         row["jlwki"] = round(float(np.mean([b["jlwki"] for b in best])), 3)
-    env = AssistiveEnv(result.out_dir, manifest=result.manifest)
+    env = AssistiveEnv.from_compiled(result)
     if m.scripted is not None:
         policy = make_policy("scripted", env)
         runs = [rollout(env, policy, seed + k) for k in range(episodes)]

@@ -70,7 +70,7 @@ def collect(spec: str, robot: str | None, dataset_id: str, policy: str = "script
         os.environ["MINARI_DATASETS_PATH"] = str(Path(root).resolve())
     result = compile_task(spec, robot, out)
     m = result.manifest
-    env = AssistiveEnv(result.out_dir, manifest=result.manifest)
+    env = AssistiveEnv.from_compiled(result)
     env_spec = gym.envs.registration.EnvSpec(m.gym_id, entry_point="assistive_compiler.registration:make_env",
                                              kwargs={"spec": str(Path(spec).resolve()), "robot": m.robot_name},
                                              max_episode_steps=m.sim.episode_steps, disable_env_checker=True)

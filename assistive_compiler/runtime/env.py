@@ -164,7 +164,12 @@ class AssistiveEnv(gym.Env):
         ``library``: extra part directories (see :func:`assistive_compiler.library.Library.for_spec`)."""
         from ..compile.compiler import compile_task
 
-        result = compile_task(spec, robot, out_dir, library=library)
+        return cls.from_compiled(compile_task(spec, robot, out_dir, library=library), **kwargs)
+
+    @classmethod
+    def from_compiled(cls, result, **kwargs) -> "AssistiveEnv":
+        """The env of ``result`` (a :class:`~assistive_compiler.compile.compiler.CompileResult`),
+        on the manifest it carries: the artifact was just written or checked, so it is not read again."""
         return cls(result.out_dir, manifest=result.manifest, **kwargs)
 
     # -- Gymnasium API ------------------------------------------------------------------------

@@ -36,7 +36,7 @@ def episode_for_view(spec: str, robot: str | None = None, policy: str | None = N
     from ..runtime.env import AssistiveEnv
     from .app import EpisodePlayer
 
-    player = EpisodePlayer(AssistiveEnv(result.out_dir, manifest=result.manifest), policy or "scripted", seed)
+    player = EpisodePlayer(AssistiveEnv.from_compiled(result), policy or "scripted", seed)
     return result.out_dir, player.play(seed), player
 
 
