@@ -15,6 +15,7 @@ import pytest
 from assistive_compiler.cli import main
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.paths import specs_dir
+from assistive_compiler.quat import quat_angle, quat_rotate, vec_angle
 from assistive_compiler.runtime.env import AssistiveEnv
 from assistive_compiler.terms.registry import terms
 from helpers import compiled_env
@@ -290,7 +291,6 @@ def test_scripted_tool_turns_no_further_than_needed_to_face_the_itch(scratch):
     """face_normal_within_deg: the tool's pointing axis ends within the angle of the inward normal,
     turned by the smallest rotation — not at all when it already was within it."""
     from assistive_compiler.policies.scripted import ScriptedPolicy
-    from assistive_compiler.quat import quat_rotate
 
     policy = ScriptedPolicy(scratch)
     itch = scratch.snap.point({"target": "itch"})
@@ -303,11 +303,11 @@ def test_scripted_tool_turns_no_further_than_needed_to_face_the_itch(scratch):
         start = np.asarray(track.keep_orn)
         inward = -scratch.snap.normal(itch)
         d0 = quat_rotate(start, track.axis_in_point)
-        before = math.acos(np.clip(np.dot(d0, inward), -1, 1))
+        before = vec_angle(d0, inward)
         orn = np.asarray(policy._facing(track, start, inward, within))
         d = quat_rotate(orn, track.axis_in_point)
-        after = math.acos(np.clip(np.dot(d, inward), -1, 1))
-        rotation = 2 * math.acos(min(1.0, abs(float(np.dot(orn, start)))))
+        after = vec_angle(d, inward)
+        rotation = quat_angle(orn, start)
         if before <= within:
             np.testing.assert_array_equal(orn, start)
         else:
@@ -322,7 +322,6 @@ def test_level_facing_turns_the_tool_about_the_vertical_only(scratch):
     towards the skin's inward normal and stays level; a spot facing more up or down than sideways
     leaves it unturned."""
     from assistive_compiler.policies.scripted import ScriptedPolicy
-    from assistive_compiler.quat import quat_rotate
 
     policy = ScriptedPolicy(scratch)
     scratch.reset(seed=0)
@@ -534,7 +533,7 @@ def test_scripted_cup_tips_no_faster_than_its_turn_step(tmp_path):
         finally:
             env.close()
         if name == "slow":
-            turns = [math.degrees(2 * math.acos(min(1.0, abs(float(np.dot(a, b)))))) for a, b in zip(aimed, aimed[1:])]
+            turns = [math.degrees(quat_angle(a, b)) for a, b in zip(aimed, aimed[1:])]
             assert max(turns) == pytest.approx(1.0, abs=0.01)  # (acos near 1: ~1e-3 degrees of rounding)
             assert max(b - a for a, b in zip(tilt, tilt[1:])) < 1.5  # the cup follows about as fast, no faster
             assert 85 < tilt[-1] < 100  # and still tips to the waypoint's 95 degrees

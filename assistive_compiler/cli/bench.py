@@ -152,10 +152,10 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
         cold = compile_task(spec, robot, Path(tmp) / "cold", force=True)
         cached = compile_task(spec, robot, Path(tmp) / "cold")
         assert cached.cache_hit
-        envs = {"shipped": AssistiveEnv(cold.out_dir)}
+        envs = {"shipped": AssistiveEnv.from_compiled(cold)}
         variant = write_reference_variant(spec, loaded, Path(tmp) / "specs")
         if variant is not None:
-            envs["reference_solver"] = AssistiveEnv(compile_task(variant, robot, Path(tmp) / "reference_solver").out_dir)
+            envs["reference_solver"] = AssistiveEnv.from_compiled(compile_task(variant, robot, Path(tmp) / "reference_solver"))
         rates = measure_steps_paired(envs, steps, repeats, seed)
         for extra in list(envs)[1:]:
             envs.pop(extra).close()
