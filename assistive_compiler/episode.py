@@ -1,4 +1,5 @@
-"""One episode's summary, shared by the single-agent and the co-optimisation rollouts."""
+"""One episode: :func:`rollout` plays it, :class:`EpisodeTally` sums it (the co-optimisation
+rollout shares the tally)."""
 
 from __future__ import annotations
 
@@ -31,3 +32,17 @@ class EpisodeTally:
             "mean_force_on_human_n": float(np.mean(self.forces)),
             "terms": self.terms,
         }
+
+
+def rollout(env, policy, seed: int) -> dict:
+    """One episode of ``policy`` (``obs -> action``) in ``env`` from ``reset(seed=seed)``: return,
+    success, each term's unweighted values summed over the episode (the reward is Σ weight ×
+    value), mean force on the person (N)."""
+    obs, info = env.reset(seed=seed)
+    tally = EpisodeTally()
+    done = False
+    while not done:
+        obs, reward, terminated, truncated, info = env.step(policy(obs))
+        tally.add(reward, info)
+        done = terminated or truncated
+    return tally.summary(seed)

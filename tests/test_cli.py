@@ -15,7 +15,7 @@ from assistive_compiler.cli import main
 from assistive_compiler.cli.compare import COLUMNS, print_comparison
 
 TASKS = Path(__file__).resolve().parents[1] / "specs" / "tasks"
-NUMERIC = ("goals_reached", "jlwki", "compile_s", "scripted_success", "scripted_return")
+NUMERIC = ("goals_reached", "jlwki", "compile_s", "success", "return")
 
 
 def _table(out: str) -> tuple[str, list[str]]:
@@ -50,23 +50,23 @@ def test_compare_prints_an_aligned_rounded_table_and_explains_jlwki(capsys):
     assert header.split() == list(COLUMNS)
     assert [r.split()[0] for r in rows] == ["jaco", "pr2"]
     _assert_aligned(header, rows)
-    success_at = header.index("scripted_success")
+    success_at = header.index("success")
     for row in rows:
-        assert re.fullmatch(r"[01]\.\d\d", row[success_at:success_at + len("scripted_success")].strip())
+        assert re.fullmatch(r"[01]\.\d\d", row[success_at:success_at + len("success")].strip())
     assert "mounted on wheelchair" in rows[0] and "base search" in rows[1]
     assert re.search(r"\d/\d+\s+\d+\.\d{3}\s", rows[1])  # goals reached, then the JLWKI to 3 decimals
     assert "jlwki: joint-limit-weighted kinematic isotropy" in captured.out
     # Progress on stderr, one line per robot finished: stdout holds only the report.
-    assert re.search(r"^\[1/2\] jaco: compiled in [\d.]+ s \(mounted on wheelchair\), scripted success [01]\.\d\d$", captured.err, re.M)
+    assert re.search(r"^\[1/2\] jaco: compiled in [\d.]+ s \(mounted on wheelchair\), success [01]\.\d\d$", captured.err, re.M)
     assert re.search(r"^\[2/2\] pr2: compiled in [\d.]+ s \(base search\)", captured.err, re.M)
 
 
 def test_compare_table_rounds_success_and_lists_compile_failures_below(capsys):
     rows = [
         {"robot": "pr2", "compile_s": 8.16, "placement": "base search", "goals_reached": "3/4", "jlwki": 1.234,
-         "scripted_success": 1 / 3, "scripted_return": -12.5},
+         "success": 1 / 3, "return": -12.5},
         {"robot": "sawyer", "error": "robot 'sawyer' reaches the mouth from none of 50 sampled base poses"},
-        {"robot": "jaco", "compile_s": 2.5, "placement": "mounted on wheelchair", "scripted_success": 1.0, "scripted_return": 118.2},
+        {"robot": "jaco", "compile_s": 2.5, "placement": "mounted on wheelchair", "success": 1.0, "return": 118.2},
     ]
     print_comparison(rows)
     out = capsys.readouterr().out
@@ -108,5 +108,5 @@ def test_every_command_group_registers_its_commands():
 
     sub = next(a for a in build_parser()._actions if a.dest == "command")
     assert set(sub.choices) == {"validate", "compile", "list", "schema", "run", "demo", "render", "render-person", "bench", "compare",
-                                "view", "collect", "train", "evaluate", "table"}
+                                "view", "collect", "train", "evaluate", "table", "export", "results"}
     assert all(callable(m.add_commands) for m in COMMAND_MODULES)

@@ -25,7 +25,7 @@ def test_shipped_configs_validate_and_match_the_schema(path):
     import yaml
 
     config = load_training_config(path)
-    assert config.algorithm == "ppo"
+    assert config.algorithm in ("ppo", "sac") and getattr(config, config.algorithm) is not None
     jsonschema.validate(yaml.safe_load(path.read_text()), training_schema())
 
 
@@ -68,6 +68,45 @@ def test_minibatch_larger_than_the_batch_is_located(tmp_path):
     assert [str(p) for p in err.value.problems] == [
         f"{path}:{at(text, '64')}: ppo.minibatch_size: minibatch_size 64 is larger than the batch rollout_steps × envs = 10 × 2 = 20"
     ]
+
+
+def test_sac_recipe_is_standard_sac_on_one_env():
+    """The recipe (sac_laptop): SB3's standard SAC settings, one env process, one update per env step."""
+    c = load_training_config(REPO / "specs" / "training" / "sac_laptop.yaml")
+    assert (c.algorithm, c.ppo, c.envs, c.network.hidden, c.network.activation) == ("sac", None, 1, [256, 256], "relu")
+    s = c.sac
+    assert (s.learning_rate, s.batch_size, s.tau, s.gamma, s.ent_coef, s.target_entropy) == (3e-4, 256, 0.005, 0.99, "auto", "auto")
+    assert (s.train_freq, s.gradient_steps, c.batch_size, c.gamma, c.total_steps) == (1, 1, 1, 0.99, 1_000_000)
+
+
+def test_algorithm_and_its_section_must_agree(tmp_path):
+    text = ("algorithm: sac\nppo: {rollout_steps: 10, minibatch_size: 8, epochs: 1}\n"
+            "sac: {ent_coef: -0.1, gradient_stepz: 2}\ntotal_steps: 100\ncheckpoint_every_steps: 50\n")
+    path = tmp_path / "mixed.yaml"
+    path.write_text(text)
+    with pytest.raises(SpecError) as err:
+        load_training_config(path)
+    messages = [str(p) for p in err.value.problems]
+    assert any(m.startswith(f"{path}:{at(text, 'gradient_stepz')}: unknown key 'gradient_stepz' in sac") and
+               "(did you mean 'gradient_steps'?)" in m for m in messages), messages
+    text = "algorithm: sac\nppo: {rollout_steps: 10, minibatch_size: 8, epochs: 1}\nsac: {ent_coef: -0.1}\ntotal_steps: 100\ncheckpoint_every_steps: 50\n"
+    path.write_text(text)
+    with pytest.raises(SpecError) as err:
+        load_training_config(path)
+    assert [str(p) for p in err.value.problems] == [
+        f"{path}:{at(text, '-0.1')}: sac.ent_coef: the entropy temperature must be > 0 (or 'auto'), got -0.1"]
+    text = "algorithm: sac\nppo: {rollout_steps: 10, minibatch_size: 8, epochs: 1}\nsac: {}\ntotal_steps: 100\ncheckpoint_every_steps: 50\n"
+    path.write_text(text)
+    with pytest.raises(SpecError) as err:
+        load_training_config(path)
+    assert [str(p) for p in err.value.problems] == [
+        f"{path}:{at(text, '{rollout_steps')}: ppo: a 'ppo:' section configures algorithm 'ppo', but algorithm is 'sac'; "
+        "remove it or set algorithm: ppo"]
+    text = "algorithm: sac\ntotal_steps: 100\ncheckpoint_every_steps: 50\n"
+    path.write_text(text)
+    with pytest.raises(SpecError) as err:
+        load_training_config(path)
+    assert [str(p) for p in err.value.problems] == [f"{path}:1:1: sac: algorithm 'sac' needs its settings in a 'sac:' section"]
 
 
 def test_overrides_are_validated():

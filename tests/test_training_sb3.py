@@ -147,3 +147,132 @@ def test_ctrl_c_or_sigterm_leaves_a_resumable_checkpoint(tmp_path, stop):
     steps, checkpoint = RunDir(out).latest_checkpoint()
     assert 400 <= steps < 1_000_000 and (checkpoint / "model.zip").is_file()
     assert json.loads((out / "summary.json").read_text())["interrupted"] is True
+
+
+# --------------------------------------------------------------------------------------------
+# SAC (the recipe's algorithm), export to a NumPy policy, and trained policies by source
+
+SAC_TINY = """algorithm: sac
+network: {hidden: [32, 32], activation: relu}
+sac: {learning_starts: 100, buffer_size: 5000, batch_size: 32}
+total_steps: 600
+envs: 1
+seed: 3
+checkpoint_every_steps: 400
+eval_episodes: 2
+"""
+
+
+@pytest.fixture(scope="module")
+def sac_run(tmp_path_factory) -> Path:
+    """A few hundred SAC steps on reach: enough to update the networks, checkpoint and resume."""
+    root = tmp_path_factory.mktemp("sac")
+    config = root / "sac_tiny.yaml"
+    config.write_text(SAC_TINY)
+    out = root / "reach-sac"
+    assert main(["train", str(REACH), "--robot", "jaco", "--config", str(config), "--out", str(out), "--quiet"]) == 0
+    return out
+
+
+def test_sac_run_checkpoints_with_its_replay_buffer_and_resumes(sac_run, tmp_path):
+    run = RunDir(sac_run)
+    steps = sorted(int(p.name.split("_")[1]) for p in run.checkpoints.glob("step_*"))
+    assert steps == [400, 600]
+    # Only the newest checkpoint keeps the replay buffer (the bulk of a checkpoint).
+    assert not (run.checkpoint_dir(400) / "replay_buffer.pkl").exists()
+    assert (run.checkpoint_dir(600) / "replay_buffer.pkl").is_file()
+    assert json.loads((run.checkpoint_dir(600) / "COMPLETE").read_text())["algorithm"] == "sac"
+    assert run.info().training_config.algorithm == "sac" and "ppo" not in (sac_run / "config.yaml").read_text()
+    copy = tmp_path / "resumed"
+    shutil.copytree(sac_run, copy)
+    assert main(["train", str(REACH), "--robot", "jaco", "--config", str(sac_run / "config.yaml"), "--out", str(copy), "--resume",
+                 "--steps", "800", "--quiet"]) == 0
+    from stable_baselines3 import SAC
+
+    model = SAC.load(str(RunDir(copy).latest_checkpoint()[1] / "model.zip"))
+    assert model.num_timesteps == 800
+    model.load_replay_buffer(str(RunDir(copy).latest_checkpoint()[1] / "replay_buffer.pkl"))
+    assert model.replay_buffer.size() == 800  # the resumed run kept the first 600 transitions
+
+
+def test_sac_resume_without_the_replay_buffer_is_refused(sac_run, tmp_path, capsys):
+    copy = tmp_path / "no-buffer"
+    shutil.copytree(sac_run, copy)
+    buffer = RunDir(copy).latest_checkpoint()[1] / "replay_buffer.pkl"
+    buffer.unlink()
+    code = main(["train", str(REACH), "--robot", "jaco", "--config", str(sac_run / "config.yaml"), "--out", str(copy), "--resume",
+                 "--steps", "800", "--quiet"])
+    assert code == 2
+    assert f"{buffer}: --resume of a SAC run needs the newest checkpoint's replay buffer, which is missing" in capsys.readouterr().err
+
+
+def test_rllib_engine_refuses_sac(sac_run, capsys):
+    code = main(["train", str(REACH), "--robot", "jaco", "--config", str(sac_run / "config.yaml"), "--engine", "rllib", "--quiet"])
+    assert code == 2
+    assert "algorithm 'sac' trains on the sb3 engine (one machine, single agent); the rllib engine (--coop, --address) runs algorithm 'ppo'" \
+        in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("which", ["ppo", "sac"])
+def test_export_gives_the_checkpoints_actions_in_numpy(which, reach_run, sac_run, tmp_path):
+    """An exported policy (NumPy) acts as its checkpoint does: same actions to float precision,
+    the same episodes; its policy.json carries the evaluation on unseen seeds."""
+    from assistive_compiler.policies.mlp import MLPPolicy
+    from assistive_compiler.training.export import export_run
+    from assistive_compiler.training.sb3 import SB3Policy
+
+    run_dir = reach_run if which == "ppo" else sac_run
+    record = export_run(run_dir, tmp_path / which, episodes=3, seed=100, label=f"{which} tiny")
+    exported = MLPPolicy.load(tmp_path / which)
+    steps, checkpoint = RunDir(run_dir).latest_checkpoint()
+    original = SB3Policy(checkpoint, which)
+    rng = np.random.default_rng(1)
+    for obs in rng.normal(0, 2, (50, exported.obs_dim)).astype(np.float32):
+        assert np.allclose(exported(obs), original(obs), atol=1e-5)
+    assert (exported.head, record["algorithm"], record["trained_steps"], record["label"]) == \
+        ("clip" if which == "ppo" else "tanh", which, steps, f"{which} tiny")
+    assert (exported.obs_mean is not None) == (which == "ppo")  # ppo_quick normalises observations
+    ours = evaluate(run_dir, episodes=3, seed=100)
+    assert [round(e["return"], 3) for e in ours["per_episode"]] == record["evaluation"]["returns"]
+    assert record["evaluation"]["success_rate"] == ours["success_rate"]
+    assert (tmp_path / which / "curve.csv").read_text() == (run_dir / "curve.csv").read_text()
+
+
+def test_run_render_and_evaluate_take_a_run_directory_or_an_exported_policy(reach_run, tmp_path, capsys):
+    from assistive_compiler.training.export import export_run
+
+    export_run(reach_run, tmp_path / "exported", episodes=2, seed=5)
+    returns = {}
+    for source in (str(reach_run), str(tmp_path / "exported")):
+        assert main(["run", str(REACH), "--robot", "jaco", "--policy", source, "--episodes", "2", "--seed", "5", "--json",
+                     "--out", str(tmp_path / "artifact"), "--quiet"]) == 0
+        report = json.loads(capsys.readouterr().out)
+        returns[source] = [round(e["return"], 4) for e in report["episodes"]]
+        assert report["policy"] == source
+    assert returns[str(reach_run)] == returns[str(tmp_path / "exported")]
+    gif = tmp_path / "exported.gif"
+    assert main(["render", str(REACH), "--robot", "jaco", "--policy", str(tmp_path / "exported"), "--seed", "5", "--out", str(gif),
+                 "--out-dir", str(tmp_path / "artifact")]) == 0
+    assert Image.open(gif).n_frames > 10
+    capsys.readouterr()
+    assert main(["evaluate", "--policy", str(tmp_path / "exported"), "--episodes", "2", "--seed", "5", "--json"]) == 0
+    assert [round(e["return"], 4) for e in json.loads(capsys.readouterr().out)["per_episode"]] == returns[str(reach_run)]
+
+
+def test_a_trained_policy_of_another_task_is_refused(reach_run, capsys):
+    code = main(["run", str(REPO / "specs" / "tasks" / "feeding.yaml"), "--robot", "jaco", "--policy", str(reach_run), "--episodes", "1"])
+    assert code == 2
+    assert capsys.readouterr().err.strip().endswith(f"error: --policy {reach_run}: trained for reach with jaco, but the env is feeding with jaco")
+
+
+def test_training_needs_only_the_declared_train_extra(tmp_path):
+    """The training path imports nothing the train extra does not declare (tqdm was one): a run
+    with tqdm made unimportable still trains and writes its curve."""
+    out = tmp_path / "no-tqdm"
+    code = ("import sys; sys.modules['tqdm'] = None\n"
+            "from assistive_compiler.cli import main\n"
+            f"sys.exit(main(['train', {str(REACH)!r}, '--robot', 'jaco', '--config', 'ppo_quick', '--envs', '1', '--steps', '800', "
+            f"'--out', {str(out)!r}]))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert RunDir(out).latest_checkpoint()[0] == 800 and (out / "curve.csv").is_file()

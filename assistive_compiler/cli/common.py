@@ -47,13 +47,13 @@ def use_library_dirs(dirs: list[str]) -> None:
 
 def add_spec_arguments(p: argparse.ArgumentParser, policy: bool = True) -> None:
     """``spec``, ``--robot``, ``--policy`` (optional), ``--seed`` and ``--library``: what a rollout command needs."""
-    from ..policies import POLICIES
+    from ..policies import POLICY_HELP
 
     add_library_argument(p)
     p.add_argument("spec", help="task spec file")
     p.add_argument("--robot", help="robot (default: the spec's default)")
     if policy:
-        p.add_argument("--policy", choices=POLICIES, default="scripted", help="policy to roll out (default scripted)")
+        p.add_argument("--policy", default="scripted", help=f"policy to roll out: {POLICY_HELP} (default scripted)")
     p.add_argument("--seed", type=int, default=0, help="first episode seed")
 
 

@@ -1,32 +1,47 @@
-"""``evaluate``: roll out a run's trained policy (SB3 or RLlib, static or co-optimised) as the
-reference evaluates: mean ± std return, success rate, mean force on the person; deterministic
-for a seed; optionally a GIF of one rollout. Needs the ``train`` extra."""
+"""``evaluate``: roll out a trained policy — a run directory (SB3 or RLlib, static or
+co-optimised; needs the ``train`` extra), a shipped one (``pretrained:<task>-<robot>``) or an
+exported folder (NumPy only) — as the reference evaluates: mean ± std return, success rate, mean
+force on the person; deterministic for a seed; optionally a GIF of one rollout."""
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
+from pathlib import Path
 
-from .common import EXIT_FAILED, EXIT_OK, engine_modules, require_extra
+from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, engine_modules, require_extra
 
 
 def cmd_evaluate(args: argparse.Namespace) -> int:
+    from ..policies.mlp import POLICY_FILE
+    from ..policies.pretrained import PREFIX
+    from ..training.evaluate import evaluate_exported, format_report
     from ..training.run_dir import RunDir
 
-    run = RunDir(args.run_dir)
+    source = args.policy or args.run_dir
+    if source is None:
+        print("evaluate: give a run directory, or --policy pretrained:<task>-<robot> (or a run directory)", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    if source.startswith(PREFIX) or (Path(source) / POLICY_FILE).is_file():  # shipped or exported: NumPy only
+        result = evaluate_exported(source, episodes=args.episodes or 100, seed=args.seed, render=args.render)
+        print(json.dumps(result, indent=1) if args.json else format_report(result))
+        return EXIT_OK
+    run = RunDir(source)
     if not require_extra(*engine_modules(run.info().engine)):
         return EXIT_FAILED
-    from ..training.evaluate import evaluate, format_report, save_evaluation
+    from ..training.evaluate import evaluate, save_evaluation
 
-    result = evaluate(args.run_dir, episodes=args.episodes, seed=args.seed, render=args.render)
+    result = evaluate(source, episodes=args.episodes, seed=args.seed, render=args.render)
     save_evaluation(run, result)
     print(json.dumps(result, indent=1) if args.json else format_report(result))
     return EXIT_OK
 
 
 def add_commands(sub) -> None:
-    p = sub.add_parser("evaluate", help="roll out a run's trained policy: mean ± std return, success rate, force on the person")
-    p.add_argument("run_dir", help="a run directory written by train")
+    p = sub.add_parser("evaluate", help="roll out a trained policy: mean ± std return, success rate, force on the person")
+    p.add_argument("run_dir", nargs="?", help="a run directory written by train (or give --policy)")
+    p.add_argument("--policy", help="instead of RUN_DIR: pretrained:<task>-<robot> (shipped), an exported policy folder or a run directory")
     p.add_argument("--episodes", type=int, help="episodes (default: the run config's eval_episodes; the paper: 100)")
     p.add_argument("--seed", type=int, default=0, help="seed of the first episode (episode k: seed + k)")
     p.add_argument("--render", metavar="OUT", help="also write one rollout as OUT (.gif, or .png for a strip)")

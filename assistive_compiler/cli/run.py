@@ -1,8 +1,8 @@
 """The rollout commands: ``run`` (a policy over episodes: returns, success, largest terms) and
 ``demo`` (the README's main job: Feeding on Jaco, scripted, with a picture).
 
-:func:`rollout` is the one episode loop both use; it is a plain function so that other commands
-(training, evaluation, co-optimisation) reuse it.
+Both play episodes with :func:`assistive_compiler.episode.rollout`, the one episode loop that
+training, evaluation and export use too.
 """
 
 from __future__ import annotations
@@ -14,25 +14,34 @@ from pathlib import Path
 
 import numpy as np
 
-from ..episode import EpisodeTally
+from ..episode import rollout
 from .common import EXIT_BAD_INPUT, EXIT_OK, add_library_argument, add_spec_arguments, make_env
-
-
-def rollout(env, policy, seed: int) -> dict:
-    """One episode: return, success, each term's unweighted values summed over the episode (the
-    reward is Σ weight × value: see ``term_weights`` in ``run --json``), mean force on the person (N)."""
-    obs, info = env.reset(seed=seed)
-    tally = EpisodeTally()
-    done = False
-    while not done:
-        obs, reward, terminated, truncated, info = env.step(policy(obs))
-        tally.add(reward, info)
-        done = terminated or truncated
-    return tally.summary(seed)
 
 
 def _yes_no(flag: bool) -> str:
     return "yes" if flag else "no"
+
+
+def _default_human_policy(robot_policy: str) -> str:
+    """Under --coop without --human-policy: a co-optimised pair plays its own person, else random."""
+    from ..policies import POLICIES
+
+    if robot_policy not in POLICIES:
+        from ..policies.pretrained import load_trained
+
+        if load_trained(robot_policy)[1].get("coop"):
+            return robot_policy
+    return "random"
+
+
+def _check_human_policy(name: str) -> None:
+    """A bad --human-policy is a usage error (the trained-policy loader says what is expected)."""
+    from ..policies import HUMAN_POLICIES
+
+    if name not in HUMAN_POLICIES:
+        from ..policies.pretrained import load_trained
+
+        load_trained(name)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
@@ -46,6 +55,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         from ..coop import parallel_env, rollout_coop
 
         coop_env = parallel_env(args.spec, args.robot, out_dir=args.out)
+        args.human_policy = args.human_policy or _default_human_policy(args.policy)
+        _check_human_policy(args.human_policy)
         env, label = coop_env.env, f"{args.policy}, human {args.human_policy}"
 
         def play(seed: int) -> dict:
@@ -137,8 +148,10 @@ def add_commands(sub) -> None:
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument("--coop", action="store_true", help="co-optimisation: the person acts too (by --human-policy), shared reward")
-    p.add_argument("--human-policy", dest="human_policy", choices=HUMAN_POLICIES, default="random",
-                   help="with --coop: random, zero (keep still by acting) or hold (no human action: the static person); default random")
+    p.add_argument("--human-policy", dest="human_policy", default=None,
+                   help=f"with --coop: {', '.join(HUMAN_POLICIES)} (zero: keep still by acting; hold: no human action, the static "
+                        "person), or a co-optimised pair (pretrained:<task>-<robot>-coop, a --coop run directory); default: the "
+                        "pair's own person when --policy is one, else random")
     p.add_argument("--record", metavar="DIR", help="also write each episode to DIR/episode-NNNN.npz (poses, actions, per-term "
                    "rewards, success; see assistive_compiler.record.format); view one with: view SPEC --replay FILE")
     p.set_defaults(func=cmd_run)

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, add_library_argument, engine_modules, require_extra
 
-SHIPPED_CONFIGS = "ppo_paper, ppo_laptop, ppo_quick, ppo_rllib_reference"
+SHIPPED_CONFIGS = "sac_laptop, ppo_paper, ppo_laptop, ppo_quick, ppo_rllib_reference"
 
 
 def training_config_path(name: str) -> str:

@@ -34,9 +34,9 @@ def add_commands(sub) -> None:
     p = sub.add_parser("view", help="view an episode in the browser (3D scene, timeline, per-term reward plots), or --gui")
     add_spec_arguments(p, policy=False)
     source = p.add_mutually_exclusive_group()
-    from ..policies import POLICIES
+    from ..policies import POLICY_HELP
 
-    source.add_argument("--policy", choices=POLICIES, help="play this policy headless first (default scripted); the page can play more")
+    source.add_argument("--policy", help=f"play this policy headless first: {POLICY_HELP} (default scripted); the page can play more")
     source.add_argument("--replay", metavar="FILE", help="show a recording (run --record DIR) of this spec and robot")
     p.add_argument("--host", default="127.0.0.1", help="address to serve on (default 127.0.0.1: this machine only)")
     p.add_argument("--port", type=int, default=8080, help="port (default 8080)")

@@ -3,6 +3,9 @@
 Robot: ``random``, ``zero``, ``scripted`` (the task's IK baseline). Human: ``random``, ``zero``
 (the person keeps its policy joints where they are: a zero delta each step) and ``hold`` (no
 human action at all: the static person of the single-agent task, ``step_agents(·, None)``).
+Either agent: a trained policy by source (``pretrained:<task>-<robot>[-coop]``, a run directory,
+an exported policy folder); a co-optimised pair gives each agent its own half, a robot-only
+policy plays the robot.
 A callable ``obs -> action`` or an object with Stable-Baselines3's ``predict(obs, deterministic)``
 (a trained model) is used as it is.
 """
@@ -30,6 +33,8 @@ def agent_policy(env, agent: str, policy: Any, seed: int = 0) -> Policy:
         raise ValueError(f"agent must be 'robot' or 'human', got {agent!r}")
     if isinstance(policy, str):
         names = ROBOT_POLICIES if agent == "robot" else HUMAN_POLICIES
+        if policy not in names and _is_trained(policy):
+            return trained_agent_policy(env, agent, policy)
         if policy not in names:
             raise ValueError(f"unknown {agent} policy '{policy}'; expected one of {', '.join(names)}")
         shape = env.action_space(agent).shape
@@ -48,3 +53,26 @@ def agent_policy(env, agent: str, policy: Any, seed: int = 0) -> Policy:
     if callable(policy):
         return policy
     raise TypeError(f"a {agent} policy must be a name, a callable obs -> action or a model with predict(), got {type(policy).__name__}")
+
+
+def _is_trained(source: str) -> bool:
+    from pathlib import Path
+
+    from ..policies.pretrained import PREFIX
+
+    return source.startswith(PREFIX) or Path(source).is_dir()
+
+
+def trained_agent_policy(env, agent: str, source: str) -> Policy:
+    """``agent``'s part of the trained policy ``source``, checked against the env's task and robot."""
+    from ..errors import UsageError
+    from ..policies.pretrained import check_fits, load_trained
+
+    policy, info = load_trained(source)
+    check_fits(info, env.env.manifest, source, coop=True)
+    if info.get("coop"):
+        return policy.agent(agent)
+    if agent == "human":
+        raise UsageError(f"--human-policy {source}: trained for the robot alone; a person's policy comes from a "
+                         "co-optimised pair (pretrained:<task>-<robot>-coop or a --coop run)")
+    return policy

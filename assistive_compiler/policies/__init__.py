@@ -1,4 +1,6 @@
-"""Baseline policies: ``random``, ``zero`` and ``scripted`` (see :func:`make_policy`)."""
+"""Policies to roll out: the baselines ``random``, ``zero`` and ``scripted``, and trained ones —
+``pretrained:<task>-<robot>`` (shipped), a training run directory, or an exported policy folder
+(see :func:`make_policy` and :mod:`.pretrained`)."""
 
 from __future__ import annotations
 
@@ -9,10 +11,15 @@ import numpy as np
 POLICIES = ("random", "zero", "scripted")
 #: The person's policies in co-optimisation (see :mod:`assistive_compiler.coop.policies`).
 HUMAN_POLICIES = ("random", "zero", "hold")
+#: How ``--policy`` is described in every rollout command's help.
+POLICY_HELP = ("random, zero, scripted, pretrained:<task>-<robot> (a shipped trained policy, e.g. pretrained:feeding-jaco), "
+               "or a training run directory (its newest checkpoint)")
 
 
 def make_policy(name: str, env, seed: int = 0) -> Callable[[np.ndarray], np.ndarray]:
-    """A callable ``obs -> action`` for ``env``. ``scripted`` needs a task with a ``scripted:`` section."""
+    """A callable ``obs -> action`` for ``env``. ``scripted`` needs a task with a ``scripted:``
+    section; a trained policy (``pretrained:...``, a run or policy folder) must have been trained
+    for the env's task and robot."""
     if name == "random":
         space = env.action_space
         space.seed(seed)
@@ -23,4 +30,8 @@ def make_policy(name: str, env, seed: int = 0) -> Callable[[np.ndarray], np.ndar
         from .scripted import ScriptedPolicy
 
         return ScriptedPolicy(env)
-    raise ValueError(f"unknown policy '{name}'; expected one of {', '.join(POLICIES)}")
+    from .pretrained import check_fits, load_trained
+
+    policy, info = load_trained(name)
+    check_fits(info, env.manifest, name)
+    return policy

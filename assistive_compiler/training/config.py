@@ -1,9 +1,10 @@
 """Training configs are specs too: validated YAML (``specs/training/*.yaml``) with located errors.
 
-A :class:`TrainingConfig` says *how* to learn a task's policy — algorithm, network, rollout and
-batch sizes, epochs, discounting, learning rate, how many steps and env processes, the seed and
-how often to checkpoint. The same config drives Stable-Baselines3 (single agent, one machine) and
-Ray RLlib (co-optimisation, clusters); :mod:`.sb3` and :mod:`.rllib` translate it.
+A :class:`TrainingConfig` says *how* to learn a task's policy — algorithm (the paper's on-policy
+PPO, or the off-policy SAC that learns from far fewer env steps), network, the algorithm's own
+settings, how many steps and env processes, the seed and how often to checkpoint. The same config
+drives Stable-Baselines3 (single agent, one machine) and Ray RLlib (co-optimisation, clusters);
+:mod:`.sb3` and :mod:`.rllib` translate it.
 """
 
 from __future__ import annotations
@@ -62,13 +63,52 @@ class PPO(Strict):
     normalize_rewards: bool = Field(True, description="Scale rewards by a running std of the discounted return (as that trainer).")
 
 
+class SAC(Strict):
+    """Soft actor-critic (Haarnoja et al. 2018) settings: off-policy, a replay buffer, twin Q
+    critics and an entropy temperature tuned to a target entropy."""
+
+    learning_rate: float = Field(3e-4, gt=0, le=1, description="Adam learning rate of the actor, the critics and the temperature.")
+    buffer_size: int = Field(1_000_000, ge=1, description="Transitions the replay buffer holds (the oldest are overwritten).")
+    learning_starts: int = Field(
+        5_000, ge=0,
+        description="Env steps of uniformly random actions before the first update (fills the buffer with varied data).",
+    )
+    batch_size: int = Field(256, ge=1, description="Transitions per gradient step, sampled uniformly from the buffer.")
+    tau: float = Field(0.005, gt=0, le=1, description="Polyak factor of the target critics' soft update.")
+    gamma: float = Field(0.99, gt=0, le=1, description="Discount factor γ per env step.")
+    train_freq: int = Field(1, ge=1, description="Env steps (per env process) between updates.")
+    gradient_steps: int = Field(
+        1, ge=1, le=1000,
+        description="Gradient steps per update; updates per env step = gradient_steps / (train_freq × envs).",
+    )
+    ent_coef: float | Literal["auto"] = Field(
+        "auto", description="Entropy temperature α: a number, or 'auto' to learn it toward target_entropy."
+    )
+    target_entropy: float | Literal["auto"] = Field(
+        "auto", description="Target policy entropy (nats) with ent_coef 'auto'; 'auto' is −(action dimensions)."
+    )
+
+    @model_validator(mode="after")
+    def _positive_temperature(self) -> "SAC":
+        if not isinstance(self.ent_coef, str) and self.ent_coef <= 0:
+            raise ValueError(f"@ent_coef: the entropy temperature must be > 0 (or 'auto'), got {self.ent_coef}")
+        return self
+
+
+ALGORITHM_SECTIONS = {"ppo": "PPO", "sac": "SAC"}
+
+
 class TrainingConfig(Strict):
     """How to train a policy for one task and robot."""
 
-    algorithm: Literal["ppo"] = Field(description="The learning algorithm (the paper: PPO).")
+    algorithm: Literal["ppo", "sac"] = Field(
+        description="The learning algorithm: 'ppo' (the paper's) or 'sac' (off-policy: far fewer env steps per success). "
+                    "Its settings go in the section of the same name."
+    )
     description: str = Field("", description="What this config is for, in a sentence.")
-    network: Network = Field(default_factory=Network, description="Policy and value network shape.")
-    ppo: PPO = Field(description="PPO settings.")
+    network: Network = Field(default_factory=Network, description="Network shape: PPO's policy and value MLPs, SAC's actor and each critic.")
+    ppo: PPO | None = Field(None, description="PPO settings (algorithm: ppo).")
+    sac: SAC | None = Field(None, description="SAC settings (algorithm: sac).")
     total_steps: int = Field(ge=1, description="Env steps to train for, over all env processes (the paper: 10,000,000).")
     envs: int = Field(1, ge=1, le=1024, description="Env processes collecting experience in parallel (the paper: 36).")
     seed: int = Field(0, ge=0, description="Seed of the policy's initialisation, the envs and the sampling.")
@@ -76,7 +116,20 @@ class TrainingConfig(Strict):
     eval_episodes: int = Field(100, ge=1, description="Episodes `evaluate` runs by default (the paper: 100 rollouts).")
 
     @model_validator(mode="after")
+    def _one_algorithm_section(self) -> "TrainingConfig":
+        for name in ALGORITHM_SECTIONS:
+            given = getattr(self, name) is not None
+            if name == self.algorithm and not given:
+                raise ValueError(f"@{name}: algorithm '{name}' needs its settings in a '{name}:' section")
+            if name != self.algorithm and given:
+                raise ValueError(f"@{name}: a '{name}:' section configures algorithm '{name}', but algorithm is "
+                                 f"'{self.algorithm}'; remove it or set algorithm: {name}")
+        return self
+
+    @model_validator(mode="after")
     def _batch(self) -> "TrainingConfig":
+        if self.ppo is None:
+            return self
         batch = self.ppo.rollout_steps * self.envs
         if self.ppo.minibatch_size > batch:
             raise ValueError(
@@ -87,8 +140,15 @@ class TrainingConfig(Strict):
 
     @property
     def batch_size(self) -> int:
-        """Env steps per update, over all env processes."""
-        return self.ppo.rollout_steps * self.envs
+        """Env steps per update, over all env processes (PPO: rollout_steps × envs; SAC: train_freq × envs)."""
+        if self.ppo is not None:
+            return self.ppo.rollout_steps * self.envs
+        return self.sac.train_freq * self.envs
+
+    @property
+    def gamma(self) -> float:
+        """The discount factor of whichever algorithm is configured."""
+        return (self.ppo or self.sac).gamma
 
     def with_overrides(self, *, steps: int | None = None, seed: int | None = None, envs: int | None = None) -> "TrainingConfig":
         """This config with command-line overrides applied, validated again."""

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..episode import rollout
 from ..errors import UsageError
 from ..paths import display
 from .run_dir import RunDir, RunInfo
@@ -30,7 +31,7 @@ def load_policy(info: RunInfo, checkpoint: Path):
     if info.engine == "sb3":
         from .sb3 import SB3Policy
 
-        return SB3Policy(checkpoint)
+        return SB3Policy(checkpoint, info.training_config.algorithm)
     from .rllib import RLlibPolicy
 
     return RLlibPolicy(checkpoint, coop=info.coop)
@@ -40,9 +41,59 @@ def _stats(values: list[float]) -> tuple[float, float]:
     return float(np.mean(values)), float(np.std(values))
 
 
+def trained_task_spec(info: dict) -> Path:
+    """The spec an exported policy was trained on: its recorded path where it exists, else the
+    shipped task of the same name."""
+    from ..paths import specs_dir
+
+    recorded = Path(info.get("spec", ""))
+    if recorded.is_file():
+        return recorded
+    return specs_dir() / "tasks" / f"{info['task']}.yaml"
+
+
+def evaluate_exported(source: str, episodes: int = 100, seed: int = 0, render: str | None = None) -> dict:
+    """Evaluate a shipped or exported policy (``pretrained:<name>`` or a policy folder) on its
+    task, compiled on the current code (NumPy only; no training library needed)."""
+    from ..policies.pretrained import load_trained
+    from ..registration import cached_artifact_dir
+    from ..runtime.env import AssistiveEnv
+
+    policy, info = load_trained(source)
+    if info.get("coop"):
+        raise UsageError(f"evaluate {source}: co-optimised pairs are evaluated from their run directory for now")
+    spec = trained_task_spec(info)
+    env = AssistiveEnv.from_spec(spec, robot=info["robot"], out_dir=cached_artifact_dir(spec, info["robot"]))
+    results = [rollout(env, policy, seed + k) for k in range(episodes)]
+    content_hash = env.manifest.content_hash
+    env.close()
+    out = {"run": source, "gym_id": info["gym_id"], "task": info["task"], "robot": info["robot"], "coop": False,
+           "engine": info["engine"], "checkpoint": source, "trained_steps": info["trained_steps"], "episodes": episodes,
+           "seed": seed, "content_hash": content_hash, "trained_on_content_hash": info["content_hash"],
+           **_figures(results), "per_episode": results}
+    if render:
+        from ..cli.render import record, write_picture
+
+        env = AssistiveEnv.from_spec(spec, robot=info["robot"], out_dir=cached_artifact_dir(spec, info["robot"]),
+                                     render_mode="rgb_array")
+        frames, summary = record(env, policy, seed, 2)
+        env.close()
+        write_picture(frames, Path(render), fps=5)
+        out["render"] = (f"wrote {display(Path(render))} ({len(frames)} frames; return {summary['return']:.1f}, "
+                         f"success {'yes' if summary['success'] else 'no'})")
+    return out
+
+
+def _figures(results: list[dict]) -> dict:
+    mean_r, std_r = _stats([e["return"] for e in results])
+    mean_f, std_f = _stats([e["mean_force_on_human_n"] for e in results])
+    mean_s, std_s = _stats([float(e["success"]) for e in results])
+    return {"mean_return": mean_r, "std_return": std_r, "success_rate": mean_s, "std_success": std_s,
+            "mean_force_on_human_n": mean_f, "std_force_on_human_n": std_f}
+
+
 def evaluate(run_dir: str | Path, episodes: int | None = None, seed: int = 0, render: str | None = None) -> dict:
     """Evaluate the run's newest checkpoint; optionally write a rollout (``render``: .gif or .png)."""
-    from ..cli.run import rollout
     from ..runtime.env import AssistiveEnv
 
     run = RunDir(run_dir)
@@ -60,14 +111,10 @@ def evaluate(run_dir: str | Path, episodes: int | None = None, seed: int = 0, re
         env = AssistiveEnv(run.artifact)
         results = [rollout(env, policy, seed + k) for k in range(episodes)]
     env.close()
-    mean_r, std_r = _stats([e["return"] for e in results])
-    mean_f, std_f = _stats([e["mean_force_on_human_n"] for e in results])
-    mean_s, std_s = _stats([float(e["success"]) for e in results])
     out = {
         "run": display(run.path), "gym_id": info.gym_id, "task": info.task, "robot": info.robot, "coop": info.coop,
         "engine": info.engine, "checkpoint": display(checkpoint), "trained_steps": steps, "episodes": episodes, "seed": seed,
-        "mean_return": mean_r, "std_return": std_r, "success_rate": mean_s, "std_success": std_s,
-        "mean_force_on_human_n": mean_f, "std_force_on_human_n": std_f, "per_episode": results,
+        **_figures(results), "per_episode": results,
     }
     if render:
         out["render"] = render_rollout(run, info, checkpoint, seed, Path(render))

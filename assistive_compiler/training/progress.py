@@ -25,12 +25,39 @@ def print_reward_table(weights: dict[str, float], title: str, out=sys.stderr) ->
         print(f"  {name:<{width}}  {weight:+g}", file=out)
 
 
+class TrainingBar:
+    """Training progress on stderr, with rich (as every other command's progress): a live bar on a
+    terminal; elsewhere (a log file of a background run) one plain line per update."""
+
+    def __init__(self, total_steps: int, start_steps: int, *, enabled: bool = True):
+        self.total, self.enabled, self.live = total_steps, enabled, enabled and sys.stderr.isatty()
+        self._last = ""
+        if self.live:
+            from rich.console import Console
+            from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+            self.progress = Progress(TextColumn("train"), BarColumn(), TextColumn("{task.completed:,}/{task.total:,} steps"),
+                                     TextColumn("{task.fields[status]}"), TimeElapsedColumn(),
+                                     console=Console(file=sys.stderr, highlight=False))
+            self.task = self.progress.add_task("train", total=total_steps, completed=start_steps, status="")
+            self.progress.start()
+
+    def update(self, steps: int, status: str) -> None:
+        if self.live:
+            self.progress.update(self.task, completed=steps, status=status)
+        elif self.enabled:
+            print(f"train {steps:,}/{self.total:,} steps  {status}", file=sys.stderr, flush=True)
+
+    def close(self) -> None:
+        if self.live:
+            self.progress.stop()
+
+
 class Progress:
     """Collects finished episodes and, at each update, writes one curve row and TensorBoard point."""
 
     def __init__(self, run: RunDir, weights: dict[str, float], total_steps: int, start_steps: int, *, quiet: bool = False):
         from torch.utils.tensorboard import SummaryWriter
-        from tqdm import tqdm
 
         self.run, self.weights = run, weights
         self.writer = SummaryWriter(str(run.tb / "episodes"))
@@ -39,9 +66,7 @@ class Progress:
         #: (episodes, mean return, success rate, each term's mean weighted episode sum) since the last update
         self.pending: list[tuple[int, float, float, dict[str, float]]] = []
         self.last_return: float | None = None
-        self.bar = tqdm(total=total_steps, initial=start_steps, unit="step", unit_scale=True, file=sys.stderr,
-                        disable=quiet, dynamic_ncols=True, desc="train")
-        self._bar_at = start_steps
+        self.bar = TrainingBar(total_steps, start_steps, enabled=not quiet)
         new = not run.curve_csv.is_file()
         self._csv = run.curve_csv.open("a", newline="")
         self._rows = csv.writer(self._csv)
@@ -86,12 +111,10 @@ class Progress:
         for key, value in scalars.items():
             self.writer.add_scalar(key, value, steps)
         self.writer.flush()
-        self.bar.update(steps - self._bar_at)
-        self._bar_at = steps
-        post = {"steps/s": f"{rate:.0f}"}
+        status = f"{rate:.0f} steps/s"
         if self.last_return is not None:
-            post["return"] = f"{self.last_return:.1f}"
-        self.bar.set_postfix(post)
+            status += f", return {self.last_return:.1f}, success {scalars.get('Episode/success_rate', float('nan')):.2f}"
+        self.bar.update(steps, status)
         return scalars
 
     def wall_s(self) -> float:

@@ -131,7 +131,7 @@ def new_run_info(spec: str, manifest, robot: str, coop: bool, engine: str, confi
     return RunInfo(
         spec=display(Path(spec)), task=manifest.task, robot=robot, coop=coop, engine=engine,
         content_hash=manifest.content_hash, gym_id=manifest.gym_id + ("" if not coop else " (Human)"),
-        config=config.model_dump(), versions=package_versions(), command=sys.argv[:],
+        config=config.model_dump(exclude_none=True), versions=package_versions(), command=sys.argv[:],
         created=time.strftime("%Y-%m-%dT%H:%M:%S"),
     )
 

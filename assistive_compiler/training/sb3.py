@@ -1,10 +1,11 @@
-"""Single-agent training on one machine: Stable-Baselines3 PPO over ``envs`` env processes.
+"""Single-agent training on one machine: Stable-Baselines3 PPO or SAC over ``envs`` env processes.
 
 The envs are SB3's process-based vector env (:class:`SubprocVecEnv`; one env runs in-process),
 each a :class:`~assistive_compiler.runtime.env.AssistiveEnv` built from the run's compiled
-artifact, optionally behind :class:`VecNormalize` (running observation and return statistics,
-saved with every checkpoint). A checkpoint is a directory holding ``model.zip`` and
-``vecnormalize.pkl``; resuming loads both and continues the step count.
+artifact, optionally (PPO) behind :class:`VecNormalize` (running observation and return
+statistics, saved with every checkpoint). A checkpoint is a directory holding ``model.zip``, PPO's
+``vecnormalize.pkl`` and SAC's ``replay_buffer.pkl`` (kept in the newest checkpoint only: it is
+the bulk of a checkpoint); resuming loads them and continues the step count.
 """
 
 from __future__ import annotations
@@ -20,6 +21,21 @@ from .progress import Progress
 from .run_dir import RunDir
 
 ACTIVATIONS = {"tanh": "Tanh", "relu": "ReLU"}
+#: Env steps between two learning-curve rows for SAC, whose "rollouts" are single env steps.
+SAC_LOG_EVERY_STEPS = 2_000
+REPLAY_BUFFER = "replay_buffer.pkl"
+
+
+def algorithm_class(config_or_name):
+    """SB3's class for the config's algorithm (or an algorithm name)."""
+    name = getattr(config_or_name, "algorithm", config_or_name)
+    if name == "sac":
+        from stable_baselines3 import SAC
+
+        return SAC
+    from stable_baselines3 import PPO
+
+    return PPO
 
 
 def make_monitored_env(artifact_dir: str, in_worker: bool = False):
@@ -50,13 +66,14 @@ def policy_kwargs(config: TrainingConfig) -> dict:
     import torch.nn as nn
 
     hidden = list(config.network.hidden)
-    return {"net_arch": {"pi": hidden, "vf": hidden}, "activation_fn": getattr(nn, ACTIVATIONS[config.network.activation])}
+    arch = {"pi": hidden, "vf": hidden} if config.algorithm == "ppo" else {"pi": hidden, "qf": hidden}
+    return {"net_arch": arch, "activation_fn": getattr(nn, ACTIVATIONS[config.network.activation])}
 
 
 def _normalized(venv, config: TrainingConfig, checkpoint: Path | None):
     from stable_baselines3.common.vec_env import VecNormalize
 
-    if not (config.ppo.normalize_observations or config.ppo.normalize_rewards):
+    if config.ppo is None or not (config.ppo.normalize_observations or config.ppo.normalize_rewards):
         return venv
     if checkpoint is not None:
         return VecNormalize.load(str(checkpoint / "vecnormalize.pkl"), venv)
@@ -65,8 +82,14 @@ def _normalized(venv, config: TrainingConfig, checkpoint: Path | None):
 
 
 def _new_model(venv, config: TrainingConfig, run: RunDir):
-    from stable_baselines3 import PPO
+    from stable_baselines3 import PPO, SAC
 
+    if config.sac is not None:
+        s = config.sac
+        return SAC("MlpPolicy", venv, learning_rate=s.learning_rate, buffer_size=s.buffer_size, learning_starts=s.learning_starts,
+                   batch_size=s.batch_size, tau=s.tau, gamma=s.gamma, train_freq=s.train_freq, gradient_steps=s.gradient_steps,
+                   ent_coef=s.ent_coef, target_entropy=s.target_entropy, policy_kwargs=policy_kwargs(config),
+                   tensorboard_log=str(run.tb), seed=config.seed, device="cpu", verbose=0)
     p = config.ppo
     return PPO("MlpPolicy", venv, n_steps=p.rollout_steps, batch_size=p.minibatch_size, n_epochs=p.epochs, gamma=p.gamma,
                gae_lambda=p.gae_lambda, learning_rate=p.learning_rate, clip_range=p.clip_range, ent_coef=p.entropy_coef,
@@ -75,19 +98,31 @@ def _new_model(venv, config: TrainingConfig, run: RunDir):
 
 
 def save_checkpoint(run: RunDir, model, steps: int) -> Path:
+    """Write a complete checkpoint at ``steps``; an off-policy model's replay buffer goes with it
+    and leaves the older checkpoints (they stay loadable as policies, not resumable with data)."""
+    from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
     from stable_baselines3.common.vec_env import VecNormalize
 
+    older = run.latest_checkpoint()
     out = run.begin_checkpoint(steps)
     model.save(str(out / "model.zip"))
     venv = model.get_env()
     if isinstance(venv, VecNormalize):
         venv.save(str(out / "vecnormalize.pkl"))
-    run.end_checkpoint(out, steps, {"engine": "sb3"})
+    off_policy = isinstance(model, OffPolicyAlgorithm)
+    if off_policy:
+        model.save_replay_buffer(str(out / REPLAY_BUFFER))
+    run.end_checkpoint(out, steps, {"engine": "sb3", "algorithm": type(model).__name__.lower()})
+    if off_policy and older is not None and older[1] != out:
+        (older[1] / REPLAY_BUFFER).unlink(missing_ok=True)
     return out
 
 
 def _callback(run: RunDir, progress: Progress, config: TrainingConfig, n_envs: int, stop=None):
     from stable_baselines3.common.callbacks import BaseCallback
+
+    # PPO: a row per rollout (its update); SAC updates every step, so a row per SAC_LOG_EVERY_STEPS
+    log_every = config.batch_size if config.ppo is not None else max(config.batch_size, SAC_LOG_EVERY_STEPS)
 
     class RunCallback(BaseCallback):
         """Per-term episode sums, the learning curve and checkpoints, at the end of each rollout."""
@@ -100,6 +135,7 @@ def _callback(run: RunDir, progress: Progress, config: TrainingConfig, n_envs: i
         def _on_training_start(self) -> None:
             every = config.checkpoint_every_steps
             self.next_checkpoint = (self.num_timesteps // every + 1) * every
+            self.next_log = self.num_timesteps + log_every
 
         def _on_step(self) -> bool:
             for i, (info, done) in enumerate(zip(self.locals["infos"], self.locals["dones"])):
@@ -111,6 +147,9 @@ def _callback(run: RunDir, progress: Progress, config: TrainingConfig, n_envs: i
             return not stop  # False ends model.learn() after this step
 
         def _on_rollout_end(self) -> None:
+            if self.num_timesteps < self.next_log and self.num_timesteps < self.next_checkpoint:
+                return
+            self.next_log = self.num_timesteps + log_every
             for key, value in progress.update(self.num_timesteps).items():
                 self.logger.record(key, value)
             if self.num_timesteps >= self.next_checkpoint:
@@ -129,16 +168,22 @@ def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, res
     training after the current env step; a checkpoint is written and the figures come back with
     ``interrupted: True``; a later ``resume`` continues from it."""
     import torch
-    from stable_baselines3 import PPO
 
-    torch.set_num_threads(1)  # a 2×64 MLP: more threads only contend with the env processes
+    torch.set_num_threads(1)  # small MLPs: more threads only contend with the env processes
     latest = run.latest_checkpoint() if resume else None
     start_steps = latest[0] if latest else 0
     venv = make_vec_env(run.artifact, config.envs, config.seed + start_steps)
     venv = _normalized(venv, config, latest[1] if latest else None)
     if latest:
-        model = PPO.load(str(latest[1] / "model.zip"), env=venv, device="cpu")
+        model = algorithm_class(config).load(str(latest[1] / "model.zip"), env=venv, device="cpu")
         model.set_random_seed(config.seed + start_steps)
+        if config.sac is not None:
+            buffer = latest[1] / REPLAY_BUFFER
+            if not buffer.is_file():
+                from ..errors import UsageError
+
+                raise UsageError(f"{buffer}: --resume of a SAC run needs the newest checkpoint's replay buffer, which is missing")
+            model.load_replay_buffer(str(buffer))
     else:
         model = _new_model(venv, config, run)
     progress = Progress(run, weights, config.total_steps, start_steps, quiet=quiet)
@@ -168,10 +213,10 @@ def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, res
 class SB3Policy:
     """A trained SB3 policy as a function of raw observations (normalised as during training)."""
 
-    def __init__(self, checkpoint: Path):
-        from stable_baselines3 import PPO
-
-        self.model = PPO.load(str(checkpoint / "model.zip"), device="cpu")
+    def __init__(self, checkpoint: Path, algorithm: str = "ppo"):
+        self.algorithm = algorithm
+        self.model = algorithm_class(algorithm).load(str(checkpoint / "model.zip"), device="cpu",
+                                                     custom_objects={"replay_buffer_class": None})
         self.obs_rms = None
         stats = checkpoint / "vecnormalize.pkl"
         if stats.is_file():

@@ -1,6 +1,6 @@
 """``train``: compile the task, open (or resume) a run directory, and hand it to an engine.
 
-Engines: ``sb3`` (Stable-Baselines3 PPO, single agent, one machine) and ``rllib`` (Ray RLlib PPO:
+Engines: ``sb3`` (Stable-Baselines3 PPO or SAC, single agent, one machine) and ``rllib`` (Ray RLlib PPO:
 co-optimisation with policies ``robot`` and ``human``, or any run on a Ray cluster via
 ``--address``). ``auto`` picks RLlib for ``--coop`` or an ``--address``, SB3 otherwise.
 """
@@ -66,6 +66,9 @@ def train(spec: str, *, robot: str | None, config_path: str, coop: bool = False,
     """Train a policy for ``spec`` and ``robot`` as ``config_path`` says; returns the run's summary."""
     engine = choose_engine(engine, coop, address)
     config: TrainingConfig = load_training_config(config_path).with_overrides(steps=steps, seed=seed, envs=envs)
+    if engine == "rllib" and config.algorithm != "ppo":
+        raise UsageError(f"{display(Path(config_path))}: algorithm '{config.algorithm}' trains on the sb3 engine (one machine, "
+                         "single agent); the rllib engine (--coop, --address) runs algorithm 'ppo'")
     result, robot = compile_for_run(spec, robot, coop)
     if engine == "rllib":
         from .rllib import init_ray
@@ -88,7 +91,7 @@ def train(spec: str, *, robot: str | None, config_path: str, coop: bool = False,
     if not quiet:
         from .progress import print_reward_table
 
-        print(f"{manifest.gym_id}{' + human (co-optimisation)' if coop else ''}: {engine} PPO, {config.envs} envs, "
+        print(f"{manifest.gym_id}{' + human (co-optimisation)' if coop else ''}: {engine} {config.algorithm.upper()}, {config.envs} envs, "
               f"{config.total_steps:,} steps -> {display(run.path)}", file=sys.stderr)
         print_reward_table(weights, manifest.task)
     with stop_on_signals() as stop:

@@ -1,0 +1,63 @@
+"""``export`` (a run's newest checkpoint as a shipped-policy folder, evaluated) and ``results``
+(``docs/results.md``'s tables, curves and pictures from the shipped policies). The work is in
+:mod:`assistive_compiler.training.export` and :mod:`assistive_compiler.training.results`."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .common import EXIT_FAILED, EXIT_OK, engine_modules, require_extra
+
+
+def cmd_export(args: argparse.Namespace) -> int:
+    from ..training.run_dir import RunDir
+
+    if not require_extra(*engine_modules(RunDir(args.run_dir).info().engine)):
+        return EXIT_FAILED
+    from ..paths import display
+    from ..training.export import export_run
+
+    record = export_run(args.run_dir, args.out, episodes=args.episodes, seed=args.seed, label=args.label or "",
+                        progress=lambda line: print(line, file=sys.stderr))
+    e = record["evaluation"]
+    where = display(Path(args.out)) if args.out else f"pretrained/{record['name']}"
+    play = where if args.out else f"pretrained:{record['name']}"
+    print(f"exported {record['gym_id']} ({record['trained_steps']:,} steps) -> {where}: success {e['success_rate']:.2f}, "
+          f"return {e['mean_return']:.1f} ± {e['std_return']:.1f} over {e['episodes']} episodes from seed {e['seed']:,}; "
+          f"play it with --policy {play}")
+    return EXIT_OK
+
+
+def cmd_results(args: argparse.Namespace) -> int:
+    if not require_extra("matplotlib"):
+        return EXIT_FAILED
+    from ..paths import display
+    from ..training.results import shipped_records, update_doc, write_pictures
+
+    doc = Path(args.out)
+    records = shipped_records()
+    if not args.no_pictures:
+        write_pictures(records, doc.parent, progress=lambda name: print(f"pictures of {name}", file=sys.stderr))
+    doc.parent.mkdir(parents=True, exist_ok=True)
+    doc.write_text(update_doc(doc, records))
+    print(f"wrote {display(doc)} from {len(records)} shipped polic{'y' if len(records) == 1 else 'ies'}")
+    return EXIT_OK
+
+
+def add_commands(sub) -> None:
+    from ..training.export import EVAL_SEED
+
+    p = sub.add_parser("export", help="a run's newest checkpoint as a shipped policy (NumPy only), evaluated on unseen seeds")
+    p.add_argument("run_dir", help="a run directory written by train (SB3)")
+    p.add_argument("--out", help="policy folder (default pretrained/<task>-<robot>: shipped as pretrained:<task>-<robot>)")
+    p.add_argument("--episodes", type=int, default=100, help="evaluation episodes (default 100, as the paper)")
+    p.add_argument("--seed", type=int, default=EVAL_SEED, help=f"first evaluation seed (default {EVAL_SEED:,}: never used in training)")
+    p.add_argument("--label", help="the table row's name (default: the algorithm and its config's description)")
+    p.set_defaults(func=cmd_export)
+
+    p = sub.add_parser("results", help="regenerate docs/results.md's tables, curves and pictures from the shipped policies")
+    p.add_argument("--out", default="docs/results.md", help="the results document (its generated block is replaced)")
+    p.add_argument("--no-pictures", action="store_true", help="tables only; keep the curve and rollout pictures as they are")
+    p.set_defaults(func=cmd_results)

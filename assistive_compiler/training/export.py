@@ -1,0 +1,135 @@
+"""``export``: a run's newest checkpoint as a shipped-policy folder (NumPy only), evaluated.
+
+The folder (default ``pretrained/<task>-<robot>[-coop]``) holds the network as
+:class:`~assistive_compiler.policies.mlp.MLPPolicy` files, the run's learning curve
+(``curve.csv``) and, in ``policy.json``, everything ``results`` needs to write a table row:
+what was trained (task, robot, algorithm, config, the compiled task's content hash), how long
+(env steps, wall time, env steps/s including learning), and the exported policy's own
+evaluation as the paper evaluates (deterministic actions, ``episodes`` episodes on seeds
+``seed``.. that training never used) plus the few fixed ``regression`` seeds the test suite
+re-checks on the current code.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import UsageError
+from ..paths import display
+from ..policies.mlp import MLPPolicy
+from .run_dir import RunDir
+
+#: Unseen seeds of the evaluation: training seeds its envs with the config's seed (0–10 in the
+#: shipped configs, plus the step count on resume) and never resets with a seed after that.
+EVAL_SEED = 1_000_000
+REGRESSION_EPISODES = 10
+
+
+def _linears(module) -> list:
+    import torch.nn as nn
+
+    return [m for m in module.modules() if isinstance(m, nn.Linear)]
+
+
+def _layers(linears) -> list[tuple[np.ndarray, np.ndarray]]:
+    return [(m.weight.detach().cpu().numpy().astype(np.float64), m.bias.detach().cpu().numpy().astype(np.float64)) for m in linears]
+
+
+def mlp_from_sb3(checkpoint: Path, algorithm: str, activation: str) -> MLPPolicy:
+    """The deterministic policy of an SB3 checkpoint (SAC's actor mean through tanh; PPO's
+    Gaussian mean, clipped), with PPO's observation normalisation if it used one."""
+    from .sb3 import SB3Policy
+
+    loaded = SB3Policy(checkpoint, algorithm)
+    model = loaded.model
+    low, high = model.action_space.low, model.action_space.high
+    if algorithm == "sac":
+        layers = _layers(_linears(model.actor.latent_pi) + [model.actor.mu])
+        return MLPPolicy(layers, activation, "tanh", low, high)
+    layers = _layers(_linears(model.policy.mlp_extractor.policy_net) + [model.policy.action_net])
+    if loaded.obs_rms is None:
+        return MLPPolicy(layers, activation, "clip", low, high)
+    return MLPPolicy(layers, activation, "clip", low, high, loaded.obs_rms.mean, loaded.obs_rms.var, loaded.clip, loaded.eps)
+
+
+def check_same_actions(exported: MLPPolicy, original, observations: np.ndarray, atol: float = 1e-4) -> float:
+    """The largest difference between the exported and the original policy's actions on
+    ``observations``; raises when it exceeds ``atol`` (an export that changed the policy)."""
+    worst = max(float(np.max(np.abs(exported(o) - np.asarray(original(o), dtype=np.float64)))) for o in observations)
+    if worst > atol:
+        raise RuntimeError(f"the exported policy's actions differ from the checkpoint's by up to {worst:.2e} (> {atol:g})")
+    return worst
+
+
+def evaluate_policy(artifact: Path, policy, episodes: int, seed: int) -> dict:
+    """Mean ± std return, success rate and force on the person over seeded episodes (deterministic)."""
+    from ..runtime.env import AssistiveEnv
+    from ..episode import rollout
+
+    env = AssistiveEnv(artifact)
+    try:
+        runs = [rollout(env, policy, seed + k) for k in range(episodes)]
+    finally:
+        env.close()
+    returns = [r["return"] for r in runs]
+    forces = [r["mean_force_on_human_n"] for r in runs]
+    return {"episodes": episodes, "seed": seed, "mean_return": float(np.mean(returns)), "std_return": float(np.std(returns)),
+            "success_rate": float(np.mean([r["success"] for r in runs])), "mean_force_on_human_n": float(np.mean(forces)),
+            "std_force_on_human_n": float(np.std(forces)), "successes": [bool(r["success"]) for r in runs],
+            "returns": [round(float(x), 3) for x in returns]}
+
+
+def export_run(run_dir: str | Path, out: str | Path | None = None, *, episodes: int = 100, seed: int = EVAL_SEED,
+               label: str = "", progress=None) -> dict:
+    """Export the run's newest checkpoint to ``out`` and evaluate the exported policy there;
+    returns its ``policy.json``. ``label`` names the table row (e.g. ``"PPO (paper) baseline"``)."""
+    from ..policies.pretrained import pretrained_dir
+
+    run = RunDir(run_dir)
+    info = run.info()
+    if info.engine != "sb3":
+        raise UsageError(f"{display(run.path)}: exporting {info.engine} runs (co-optimised pairs) is not supported yet; "
+                         "play the run directory itself with --policy RUN_DIR")
+    found = run.latest_checkpoint()
+    if found is None:
+        raise UsageError(f"{display(run.path)}: the run has no complete checkpoint yet")
+    steps, checkpoint = found
+    config = info.training_config
+    policy = mlp_from_sb3(checkpoint, config.algorithm, config.network.activation)
+
+    from .sb3 import SB3Policy
+
+    original = SB3Policy(checkpoint, config.algorithm)
+    rng = np.random.default_rng(0)
+    obs = rng.normal(0.0, 1.0, (32, policy.obs_dim))
+    worst = check_same_actions(policy, original, obs)
+
+    name = f"{info.task}-{info.robot}{'-coop' if info.coop else ''}"
+    out = Path(out) if out else pretrained_dir() / name
+    summary = json.loads(run.summary_json.read_text()) if run.summary_json.is_file() else {}
+    evaluation = evaluate_policy(run.artifact, policy, episodes, seed)
+    if progress:
+        progress(f"evaluated {episodes} episodes: success {evaluation['success_rate']:.2f}")
+    regression = {k: evaluation[k] for k in ("seed", "success_rate", "mean_return")}
+    regression["episodes"] = min(REGRESSION_EPISODES, episodes)
+    regression["success_rate"] = float(np.mean(evaluation["successes"][:regression["episodes"]]))
+    regression["mean_return"] = float(np.mean(evaluation["returns"][:regression["episodes"]]))
+    wall = summary.get("wall_s")
+    record = {
+        "name": out.name, "label": label or f"{config.algorithm.upper()} ({config.description or 'config'})",
+        "task": info.task, "robot": info.robot, "coop": info.coop, "gym_id": info.gym_id, "spec": info.spec,
+        "content_hash": info.content_hash, "engine": info.engine, "algorithm": config.algorithm, "demonstrations": False,
+        "config": config.model_dump(exclude_none=True), "trained_steps": steps, "wall_s": wall,
+        "steps_per_s_including_learning": (steps / wall) if wall else None, "versions": info.versions,
+        "export_max_action_difference": worst, "evaluation": evaluation, "regression": regression,
+    }
+    if out.exists():
+        shutil.rmtree(out)
+    policy.save(out, record)
+    if run.curve_csv.is_file():
+        shutil.copy(run.curve_csv, out / "curve.csv")
+    return json.loads((out / "policy.json").read_text())

@@ -1,0 +1,149 @@
+"""``results``: the learned-results section of ``docs/results.md``, regenerated from the shipped
+policies alone (``pretrained/*/policy.json`` and ``curve.csv``).
+
+Everything between the markers ``<!-- results:begin -->`` and ``<!-- results:end -->`` is written
+here: Table I (static person) and Table II (active person) in the paper's terms — our mean return
+± std, success rate and force on the person beside the paper's return for the same robot and its
+best robot's success rate (§V) — with each cell's algorithm, env steps, wall time and env steps/s
+including learning; the paper's §V-B claim (co-optimised against static success) where both cells
+exist; and per cell its learning curve and a picture of one evaluation rollout. The prose around
+the markers is written by hand. A test keeps the block equal to what this module writes.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from .paper import PAPER, ROBOT_TITLES, TASK_TITLES, TASKS
+
+BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
+PICTURES = "results"  # beside the doc: docs/results/<name>-curve.png, docs/results/<name>.png
+
+
+def shipped_records() -> list[dict]:
+    """Every shipped policy's ``policy.json``, by name."""
+    from ..policies.mlp import POLICY_FILE
+    from ..policies.pretrained import pretrained_dir, shipped_names
+
+    return [json.loads((pretrained_dir() / n / POLICY_FILE).read_text()) for n in shipped_names()]
+
+
+def _hours(seconds: float | None) -> str:
+    if not seconds:
+        return "—"
+    return f"{seconds / 3600:.1f} h" if seconds >= 3600 else f"{seconds / 60:.0f} min"
+
+
+def _row(r: dict, paper: dict, paper_success: dict) -> list[str]:
+    e = r["evaluation"]
+    paper_return = paper.get(r["task"], {}).get(r["robot"])
+    paper_s = paper_success.get(r["task"])
+    goal = "—" if paper_s is None else ("yes" if 100 * e["success_rate"] >= paper_s else "no")
+    return [
+        TASK_TITLES.get(r["task"], r["task"]), ROBOT_TITLES.get(r["robot"], r["robot"]), r["label"] + (" (demonstrations)" if r["demonstrations"] else ""),
+        f"{r['trained_steps']:,}", _hours(r.get("wall_s")),
+        "—" if not r.get("steps_per_s_including_learning") else f"{r['steps_per_s_including_learning']:.0f}",
+        f"{e['mean_return']:.1f} ± {e['std_return']:.1f}", f"{100 * e['success_rate']:.0f}%",
+        f"{e['mean_force_on_human_n']:.2f}", "—" if paper_return is None else f"{paper_return:.1f}",
+        "—" if paper_s is None else f"{paper_s}%", goal,
+    ]
+
+
+HEADER = ["Task", "Robot", "Algorithm", "Env steps", "Wall time", "Env steps/s", "Return ± std", "Success",
+          "Force on person (N)", "Paper return", "Paper success (best robot)", "≥ paper"]
+
+
+def _table(rows: list[list[str]]) -> str:
+    lines = ["| " + " | ".join(HEADER) + " |", "|" + "|".join("---" for _ in HEADER) + "|"]
+    return "\n".join(lines + ["| " + " | ".join(r) + " |" for r in rows])
+
+
+def _order(r: dict) -> tuple:
+    return (TASKS.index(r["task"]) if r["task"] in TASKS else len(TASKS), r["task"], r["robot"], r["name"])
+
+
+def results_block(records: list[dict]) -> str:
+    """The generated Markdown between the markers (no pictures are made here)."""
+    parts = [BEGIN, "<!-- written by `assistive-compiler results`; edit the policies or the prose outside the markers -->", ""]
+    for coop in (False, True):
+        title, paper, paper_success = PAPER[coop]
+        rows = sorted((r for r in records if bool(r["coop"]) == coop), key=_order)
+        parts.append(f"### {title}\n")
+        if not rows:
+            parts.append("No cell of this table has been trained here yet.\n")
+            continue
+        missing = [TASK_TITLES[t] for t in TASKS if t in paper and not any(r["task"] == t for r in rows)]
+        parts.append(_table([_row(r, paper, paper_success) for r in rows]) + "\n")
+        if missing:
+            parts.append(f"Not trained yet: {', '.join(missing)}.\n")
+    claim = []
+    for task in TASKS:
+        static = [r for r in records if r["task"] == task and not r["coop"] and not r["name"].endswith(("-ppo",))]
+        active = [r for r in records if r["task"] == task and r["coop"]]
+        for a in active:
+            for s in (x for x in static if x["robot"] == a["robot"]):
+                claim.append(f"| {TASK_TITLES[task]} | {ROBOT_TITLES.get(a['robot'], a['robot'])} | "
+                             f"{100 * s['evaluation']['success_rate']:.0f}% | {100 * a['evaluation']['success_rate']:.0f}% |")
+    parts.append("### The paper's claim (§V-B): an active person raises success\n")
+    if claim:
+        parts.append("| Task | Robot | Static person | Active person (co-optimised) |\n|---|---|---|---|\n" + "\n".join(claim) + "\n")
+    else:
+        parts.append("Not measured yet: it needs a co-optimised cell beside a static one of the same task and robot.\n")
+    parts.append("### Each cell\n")
+    for r in sorted(records, key=_order):
+        e = r["evaluation"]
+        parts.append(f"#### {TASK_TITLES.get(r['task'], r['task'])} × {ROBOT_TITLES.get(r['robot'], r['robot'])}: {r['label']}\n")
+        parts.append(f"`--policy pretrained:{r['name']}`: {r['trained_steps']:,} env steps "
+                     f"({_hours(r.get('wall_s'))}), evaluated on {e['episodes']} episodes, seeds {e['seed']:,}–"
+                     f"{e['seed'] + e['episodes'] - 1:,} (never used in training), deterministic actions: success "
+                     f"{100 * e['success_rate']:.0f}%, return {e['mean_return']:.1f} ± {e['std_return']:.1f}. "
+                     f"Trained on the compiled task {r['content_hash'][:12]}.\n")
+        parts.append(f"![{r['name']} learning curve]({PICTURES}/{r['name']}-curve.png)\n")
+        parts.append(f"![{r['name']} rollout, seed {e['seed']:,}]({PICTURES}/{r['name']}.png)\n")
+    parts.append(END)
+    return "\n".join(parts)
+
+
+def write_pictures(records: list[dict], doc_dir: Path, progress=None) -> list[Path]:
+    """Each cell's learning curve and a strip of its first evaluation episode (rendered anew)."""
+    from ..cli.render import record, write_picture
+    from ..policies.pretrained import PREFIX, pretrained_dir
+    from ..registration import cached_artifact_dir
+    from ..runtime.env import AssistiveEnv
+    from .curves import plot_curves, read_curve
+    from .evaluate import trained_task_spec
+    from ..policies.pretrained import load_trained
+
+    out_dir = doc_dir / PICTURES
+    written = []
+    for r in records:
+        curve = read_curve(pretrained_dir() / r["name"] / "curve.csv")
+        if curve:
+            png = out_dir / f"{r['name']}-curve.png"
+            plot_curves({r["label"]: curve}, png, title=f"{r['gym_id']}: {r['label']} (training episodes, stochastic actions)")
+            written.append(png)
+        if r["coop"]:
+            continue
+        policy, _ = load_trained(PREFIX + r["name"])
+        spec = trained_task_spec(r)
+        env = AssistiveEnv.from_spec(spec, robot=r["robot"], out_dir=cached_artifact_dir(spec, r["robot"]), render_mode="rgb_array")
+        frames, _ = record(env, policy, r["evaluation"]["seed"], 2)
+        env.close()
+        png = out_dir / f"{r['name']}.png"
+        write_picture(frames, png, fps=5)
+        written.append(png)
+        if progress:
+            progress(r["name"])
+    return written
+
+
+def update_doc(doc: Path, records: list[dict]) -> str:
+    """``doc`` with its generated block replaced (appended where the markers are missing)."""
+    text = doc.read_text() if doc.is_file() else "# Training results measured here\n"
+    block = results_block(records)
+    if BEGIN in text and END in text:
+        head, rest = text.split(BEGIN, 1)
+        tail = rest.split(END, 1)[1]
+        return head + block + tail
+    return text.rstrip("\n") + "\n\n" + block + "\n"
