@@ -80,3 +80,38 @@ def test_unreachable_ray_address_fails_fast_with_a_message(tmp_path, capsys):
     assert code == 2 and elapsed < 20
     assert "error: --address: no Ray cluster reachable at 127.0.0.1:1" in err
     assert not out.exists()
+
+
+SAC_TINY = """\
+algorithm: sac
+network: {hidden: [16, 16], activation: relu}
+sac: {learning_starts: 40, buffer_size: 2000, batch_size: 16}
+total_steps: 100
+envs: 1
+checkpoint_every_steps: 100
+eval_episodes: 1
+"""
+
+
+@pytest.mark.slow
+def test_multi_agent_sac_trains_and_exports_a_pair_that_plays_under_coop(local_ray, tmp_path, capsys):
+    """Co-optimisation with SAC on RLlib: robot and human modules learn, the pair exports to NumPy
+    (each agent's actions equal the checkpoint's) and plays both agents from `run --coop`."""
+    from assistive_compiler.training.export import export_run
+
+    config = tmp_path / "sac_tiny.yaml"
+    config.write_text(SAC_TINY)
+    out = tmp_path / "feeding-coop-sac"
+    figures = train(str(FEEDING), robot="jaco", config_path=str(config), coop=True, out=str(out), quiet=True)
+    assert figures["steps"] >= 100 and RunDir(out).info().training_config.algorithm == "sac"
+    record = export_run(out, tmp_path / "pair", episodes=1, seed=7)
+    assert record["coop"] and record["export_max_action_difference"] < 1e-4
+    assert {p.name for p in (tmp_path / "pair").iterdir()} >= {"policy.json", "robot", "human"}
+    checkpoint_return = evaluate(out, episodes=1, seed=7)["mean_return"]
+    assert record["evaluation"]["mean_return"] == pytest.approx(checkpoint_return, abs=0.05)  # float64 NumPy vs float32 torch
+    capsys.readouterr()
+    assert main(["run", str(FEEDING), "--robot", "jaco", "--coop", "--policy", str(tmp_path / "pair"), "--episodes", "1",
+                 "--seed", "7", "--json", "--quiet"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["human_policy"] == str(tmp_path / "pair")  # the pair plays the person too
+    assert report["episodes"][0]["return"] == pytest.approx(record["evaluation"]["returns"][0], abs=1e-3)

@@ -34,7 +34,7 @@ def load_policy(info: RunInfo, checkpoint: Path):
         return SB3Policy(checkpoint, info.training_config.algorithm)
     from .rllib import RLlibPolicy
 
-    return RLlibPolicy(checkpoint, coop=info.coop)
+    return RLlibPolicy(checkpoint, coop=info.coop, algorithm=info.training_config.algorithm)
 
 
 def _stats(values: list[float]) -> tuple[float, float]:
@@ -54,29 +54,38 @@ def trained_task_spec(info: dict) -> Path:
 
 def evaluate_exported(source: str, episodes: int = 100, seed: int = 0, render: str | None = None) -> dict:
     """Evaluate a shipped or exported policy (``pretrained:<name>`` or a policy folder) on its
-    task, compiled on the current code (NumPy only; no training library needed)."""
+    task, compiled on the current code (NumPy only; no training library needed). A co-optimised
+    pair plays both agents."""
+    from ..compile.compiler import compile_task
     from ..policies.pretrained import load_trained
     from ..registration import cached_artifact_dir
-    from ..runtime.env import AssistiveEnv
 
     policy, info = load_trained(source)
-    if info.get("coop"):
-        raise UsageError(f"evaluate {source}: co-optimised pairs are evaluated from their run directory for now")
     spec = trained_task_spec(info)
-    env = AssistiveEnv.from_spec(spec, robot=info["robot"], out_dir=cached_artifact_dir(spec, info["robot"]))
-    results = [rollout(env, policy, seed + k) for k in range(episodes)]
-    content_hash = env.manifest.content_hash
+    compiled = compile_task(spec, info["robot"], cached_artifact_dir(spec, info["robot"]))
+    if info.get("coop"):
+        from ..coop.parallel import AssistiveParallelEnv
+        from ..coop.rollout import rollout_coop
+
+        env = AssistiveParallelEnv(compiled.out_dir)
+        results = [rollout_coop(env, policy.robot, policy.human, seed + k) for k in range(episodes)]
+    else:
+        from ..runtime.env import AssistiveEnv
+
+        env = AssistiveEnv.from_compiled(compiled)
+        results = [rollout(env, policy, seed + k) for k in range(episodes)]
     env.close()
-    out = {"run": source, "gym_id": info["gym_id"], "task": info["task"], "robot": info["robot"], "coop": False,
+    out = {"run": source, "gym_id": info["gym_id"], "task": info["task"], "robot": info["robot"], "coop": bool(info.get("coop")),
            "engine": info["engine"], "checkpoint": source, "trained_steps": info["trained_steps"], "episodes": episodes,
-           "seed": seed, "content_hash": content_hash, "trained_on_content_hash": info["content_hash"],
+           "seed": seed, "content_hash": compiled.manifest.content_hash, "trained_on_content_hash": info["content_hash"],
            **_figures(results), "per_episode": results}
     if render:
         from ..cli.render import record, write_picture
+        from ..runtime.env import AssistiveEnv
 
-        env = AssistiveEnv.from_spec(spec, robot=info["robot"], out_dir=cached_artifact_dir(spec, info["robot"]),
-                                     render_mode="rgb_array")
-        frames, summary = record(env, policy, seed, 2)
+        env = AssistiveEnv(compiled.out_dir, render_mode="rgb_array")
+        target, act = (env, policy) if not info.get("coop") else _both(env, policy)
+        frames, summary = record(target, act, seed, 2)
         env.close()
         write_picture(frames, Path(render), fps=5)
         out["render"] = (f"wrote {display(Path(render))} ({len(frames)} frames; return {summary['return']:.1f}, "

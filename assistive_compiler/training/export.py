@@ -56,6 +56,18 @@ def mlp_from_sb3(checkpoint: Path, algorithm: str, activation: str) -> MLPPolicy
     return MLPPolicy(layers, activation, "clip", low, high, loaded.obs_rms.mean, loaded.obs_rms.var, loaded.clip, loaded.eps)
 
 
+def mlp_from_rllib(module, algorithm: str, activation: str) -> MLPPolicy:
+    """The deterministic policy of an RLlib RLModule (the actor's encoder and its head, the
+    Gaussian's means only): SAC's squashed through tanh, PPO's clipped to the action bounds."""
+    encoder = module.pi_encoder if algorithm == "sac" else module.encoder.actor_encoder
+    layers = _layers(_linears(encoder) + _linears(module.pi))
+    w, b = layers[-1]
+    half = w.shape[0] // 2  # the head gives means, then log-stds
+    layers[-1] = (w[:half], b[:half])
+    space = module.action_space
+    return MLPPolicy(layers, activation, "tanh" if algorithm == "sac" else "clip", space.low, space.high)
+
+
 def check_same_actions(exported: MLPPolicy, original, observations: np.ndarray, atol: float = 1e-4) -> float:
     """The largest difference between the exported and the original policy's actions on
     ``observations``; raises when it exceeds ``atol`` (an export that changed the policy)."""
@@ -66,13 +78,24 @@ def check_same_actions(exported: MLPPolicy, original, observations: np.ndarray, 
 
 
 def evaluate_policy(artifact: Path, policy, episodes: int, seed: int) -> dict:
-    """Mean ± std return, success rate and force on the person over seeded episodes (deterministic)."""
-    from ..runtime.env import AssistiveEnv
+    """Mean ± std return, success rate and force on the person over seeded episodes (deterministic);
+    a co-optimised pair (:class:`~assistive_compiler.policies.pretrained.CoopPolicy`) plays both agents."""
     from ..episode import rollout
+    from ..policies.pretrained import CoopPolicy
 
-    env = AssistiveEnv(artifact)
+    if isinstance(policy, CoopPolicy):
+        from ..coop.parallel import AssistiveParallelEnv
+        from ..coop.rollout import rollout_coop
+
+        env = AssistiveParallelEnv(artifact)
+        play = lambda k: rollout_coop(env, policy.robot, policy.human, seed + k)  # noqa: E731
+    else:
+        from ..runtime.env import AssistiveEnv
+
+        env = AssistiveEnv(artifact)
+        play = lambda k: rollout(env, policy, seed + k)  # noqa: E731
     try:
-        runs = [rollout(env, policy, seed + k) for k in range(episodes)]
+        runs = [play(k) for k in range(episodes)]
     finally:
         env.close()
     returns = [r["return"] for r in runs]
@@ -91,22 +114,26 @@ def export_run(run_dir: str | Path, out: str | Path | None = None, *, episodes: 
 
     run = RunDir(run_dir)
     info = run.info()
-    if info.engine != "sb3":
-        raise UsageError(f"{display(run.path)}: exporting {info.engine} runs (co-optimised pairs) is not supported yet; "
-                         "play the run directory itself with --policy RUN_DIR")
     found = run.latest_checkpoint()
     if found is None:
         raise UsageError(f"{display(run.path)}: the run has no complete checkpoint yet")
     steps, checkpoint = found
     config = info.training_config
-    policy = mlp_from_sb3(checkpoint, config.algorithm, config.network.activation)
-
-    from .sb3 import SB3Policy
-
-    original = SB3Policy(checkpoint, config.algorithm)
     rng = np.random.default_rng(0)
-    obs = rng.normal(0.0, 1.0, (32, policy.obs_dim))
-    worst = check_same_actions(policy, original, obs)
+    if info.engine == "sb3":
+        from .sb3 import SB3Policy
+
+        policy = mlp_from_sb3(checkpoint, config.algorithm, config.network.activation)
+        worst = check_same_actions(policy, SB3Policy(checkpoint, config.algorithm), rng.normal(0.0, 1.0, (32, policy.obs_dim)))
+    else:
+        from ..policies.pretrained import CoopPolicy
+        from .rllib import SINGLE_MODULE, RLlibPolicy
+
+        original = RLlibPolicy(checkpoint, info.coop, config.algorithm)
+        parts = {name: mlp_from_rllib(module, config.algorithm, config.network.activation) for name, module in original.modules.items()}
+        worst = max(check_same_actions(part, lambda o, n=name: original._act(n, o), rng.normal(0.0, 1.0, (32, part.obs_dim)))
+                    for name, part in parts.items())
+        policy = CoopPolicy(parts["robot"], parts["human"], {}) if info.coop else parts[SINGLE_MODULE]
 
     name = f"{info.task}-{info.robot}{'-coop' if info.coop else ''}"
     out = Path(out) if out else pretrained_dir() / name
@@ -129,7 +156,12 @@ def export_run(run_dir: str | Path, out: str | Path | None = None, *, episodes: 
     }
     if out.exists():
         shutil.rmtree(out)
-    policy.save(out, record)
+    if info.coop:
+        for agent in ("robot", "human"):
+            policy.agent(agent).save(out / agent, {"agent": agent, "task": info.task, "robot": info.robot})
+        (out / "policy.json").write_text(json.dumps(record, indent=1) + "\n")
+    else:
+        policy.save(out, record)
     if run.curve_csv.is_file():
         shutil.copy(run.curve_csv, out / "curve.csv")
     return json.loads((out / "policy.json").read_text())

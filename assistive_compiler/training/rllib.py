@@ -128,13 +128,57 @@ def _task_info(infos):
     return robot if robot and "terms" in robot else None
 
 
+#: Env steps each SAC env runner samples between two rounds of updates (the updates per env step
+#: are the config's gradient_steps / train_freq, through RLlib's training_intensity).
+SAC_FRAGMENT_STEPS = 8
+#: Env steps of one RLlib SAC iteration at most (a learning-curve row and a chance to stop or
+#: checkpoint); fewer where the run or its checkpoint interval is shorter.
+SAC_ITERATION_STEPS = 1000
+
+
+def build_sac_config(run: RunDir, config: TrainingConfig, weights: dict[str, float], coop: bool):
+    """RLlib's SACConfig for this run: the same SAC as the SB3 engine's (twin Q critics, target
+    entropy, Polyak τ), with a multi-agent episode replay buffer for co-optimisation."""
+    from ray.rllib.algorithms.sac import SACConfig
+    from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
+
+    s = config.sac
+    if s.ent_coef != "auto":
+        raise UsageError(f"sac.ent_coef {s.ent_coef}: the rllib engine learns the entropy temperature; use ent_coef: auto")
+    updates_per_step = s.gradient_steps / s.train_freq
+    buffer = "MultiAgentEpisodeReplayBuffer" if coop else "EpisodeReplayBuffer"
+    cfg = (
+        SACConfig()
+        .environment(ENV_NAME, env_config={"artifact_dir": str(run.artifact.resolve()), "coop": coop, "weights": weights})
+        .framework("torch")
+        .env_runners(num_env_runners=config.envs if config.envs > 1 else 0, num_envs_per_env_runner=1,
+                     rollout_fragment_length=SAC_FRAGMENT_STEPS, num_cpus_per_env_runner=1)
+        .learners(num_learners=0)
+        .training(actor_lr=s.learning_rate, critic_lr=s.learning_rate, alpha_lr=s.learning_rate, gamma=s.gamma, tau=s.tau,
+                  train_batch_size_per_learner=s.batch_size, num_steps_sampled_before_learning_starts=s.learning_starts,
+                  target_entropy=s.target_entropy, n_step=1, twin_q=True,
+                  training_intensity=s.batch_size * updates_per_step,
+                  replay_buffer_config={"type": buffer, "capacity": s.buffer_size})
+        .rl_module(model_config=DefaultModelConfig(fcnet_hiddens=list(config.network.hidden),
+                                                   fcnet_activation=config.network.activation))
+        .reporting(min_sample_timesteps_per_iteration=min(SAC_ITERATION_STEPS, config.total_steps, config.checkpoint_every_steps))
+        .callbacks(_callbacks_class())
+        .debugging(seed=config.seed, log_level="ERROR")
+    )
+    if coop:
+        cfg = cfg.multi_agent(policies=set(AGENTS), policy_mapping_fn=lambda agent_id, *args, **kwargs: agent_id)
+    return cfg
+
+
 def build_config(run: RunDir, config: TrainingConfig, weights: dict[str, float], coop: bool):
-    """RLlib's PPOConfig for this run."""
+    """RLlib's PPOConfig (or SACConfig: :func:`build_sac_config`) for this run."""
     from ray.rllib.algorithms.ppo import PPOConfig
     from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
     from ray.tune.registry import register_env
 
     register_env(ENV_NAME, make_rllib_env)
+    if config.sac is not None:
+        return build_sac_config(run, config, weights, coop)
     p = config.ppo
     cfg = (
         PPOConfig()
@@ -219,13 +263,13 @@ class RLlibPolicy:
     Single agent: ``obs -> action``; co-optimised: ``(robot_obs, human_obs) -> (a_robot, a_human)``.
     Loads the RLModules from the checkpoint alone: no Ray instance is needed."""
 
-    def __init__(self, checkpoint: Path, coop: bool):
+    def __init__(self, checkpoint: Path, coop: bool, algorithm: str = "ppo"):
         from ray.rllib.core.rl_module.rl_module import RLModule
 
         root = checkpoint / "algo" / "learner_group" / "learner" / "rl_module"
         names = AGENTS if coop else (SINGLE_MODULE,)
         self.modules = {name: RLModule.from_checkpoint(str((root / name).resolve())) for name in names}
-        self.coop = coop
+        self.coop, self.algorithm = coop, algorithm
 
     def _act(self, name: str, obs: np.ndarray) -> np.ndarray:
         import torch
@@ -233,7 +277,11 @@ class RLlibPolicy:
         with torch.no_grad():
             out = self.modules[name].forward_inference({"obs": torch.as_tensor(obs, dtype=torch.float32)[None]})
         dist = out["action_dist_inputs"][0].numpy()
-        return dist[: dist.shape[0] // 2]  # a diagonal Gaussian's inputs: means, then log-stds
+        mean = dist[: dist.shape[0] // 2]  # a diagonal Gaussian's inputs: means, then log-stds
+        if self.algorithm != "sac":
+            return mean
+        space = self.modules[name].action_space  # SAC's Gaussian is squashed by tanh into the action bounds
+        return (space.low + 0.5 * (np.tanh(mean) + 1.0) * (space.high - space.low)).astype(np.float32)
 
     def agent(self, name: str):
         """One co-optimised agent's policy, ``obs -> action``."""

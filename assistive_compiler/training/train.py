@@ -66,9 +66,6 @@ def train(spec: str, *, robot: str | None, config_path: str, coop: bool = False,
     """Train a policy for ``spec`` and ``robot`` as ``config_path`` says; returns the run's summary."""
     engine = choose_engine(engine, coop, address)
     config: TrainingConfig = load_training_config(config_path).with_overrides(steps=steps, seed=seed, envs=envs)
-    if engine == "rllib" and config.algorithm != "ppo":
-        raise UsageError(f"{display(Path(config_path))}: algorithm '{config.algorithm}' trains on the sb3 engine (one machine, "
-                         "single agent); the rllib engine (--coop, --address) runs algorithm 'ppo'")
     result, robot = compile_for_run(spec, robot, coop)
     if engine == "rllib":
         from .rllib import init_ray
