@@ -47,6 +47,11 @@ class SpecError(Exception):
     def at(cls, path: str | Path, message: str, line: int = 1, column: int = 1) -> "SpecError":
         return cls([Problem(Location(str(path), line, column), message)])
 
+    def __reduce__(self):
+        # Rebuilt from its problems (not from the joined message Exception would pickle), so a
+        # SpecError raised in a worker process (a Ray env runner) arrives with its locations intact.
+        return (type(self), (self.problems,))
+
 
 class UsageError(Exception):
     """Bad command-line input that is not in a file (an unknown engine, an unreachable cluster);

@@ -210,3 +210,22 @@ def _keys(data):
     elif isinstance(data, list):
         for v in data:
             yield from _keys(v)
+
+
+def test_errors_cross_process_boundaries_with_their_locations():
+    """A SpecError (or a lint error) raised in a worker process — a Ray env runner, an SB3 env
+    process — pickles and unpickles with every located problem, not Ray's 'failed to deserialize'."""
+    import pickle
+
+    from assistive_compiler.compile.lint.problems import LintError, LintProblem
+    from assistive_compiler.errors import Location, Problem, SpecError, UsageError
+
+    error = SpecError([Problem(Location("b.yaml", 7, 3), "second"), Problem(Location("a.yaml", 2, 5), "first")])
+    again = pickle.loads(pickle.dumps(error))
+    assert type(again) is SpecError and again.problems == error.problems
+    assert str(again) == "a.yaml:2:5: first\nb.yaml:7:3: second"
+    assert str(pickle.loads(pickle.dumps(SpecError.at("run/artifact", "not a compiled artifact (no manifest.json)")))) == \
+        "run/artifact:1:1: not a compiled artifact (no manifest.json)"
+    assert str(pickle.loads(pickle.dumps(UsageError("--address: no Ray cluster")))) == "--address: no Ray cluster"
+    lint = LintError([LintProblem("robot.urdf", "link 'base'", "mass must be positive")])
+    assert pickle.loads(pickle.dumps(lint)).problems == lint.problems

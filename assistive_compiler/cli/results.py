@@ -31,7 +31,7 @@ def cmd_export(args: argparse.Namespace) -> int:
 
 
 def cmd_results(args: argparse.Namespace) -> int:
-    if not require_extra("matplotlib"):
+    if not args.no_pictures and not require_extra("matplotlib"):
         return EXIT_FAILED
     from ..paths import display
     from ..training.results import shipped_records, update_doc, write_pictures

@@ -106,6 +106,22 @@ def evaluate_policy(artifact: Path, policy, episodes: int, seed: int) -> dict:
             "returns": [round(float(x), 3) for x in returns]}
 
 
+def _wall_at(run: RunDir, steps: int) -> float | None:
+    """Wall seconds of training up to ``steps`` env steps (over every sitting of a resumed run),
+    from the learning curve's last row at or before them."""
+    from .curves import read_curve
+
+    rows = [r for r in read_curve(run.curve_csv) if r["steps"] <= steps]
+    return rows[-1]["wall_s"] if rows else None
+
+
+def _default_label(info) -> str:
+    """``SAC (sac_laptop)``: the algorithm and the config the run was started with."""
+    command = list(info.command)
+    config = command[command.index("--config") + 1] if "--config" in command[:-1] else "config"
+    return f"{info.training_config.algorithm.upper()} ({Path(config).stem})"
+
+
 def export_run(run_dir: str | Path, out: str | Path | None = None, *, episodes: int = 100, seed: int = EVAL_SEED,
                label: str = "", progress=None) -> dict:
     """Export the run's newest checkpoint to ``out`` and evaluate the exported policy there;
@@ -137,17 +153,9 @@ def export_run(run_dir: str | Path, out: str | Path | None = None, *, episodes: 
 
     name = f"{info.task}-{info.robot}{'-coop' if info.coop else ''}"
     out = Path(out) if out else pretrained_dir() / name
-    summary = json.loads(run.summary_json.read_text()) if run.summary_json.is_file() else {}
-    evaluation = evaluate_policy(run.artifact, policy, episodes, seed)
-    if progress:
-        progress(f"evaluated {episodes} episodes: success {evaluation['success_rate']:.2f}")
-    regression = {k: evaluation[k] for k in ("seed", "success_rate", "mean_return")}
-    regression["episodes"] = min(REGRESSION_EPISODES, episodes)
-    regression["success_rate"] = float(np.mean(evaluation["successes"][:regression["episodes"]]))
-    regression["mean_return"] = float(np.mean(evaluation["returns"][:regression["episodes"]]))
-    wall = summary.get("wall_s")
+    wall = _wall_at(run, steps)
     record = {
-        "name": out.name, "label": label or f"{config.algorithm.upper()} ({config.description or 'config'})",
+        "name": out.name, "label": label or _default_label(info),
         "task": info.task, "robot": info.robot, "coop": info.coop, "gym_id": info.gym_id, "spec": info.spec,
         "content_hash": info.content_hash, "engine": info.engine, "algorithm": config.algorithm, "demonstrations": False,
         "config": config.model_dump(exclude_none=True), "trained_steps": steps, "wall_s": wall,

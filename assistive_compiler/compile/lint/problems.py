@@ -29,3 +29,6 @@ class LintError(Exception):
     def __init__(self, problems: list[LintProblem]) -> None:
         self.problems: list[LintProblem] = list(problems)
         super().__init__("\n".join(str(problem) for problem in self.problems))
+
+    def __reduce__(self):  # pickled with its problems, as SpecError: errors cross process boundaries intact
+        return (type(self), (self.problems,))
