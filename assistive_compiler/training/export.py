@@ -153,6 +153,12 @@ def export_run(run_dir: str | Path, out: str | Path | None = None, *, episodes: 
 
     name = f"{info.task}-{info.robot}{'-coop' if info.coop else ''}"
     out = Path(out) if out else pretrained_dir() / name
+    evaluation = evaluate_policy(run.artifact, policy, episodes, seed)
+    if progress:
+        progress(f"evaluated {episodes} episodes: success {evaluation['success_rate']:.2f}")
+    first = min(REGRESSION_EPISODES, episodes)
+    regression = {"seed": seed, "episodes": first, "success_rate": float(np.mean(evaluation["successes"][:first])),
+                  "mean_return": float(np.mean(evaluation["returns"][:first]))}
     wall = _wall_at(run, steps)
     record = {
         "name": out.name, "label": label or _default_label(info),

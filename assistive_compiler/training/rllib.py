@@ -35,16 +35,28 @@ GCS_WAIT_VAR = "RAY_gcs_server_port_wait_time_s"
 
 
 def make_rllib_env(env_config: dict):
-    """RLlib's env creator: the run's compiled task, as two agents (co-op) or one."""
+    """RLlib's env creator: the run's compiled task, as two agents (co-op) or one. The task
+    travels in the env config (:mod:`assistive_compiler.bundle`): each worker unpacks it into its
+    own cache, so no machine needs the driver's files."""
+    from ..bundle import unpack
+
+    artifact_dir = unpack(env_config["artifact_bundle"])
     if env_config["coop"]:
         from ray.rllib.env.wrappers.pettingzoo_env import ParallelPettingZooEnv
 
         from ..coop.parallel import AssistiveParallelEnv
 
-        return ParallelPettingZooEnv(AssistiveParallelEnv(env_config["artifact_dir"]))
+        return ParallelPettingZooEnv(AssistiveParallelEnv(artifact_dir))
     from ..runtime.env import AssistiveEnv
 
-    return AssistiveEnv(env_config["artifact_dir"])
+    return AssistiveEnv(artifact_dir)
+
+
+def env_config(run: RunDir, coop: bool, weights: dict[str, float]) -> dict:
+    """What every env runner gets: the compiled task itself (not a path), co-op or not, the reward weights."""
+    from ..bundle import pack
+
+    return {"artifact_bundle": pack(run.artifact), "coop": coop, "weights": weights}
 
 
 def check_address(address: str) -> None:
@@ -149,7 +161,7 @@ def build_sac_config(run: RunDir, config: TrainingConfig, weights: dict[str, flo
     buffer = "MultiAgentEpisodeReplayBuffer" if coop else "EpisodeReplayBuffer"
     cfg = (
         SACConfig()
-        .environment(ENV_NAME, env_config={"artifact_dir": str(run.artifact.resolve()), "coop": coop, "weights": weights})
+        .environment(ENV_NAME, env_config=env_config(run, coop, weights))
         .framework("torch")
         .env_runners(num_env_runners=config.envs if config.envs > 1 else 0, num_envs_per_env_runner=1,
                      rollout_fragment_length=SAC_FRAGMENT_STEPS, num_cpus_per_env_runner=1)
@@ -182,7 +194,7 @@ def build_config(run: RunDir, config: TrainingConfig, weights: dict[str, float],
     p = config.ppo
     cfg = (
         PPOConfig()
-        .environment(ENV_NAME, env_config={"artifact_dir": str(run.artifact.resolve()), "coop": coop, "weights": weights})
+        .environment(ENV_NAME, env_config=env_config(run, coop, weights))
         .framework("torch")
         .env_runners(num_env_runners=config.envs if config.envs > 1 else 0, num_envs_per_env_runner=1,
                      rollout_fragment_length=p.rollout_steps, num_cpus_per_env_runner=1)
