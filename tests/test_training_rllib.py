@@ -115,3 +115,53 @@ def test_multi_agent_sac_trains_and_exports_a_pair_that_plays_under_coop(local_r
     report = json.loads(capsys.readouterr().out)
     assert report["human_policy"] == str(tmp_path / "pair")  # the pair plays the person too
     assert report["episodes"][0]["return"] == pytest.approx(record["evaluation"]["returns"][0], abs=1e-3)
+
+
+def _free_port() -> int:
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.mark.slow
+def test_a_refused_authentication_token_says_so_and_names_rays_remedy(tmp_path):
+    """A Ray cluster that answers but rejects this machine's token (a stale ~/.ray/auth_token from an
+    earlier local ray.init()) is not 'no cluster': the message says the token was refused and how to
+    fix it. The test starts its own head node (its own HOME and token) and stops it by its id."""
+    import os
+    import signal
+    import socket
+    import subprocess
+    import sys
+
+    port = _free_port()
+    homes = {}
+    for who, token in (("head", "a" * 64), ("driver", "b" * 64)):
+        homes[who] = tmp_path / who
+        (homes[who] / ".ray").mkdir(parents=True)
+        (homes[who] / ".ray" / "auth_token").write_text(token)
+    base = {k: v for k, v in os.environ.items() if not k.startswith("RAY_")}
+    head = subprocess.Popen([sys.executable, "-m", "ray.scripts.scripts", "start", "--head", f"--port={port}", "--num-cpus=0",
+                             "--include-dashboard=false", "--block"], env={**base, "HOME": str(homes["head"]), "RAY_AUTH_MODE": "token"},
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        deadline = time.time() + 60
+        while time.time() < deadline:
+            try:
+                socket.create_connection(("127.0.0.1", port), timeout=1).close()
+                break
+            except OSError:
+                time.sleep(0.5)
+        proc = subprocess.run([sys.executable, "-m", "assistive_compiler.cli", "train", str(REACH), "--config", "ppo_quick",
+                               "--address", f"127.0.0.1:{port}", "--out", str(tmp_path / "run"), "--quiet"],
+                              env={**base, "HOME": str(homes["driver"])}, capture_output=True, text=True, timeout=120)
+    finally:
+        os.killpg(head.pid, signal.SIGTERM)
+        head.wait(timeout=60)
+    assert proc.returncode == 2
+    assert (f"error: --address: the Ray cluster at 127.0.0.1:{port} refused this machine's authentication token "
+            "(~/.ray/auth_token, $RAY_AUTH_TOKEN or $RAY_AUTH_TOKEN_PATH). Ray's remedy: every machine uses the cluster's token") \
+        in proc.stderr
+    assert not (tmp_path / "run" / "run.json").exists()  # nothing written for a run that never started

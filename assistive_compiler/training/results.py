@@ -18,7 +18,7 @@ from pathlib import Path
 from .paper import PAPER, ROBOT_TITLES, TASK_TITLES, TASKS
 
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
-PICTURES = "results"  # beside the doc: docs/results/<name>-curve.png, docs/results/<name>.png
+PICTURES = "results/cells"  # beside the doc: docs/results/cells/<name>-curve.png and <name>.png
 
 
 def shipped_records() -> list[dict]:
@@ -121,7 +121,7 @@ def write_pictures(records: list[dict], doc_dir: Path, progress=None) -> list[Pa
         curve = read_curve(pretrained_dir() / r["name"] / "curve.csv")
         if curve:
             png = out_dir / f"{r['name']}-curve.png"
-            plot_curves({r["label"]: curve}, png, title=f"{r['gym_id']}: {r['label']} (training episodes, stochastic actions)")
+            plot_curves({r["label"]: curve}, png, title=f"{r['gym_id'].split('/')[-1]}: {r['label']}, training episodes")
             written.append(png)
         if r["coop"]:
             continue

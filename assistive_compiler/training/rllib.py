@@ -75,6 +75,26 @@ def check_address(address: str) -> None:
                                              "start one with `ray start --head` there, or leave out --address to train locally") from None
 
 
+def authentication_refused(address: str) -> str | None:
+    """Why the cluster at ``address`` refused us, when it answers but rejects this machine's Ray
+    authentication token (Ray ≥ 2.5x enables token authentication; a stale ``~/.ray/auth_token``
+    from an earlier local ``ray.init()`` is the usual cause); None when it does not say so."""
+    from ray.exceptions import AuthenticationError
+
+    try:
+        from ray._raylet import GcsClient
+
+        GcsClient(address=address.split("://", 1)[-1]).internal_kv_get(b"assistive-compiler-probe", None, timeout=CONNECT_TIMEOUT_S)
+    except AuthenticationError:
+        return (f"--address: the Ray cluster at {address} refused this machine's authentication token "
+                "(~/.ray/auth_token, $RAY_AUTH_TOKEN or $RAY_AUTH_TOKEN_PATH). Ray's remedy: every machine uses the "
+                "cluster's token — print it on the head with `ray get-auth-token` and put it in ~/.ray/auth_token here "
+                "(or export RAY_AUTH_TOKEN); see https://docs.ray.io/en/latest/ray-security/token-auth.html")
+    except Exception:  # noqa: BLE001 — any other failure: not an authentication refusal
+        return None
+    return None
+
+
 def init_ray(address: str | None, envs: int) -> None:
     """Attach to ``address``, or start a local Ray instance (unless one is already running)."""
     import ray
@@ -91,6 +111,9 @@ def init_ray(address: str | None, envs: int) -> None:
         try:
             ray.init(address=address, log_to_driver=False)
         except (ConnectionError, RuntimeError) as exc:
+            refused = authentication_refused(address)
+            if refused:
+                raise UsageError(refused) from None
             raise UsageError(f"--address: no Ray cluster at {address} ({str(exc).splitlines()[0]}); "
                              "start one with `ray start --head` there, or leave out --address to train locally") from None
         finally:

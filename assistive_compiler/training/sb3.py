@@ -172,18 +172,17 @@ def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, res
     torch.set_num_threads(1)  # small MLPs: more threads only contend with the env processes
     latest = run.latest_checkpoint() if resume else None
     start_steps = latest[0] if latest else 0
+    if latest and config.sac is not None and not (latest[1] / REPLAY_BUFFER).is_file():
+        from ..errors import UsageError
+
+        raise UsageError(f"{latest[1] / REPLAY_BUFFER}: --resume of a SAC run needs the newest checkpoint's replay buffer, which is missing")
     venv = make_vec_env(run.artifact, config.envs, config.seed + start_steps)
     venv = _normalized(venv, config, latest[1] if latest else None)
     if latest:
         model = algorithm_class(config).load(str(latest[1] / "model.zip"), env=venv, device="cpu")
         model.set_random_seed(config.seed + start_steps)
         if config.sac is not None:
-            buffer = latest[1] / REPLAY_BUFFER
-            if not buffer.is_file():
-                from ..errors import UsageError
-
-                raise UsageError(f"{buffer}: --resume of a SAC run needs the newest checkpoint's replay buffer, which is missing")
-            model.load_replay_buffer(str(buffer))
+            model.load_replay_buffer(str(latest[1] / REPLAY_BUFFER))
     else:
         model = _new_model(venv, config, run)
     progress = Progress(run, weights, config.total_steps, start_steps, quiet=quiet)
