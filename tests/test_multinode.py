@@ -16,6 +16,7 @@ import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -44,6 +45,14 @@ def _namespaces_work(tmp_path: Path) -> str | None:
     result = subprocess.run(["unshare", "--mount", "--propagation", "private", "sh", "-c", f"mount -t tmpfs tmpfs {probe}"],
                             capture_output=True, text=True)
     return None if result.returncode == 0 else f"mount namespaces unavailable here ({result.stderr.strip() or result.returncode})"
+
+
+def forget_cluster(port: int) -> None:
+    """Remove Ray's record of the latest cluster (``/tmp/ray/ray_current_cluster``) where it names
+    ours: a later plain ``ray.init()`` would otherwise try to join the stopped cluster."""
+    record = Path("/tmp/ray/ray_current_cluster")
+    if record.is_file() and f":{port}" in record.read_text():
+        record.unlink()
 
 
 def _free_port() -> int:
@@ -79,9 +88,10 @@ def cluster(tmp_path_factory):
     env.update(HOME=str(home), RAY_AUTH_MODE="token")
     port = _free_port()
     ray_cli = [sys.executable, "-m", "ray.scripts.scripts", "start", "--block", "--object-store-memory=150000000"]
+    temp = tempfile.mkdtemp(prefix="rayt-", dir="/tmp")  # short (Unix socket paths); keeps the address file out of /tmp/ray
     log = root / "ray.log"
     with log.open("w") as out:
-        head = subprocess.Popen(ray_cli + ["--head", f"--port={port}", "--num-cpus=0", "--include-dashboard=false"], env=env,
+        head = subprocess.Popen(ray_cli + ["--head", f"--port={port}", "--num-cpus=0", "--include-dashboard=false", f"--temp-dir={temp}"], env=env,
                                 stdout=out, stderr=out,
                                 start_new_session=True)
         procs = [head]
@@ -100,6 +110,8 @@ def cluster(tmp_path_factory):
                 os.killpg(proc.pid, signal.SIGTERM)
             for proc in procs:
                 proc.wait(timeout=60)
+            forget_cluster(port)
+            shutil.rmtree(temp, ignore_errors=True)
 
 
 def _wait_for_worker_node(port: int, env: dict, log: Path, seconds: float = 90) -> None:

@@ -56,7 +56,15 @@ def test_multi_agent_ppo_iteration_checkpoint_resume_evaluate(local_ray, tmp_pat
     modules = checkpoint / "algo" / "learner_group" / "learner" / "rl_module"
     assert steps == 200 and (modules / "robot").is_dir() and (modules / "human").is_dir()
 
+    # A driver killed while writing its next checkpoint leaves a partial directory and a torn curve row.
+    partial = run.checkpoints / ".partial-step_0000000400"
+    (partial / "algo").mkdir(parents=True)
+    (partial / "algo" / "rllib_checkpoint.json").write_text('{"trunc')
+    with (out / "curve.csv").open("a") as f:
+        f.write("400,12.5,")
+    assert run.latest_checkpoint()[0] == 200
     resumed = train(str(FEEDING), robot="jaco", config_path=str(config), coop=True, out=str(out), resume=True, steps=400, quiet=True)
+    assert not partial.exists()
     assert resumed["steps"] == 400 and run.latest_checkpoint()[0] == 400
     rows = (out / "curve.csv").read_text().splitlines()
     assert [int(r.split(",")[0]) for r in rows[1:]] == [200, 400]
@@ -160,6 +168,9 @@ def test_a_refused_authentication_token_says_so_and_names_rays_remedy(tmp_path):
     finally:
         os.killpg(head.pid, signal.SIGTERM)
         head.wait(timeout=60)
+        from test_multinode import forget_cluster
+
+        forget_cluster(port)
     assert proc.returncode == 2
     assert (f"error: --address: the Ray cluster at 127.0.0.1:{port} refused this machine's authentication token "
             "(~/.ray/auth_token, $RAY_AUTH_TOKEN or $RAY_AUTH_TOKEN_PATH). Ray's remedy: every machine uses the cluster's token") \

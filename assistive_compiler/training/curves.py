@@ -7,11 +7,18 @@ from pathlib import Path
 
 
 def read_curve(path: Path) -> list[dict[str, float]]:
-    """The rows of a ``curve.csv`` as numbers (an empty list when there is none yet)."""
+    """The rows of a ``curve.csv`` as numbers (an empty list when there is none yet); a row cut
+    short by a killed process (the last one) is left out."""
     if not Path(path).is_file():
         return []
+    rows = []
     with Path(path).open() as f:
-        return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+        for row in csv.DictReader(f):
+            try:
+                rows.append({k: float(v) for k, v in row.items()})
+            except (TypeError, ValueError):  # a torn row: None or '' fields
+                continue
+    return rows
 
 
 def plot_curves(curves: dict[str, list[dict[str, float]]], out: Path, title: str = "", baselines: dict[str, float] | None = None) -> None:

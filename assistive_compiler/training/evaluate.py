@@ -172,8 +172,10 @@ def save_evaluation(run: RunDir, result: dict) -> Path:
     """Write ``evaluation.json`` in the run directory (``table`` reads it)."""
     import json
 
+    from .run_dir import write_atomic
+
     out = run.path / "evaluation.json"
-    out.write_text(json.dumps(result, indent=1))
+    write_atomic(out, json.dumps(result, indent=1))
     return out
 
 

@@ -25,6 +25,11 @@ def print_reward_table(weights: dict[str, float], title: str, out=sys.stderr) ->
         print(f"  {name:<{width}}  {weight:+g}", file=out)
 
 
+def _cell(value: float) -> str:
+    """A curve value as written: integers without a decimal point."""
+    return str(int(value)) if float(value).is_integer() else repr(float(value))
+
+
 class TrainingBar:
     """Training progress on stderr, with rich (as every other command's progress): a live bar on a
     terminal; elsewhere (a log file of a background run) one plain line per update."""
@@ -74,12 +79,18 @@ class Progress:
             self._rows.writerow(CURVE_FIELDS)
 
     def _previous_totals(self) -> tuple[float, int]:
-        """Wall seconds and episodes of the run before this session (resumed runs)."""
+        """Wall seconds and episodes of the run before this session (resumed runs). The curve is
+        first cut back to the resumed checkpoint: rows written after it (and a row torn by a killed
+        process) belong to training that the resumed run does again."""
+        from .curves import read_curve
+        from .run_dir import write_atomic
+
         if not self.run.curve_csv.is_file():
             return 0.0, 0
-        with self.run.curve_csv.open() as f:
-            rows = list(csv.DictReader(f))
-        return (float(rows[-1]["wall_s"]), int(rows[-1]["episodes"])) if rows else (0.0, 0)
+        rows = [r for r in read_curve(self.run.curve_csv) if r["steps"] <= self.start_steps]
+        lines = [",".join(CURVE_FIELDS)] + [",".join(_cell(r[k]) for k in CURVE_FIELDS) for r in rows]
+        write_atomic(self.run.curve_csv, "\n".join(lines) + "\n")
+        return (rows[-1]["wall_s"], int(rows[-1]["episodes"])) if rows else (0.0, 0)
 
     def episode(self, ret: float, success: bool, term_sums: dict[str, float]) -> None:
         """One finished episode: its return, success and unweighted term sums."""

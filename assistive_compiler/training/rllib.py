@@ -246,8 +246,7 @@ def _record(progress: Progress, result: dict, weights: dict[str, float]) -> None
 def save_checkpoint(run: RunDir, algo, steps: int) -> Path:
     out = run.begin_checkpoint(steps)
     algo.save_to_path(str((out / "algo").resolve()))
-    run.end_checkpoint(out, steps, {"engine": "rllib"})
-    return out
+    return run.end_checkpoint(out, steps, {"engine": "rllib"})
 
 
 def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, coop: bool, resume: bool,

@@ -16,6 +16,7 @@ Layout (``runs/<task>-<robot>[-coop]-s<seed>/`` by default)::
 from __future__ import annotations
 
 import json
+import os
 import platform
 import shutil
 import sys
@@ -31,6 +32,19 @@ from ..paths import display
 from .config import TrainingConfig
 
 RUN_FILE = "run.json"
+PARTIAL = ".partial-"
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Write ``path`` so that a reader (or a process killed mid-write) sees the old file or the new
+    one, never a torn one: a temporary file beside it, flushed to disk, then renamed over it."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp")
+    with tmp.open("w") as f:
+        f.write(text)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
 PACKAGES = ("assistive-compiler", "pybullet", "gymnasium", "numpy", "torch", "stable-baselines3", "ray", "pettingzoo")
 
 
@@ -96,8 +110,8 @@ class RunDir:
         if self.artifact.exists():
             shutil.rmtree(self.artifact)
         shutil.copytree(artifact_src, self.artifact)
-        (self.path / "config.yaml").write_text(yaml.safe_dump(info.config, sort_keys=False))
-        (self.path / RUN_FILE).write_text(json.dumps(asdict(info), indent=1))
+        write_atomic(self.path / "config.yaml", yaml.safe_dump(info.config, sort_keys=False))
+        write_atomic(self.path / RUN_FILE, json.dumps(asdict(info), indent=1))
 
     # -- checkpoints ---------------------------------------------------------------------------
     def checkpoint_dir(self, steps: int) -> Path:
@@ -111,20 +125,30 @@ class RunDir:
         return int(done[-1].name.split("_")[1]), done[-1]
 
     def begin_checkpoint(self, steps: int) -> Path:
-        """A fresh, empty directory for the checkpoint at ``steps`` (replacing an incomplete one)."""
-        out = self.checkpoint_dir(steps)
-        if out.exists():
-            shutil.rmtree(out)
-        out.mkdir(parents=True)
+        """A fresh, empty directory to write the checkpoint at ``steps`` into: a hidden partial one
+        (``checkpoints/.partial-step_N``), renamed into place by :meth:`end_checkpoint`. A process
+        killed while writing leaves only partial directories, which are never resumed from and are
+        cleared by the next checkpoint."""
+        self.checkpoints.mkdir(parents=True, exist_ok=True)
+        for stale in self.checkpoints.glob(f"{PARTIAL}*"):
+            shutil.rmtree(stale, ignore_errors=True)
+        out = self.checkpoints / f"{PARTIAL}{self.checkpoint_dir(steps).name}"
+        out.mkdir()
         return out
 
-    def end_checkpoint(self, out: Path, steps: int, extra: dict | None = None) -> None:
-        """Mark a checkpoint complete: only complete checkpoints are resumed from."""
-        (out / "COMPLETE").write_text(json.dumps({"steps": steps, "time": time.time(), **(extra or {})}))
+    def end_checkpoint(self, out: Path, steps: int, extra: dict | None = None) -> Path:
+        """Mark the written checkpoint complete and move it into place (replacing one of the same
+        steps); returns its directory. Only complete checkpoints are resumed from."""
+        write_atomic(out / "COMPLETE", json.dumps({"steps": steps, "time": time.time(), **(extra or {})}))
+        final = self.checkpoint_dir(steps)
+        if final.exists():
+            shutil.rmtree(final)
+        os.replace(out, final)
+        return final
 
     # -- results -------------------------------------------------------------------------------
     def write_summary(self, summary: dict) -> None:
-        self.summary_json.write_text(json.dumps(summary, indent=1))
+        write_atomic(self.summary_json, json.dumps(summary, indent=1))
 
 
 def new_run_info(spec: str, manifest, robot: str, coop: bool, engine: str, config: TrainingConfig) -> RunInfo:

@@ -112,10 +112,10 @@ def save_checkpoint(run: RunDir, model, steps: int) -> Path:
     off_policy = isinstance(model, OffPolicyAlgorithm)
     if off_policy:
         model.save_replay_buffer(str(out / REPLAY_BUFFER))
-    run.end_checkpoint(out, steps, {"engine": "sb3", "algorithm": type(model).__name__.lower()})
-    if off_policy and older is not None and older[1] != out:
+    final = run.end_checkpoint(out, steps, {"engine": "sb3", "algorithm": type(model).__name__.lower()})
+    if off_policy and older is not None and older[1] != final:
         (older[1] / REPLAY_BUFFER).unlink(missing_ok=True)
-    return out
+    return final
 
 
 def _callback(run: RunDir, progress: Progress, config: TrainingConfig, n_envs: int, stop=None):
