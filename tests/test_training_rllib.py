@@ -123,6 +123,9 @@ def test_multi_agent_sac_trains_and_exports_a_pair_that_plays_under_coop(local_r
     report = json.loads(capsys.readouterr().out)
     assert report["human_policy"] == str(tmp_path / "pair")  # the pair plays the person too
     assert report["episodes"][0]["return"] == pytest.approx(record["evaluation"]["returns"][0], abs=1e-3)
+    strip = tmp_path / "pair.png"
+    assert main(["render", str(FEEDING), "--robot", "jaco", "--policy", str(tmp_path / "pair"), "--seed", "7", "--out", str(strip)]) == 0
+    assert f"return {record['evaluation']['returns'][0]:.1f}" in capsys.readouterr().out  # both agents acted, as in run --coop
 
 
 def _free_port() -> int:

@@ -120,14 +120,14 @@ def parse_camera(text: str | None) -> dict | None:
 
 
 def cmd_render(args: argparse.Namespace) -> int:
-    from ..policies import make_policy
+    from ..policies import make_player
 
     out = Path(args.out)
     check_picture_path(out)
     view = parse_camera(args.camera)
     env = make_env(args.spec, args.robot, args.out_dir, render_mode="rgb_array", render_size=(args.width, args.height), camera=view)
-    policy = make_policy(args.policy, env, seed=args.seed)
-    frames, summary = record(env, policy, args.seed, args.every)
+    target, act = make_player(args.policy, env, seed=args.seed)  # a co-optimised pair: the person acts too
+    frames, summary = record(target, act, args.seed, args.every)
     fps = args.fps or control_hz(env.manifest) / args.every
     env.close()
     write_picture(frames, out, fps=fps)

@@ -35,3 +35,19 @@ def make_policy(name: str, env, seed: int = 0) -> Callable[[np.ndarray], np.ndar
     policy, info = load_trained(name)
     check_fits(info, env.manifest, name)
     return policy
+
+
+def make_player(name: str, env, seed: int = 0):
+    """``(target, act)`` to play ``name`` in ``env`` with single-agent tools (render, record):
+    ``act(obs)`` gives the action to step ``target`` with. A co-optimised pair plays both agents
+    (``target`` steps the robot and the person); any other policy is :func:`make_policy`'s."""
+    if name not in POLICIES:
+        from .pretrained import check_fits, load_trained
+
+        policy, info = load_trained(name)
+        if info.get("coop"):
+            from ..coop.rollout import both_agents
+
+            check_fits(info, env.manifest, name, coop=True)
+            return both_agents(env, policy)
+    return env, make_policy(name, env, seed=seed)

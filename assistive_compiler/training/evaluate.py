@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..coop.rollout import both_agents
 from ..episode import rollout
 from ..errors import UsageError
 from ..paths import display
@@ -84,7 +85,7 @@ def evaluate_exported(source: str, episodes: int = 100, seed: int = 0, render: s
         from ..runtime.env import AssistiveEnv
 
         env = AssistiveEnv(compiled.out_dir, render_mode="rgb_array")
-        target, act = (env, policy) if not info.get("coop") else _both(env, policy)
+        target, act = (env, policy) if not info.get("coop") else both_agents(env, policy)
         frames, summary = record(target, act, seed, 2)
         env.close()
         write_picture(frames, Path(render), fps=5)
@@ -130,30 +131,6 @@ def evaluate(run_dir: str | Path, episodes: int | None = None, seed: int = 0, re
     return out
 
 
-class BothAgents:
-    """A co-optimisation env seen as a robot-only one, so single-agent tools (``record``) can run
-    it: the robot's action comes from :meth:`robot_action`, which also picks the human's."""
-
-    def __init__(self, env, policy):
-        self.env, self.policy, self.human_action = env, policy, None
-
-    def __getattr__(self, name):
-        return getattr(self.env, name)
-
-    def robot_action(self, obs):
-        a_robot, self.human_action = self.policy(obs, self.env.observe_human())
-        return a_robot
-
-    def step(self, a_robot):
-        obs, _, reward, terminated, truncated, info = self.env.step_agents(a_robot, self.human_action)
-        return obs, reward, terminated, truncated, info
-
-
-def _both(env, policy):
-    both = BothAgents(env, policy)
-    return both, both.robot_action
-
-
 def render_rollout(run: RunDir, info: RunInfo, checkpoint: Path, seed: int, out: Path, every: int = 2) -> str:
     """Write one rollout of the trained policy as a GIF (or a PNG strip); returns a line saying so."""
     from ..cli.render import record, write_picture
@@ -161,7 +138,7 @@ def render_rollout(run: RunDir, info: RunInfo, checkpoint: Path, seed: int, out:
 
     env = AssistiveEnv(run.artifact, render_mode="rgb_array")
     policy = load_policy(info, checkpoint)
-    target, act = (env, policy) if not info.coop else _both(env, policy)
+    target, act = (env, policy) if not info.coop else both_agents(env, policy)
     frames, summary = record(target, act, seed, every)
     env.close()
     write_picture(frames, out, fps=max(1, 10 // every))

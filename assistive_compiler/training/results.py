@@ -78,11 +78,10 @@ def results_block(records: list[dict]) -> str:
         if missing:
             parts.append(f"Not trained yet: {', '.join(missing)}.\n")
     claim = []
+    by_name = {r["name"]: r for r in records}
     for task in TASKS:
-        static = [r for r in records if r["task"] == task and not r["coop"] and not r["name"].endswith(("-ppo",))]
-        active = [r for r in records if r["task"] == task and r["coop"]]
-        for a in active:
-            for s in (x for x in static if x["robot"] == a["robot"]):
+        for a in (r for r in records if r["task"] == task and r["name"] == f"{task}-{r['robot']}-coop"):
+            for s in [by_name[f"{task}-{a['robot']}"]] if f"{task}-{a['robot']}" in by_name else []:
                 claim.append(f"| {TASK_TITLES[task]} | {ROBOT_TITLES.get(a['robot'], a['robot'])} | "
                              f"{100 * s['evaluation']['success_rate']:.0f}% | {100 * a['evaluation']['success_rate']:.0f}% |")
     parts.append("### The paper's claim (§V-B): an active person raises success\n")
