@@ -87,12 +87,13 @@ def load_trained(source: str):
         policy = load_folder(path)
         return policy, policy.info
     if (path / "run.json").is_file():
-        from ..cli.common import require_extra
+        import importlib.util
 
         info = json.loads((path / "run.json").read_text())
-        engine_module = "stable_baselines3" if info["engine"] == "sb3" else "ray"
-        if not require_extra("torch", engine_module):
-            raise UsageError(f"--policy {source}: playing a run directory needs its training library (the 'train' extra)")
+        missing = [m for m in ("torch", "stable_baselines3" if info["engine"] == "sb3" else "ray") if importlib.util.find_spec(m) is None]
+        if missing:
+            raise UsageError(f"--policy {source}: playing a run directory needs its training library ({', '.join(missing)} not "
+                             "installed): install the 'train' extra (README: Training), or play its export (assistive-compiler export)")
         from ..training.evaluate import latest_checkpoint, load_policy
         from ..training.run_dir import RunDir
 
