@@ -53,44 +53,64 @@ def trained_task_spec(info: dict) -> Path:
     return specs_dir() / "tasks" / f"{info['task']}.yaml"
 
 
+def compile_for_policy(info: dict):
+    """The task an exported policy was trained on, compiled on the current code (a cache hit when unchanged)."""
+    from ..compile.compiler import compile_task
+    from ..registration import cached_artifact_dir
+
+    spec = trained_task_spec(info)
+    return compile_task(spec, info["robot"], cached_artifact_dir(spec, info["robot"]))
+
+
+def play_episodes(artifact_dir: str | Path, policy, coop: bool, episodes: int, seed: int) -> list[dict]:
+    """``episodes`` seeded episodes (``seed``, ``seed + 1``, ...) of ``policy`` on the artifact; a
+    co-optimised pair (anything with ``agent("robot")`` and ``agent("human")``) plays both agents."""
+    if coop:
+        from ..coop.parallel import AssistiveParallelEnv
+        from ..coop.rollout import rollout_coop
+
+        env = AssistiveParallelEnv(artifact_dir)
+        play = lambda k: rollout_coop(env, policy.agent("robot"), policy.agent("human"), seed + k)  # noqa: E731
+    else:
+        from ..runtime.env import AssistiveEnv
+
+        env = AssistiveEnv(artifact_dir)
+        play = lambda k: rollout(env, policy, seed + k)  # noqa: E731
+    try:
+        return [play(k) for k in range(episodes)]
+    finally:
+        env.close()
+
+
+def write_rollout(artifact_dir: str | Path, policy, coop: bool, seed: int, out: Path, every: int = 2) -> str:
+    """Write one rollout of ``policy`` as a GIF (or a PNG strip); returns a line saying so."""
+    from ..cli.render import record, write_picture
+    from ..runtime.env import AssistiveEnv
+
+    env = AssistiveEnv(artifact_dir, render_mode="rgb_array")
+    target, act = (env, policy) if not coop else both_agents(env, policy)
+    frames, summary = record(target, act, seed, every)
+    env.close()
+    write_picture(frames, out, fps=max(1, 10 // every))
+    return f"wrote {display(out)} ({len(frames)} frames; return {summary['return']:.1f}, success {'yes' if summary['success'] else 'no'})"
+
+
 def evaluate_exported(source: str, episodes: int = 100, seed: int = 0, render: str | None = None) -> dict:
     """Evaluate a shipped or exported policy (``pretrained:<name>`` or a policy folder) on its
     task, compiled on the current code (NumPy only; no training library needed). A co-optimised
     pair plays both agents."""
-    from ..compile.compiler import compile_task
     from ..policies.pretrained import load_trained
-    from ..registration import cached_artifact_dir
 
     policy, info = load_trained(source)
-    spec = trained_task_spec(info)
-    compiled = compile_task(spec, info["robot"], cached_artifact_dir(spec, info["robot"]))
-    if info.get("coop"):
-        from ..coop.parallel import AssistiveParallelEnv
-        from ..coop.rollout import rollout_coop
-
-        env = AssistiveParallelEnv(compiled.out_dir)
-        results = [rollout_coop(env, policy.robot, policy.human, seed + k) for k in range(episodes)]
-    else:
-        from ..runtime.env import AssistiveEnv
-
-        env = AssistiveEnv.from_compiled(compiled)
-        results = [rollout(env, policy, seed + k) for k in range(episodes)]
-    env.close()
-    out = {"run": source, "gym_id": info["gym_id"], "task": info["task"], "robot": info["robot"], "coop": bool(info.get("coop")),
+    coop = bool(info.get("coop"))
+    compiled = compile_for_policy(info)
+    results = play_episodes(compiled.out_dir, policy, coop, episodes, seed)
+    out = {"run": source, "gym_id": info["gym_id"], "task": info["task"], "robot": info["robot"], "coop": coop,
            "engine": info["engine"], "checkpoint": source, "trained_steps": info["trained_steps"], "episodes": episodes,
            "seed": seed, "content_hash": compiled.manifest.content_hash, "trained_on_content_hash": info["content_hash"],
            **_figures(results), "per_episode": results}
     if render:
-        from ..cli.render import record, write_picture
-        from ..runtime.env import AssistiveEnv
-
-        env = AssistiveEnv(compiled.out_dir, render_mode="rgb_array")
-        target, act = (env, policy) if not info.get("coop") else both_agents(env, policy)
-        frames, summary = record(target, act, seed, 2)
-        env.close()
-        write_picture(frames, Path(render), fps=5)
-        out["render"] = (f"wrote {display(Path(render))} ({len(frames)} frames; return {summary['return']:.1f}, "
-                         f"success {'yes' if summary['success'] else 'no'})")
+        out["render"] = write_rollout(compiled.out_dir, policy, coop, seed, Path(render))
     return out
 
 
@@ -104,23 +124,12 @@ def _figures(results: list[dict]) -> dict:
 
 def evaluate(run_dir: str | Path, episodes: int | None = None, seed: int = 0, render: str | None = None) -> dict:
     """Evaluate the run's newest checkpoint; optionally write a rollout (``render``: .gif or .png)."""
-    from ..runtime.env import AssistiveEnv
-
     run = RunDir(run_dir)
     info = run.info()
     steps, checkpoint = latest_checkpoint(run)
     episodes = episodes or info.training_config.eval_episodes
     policy = load_policy(info, checkpoint)
-    if info.coop:
-        from ..coop.parallel import AssistiveParallelEnv
-        from ..coop.rollout import rollout_coop
-
-        env = AssistiveParallelEnv(run.artifact)
-        results = [rollout_coop(env, policy.agent("robot"), policy.agent("human"), seed + k) for k in range(episodes)]
-    else:
-        env = AssistiveEnv(run.artifact)
-        results = [rollout(env, policy, seed + k) for k in range(episodes)]
-    env.close()
+    results = play_episodes(run.artifact, policy, info.coop, episodes, seed)
     out = {
         "run": display(run.path), "gym_id": info.gym_id, "task": info.task, "robot": info.robot, "coop": info.coop,
         "engine": info.engine, "checkpoint": display(checkpoint), "trained_steps": steps, "episodes": episodes, "seed": seed,
@@ -132,17 +141,8 @@ def evaluate(run_dir: str | Path, episodes: int | None = None, seed: int = 0, re
 
 
 def render_rollout(run: RunDir, info: RunInfo, checkpoint: Path, seed: int, out: Path, every: int = 2) -> str:
-    """Write one rollout of the trained policy as a GIF (or a PNG strip); returns a line saying so."""
-    from ..cli.render import record, write_picture
-    from ..runtime.env import AssistiveEnv
-
-    env = AssistiveEnv(run.artifact, render_mode="rgb_array")
-    policy = load_policy(info, checkpoint)
-    target, act = (env, policy) if not info.coop else both_agents(env, policy)
-    frames, summary = record(target, act, seed, every)
-    env.close()
-    write_picture(frames, out, fps=max(1, 10 // every))
-    return f"wrote {display(out)} ({len(frames)} frames; return {summary['return']:.1f}, success {'yes' if summary['success'] else 'no'})"
+    """Write one rollout of the run's trained policy as a GIF (or a PNG strip); returns a line saying so."""
+    return write_rollout(run.artifact, load_policy(info, checkpoint), info.coop, seed, out, every)
 
 
 def save_evaluation(run: RunDir, result: dict) -> Path:

@@ -80,24 +80,10 @@ def check_same_actions(exported: MLPPolicy, original, observations: np.ndarray, 
 def evaluate_policy(artifact: Path, policy, episodes: int, seed: int) -> dict:
     """Mean ± std return, success rate and force on the person over seeded episodes (deterministic);
     a co-optimised pair (:class:`~assistive_compiler.policies.pretrained.CoopPolicy`) plays both agents."""
-    from ..episode import rollout
     from ..policies.pretrained import CoopPolicy
+    from .evaluate import play_episodes
 
-    if isinstance(policy, CoopPolicy):
-        from ..coop.parallel import AssistiveParallelEnv
-        from ..coop.rollout import rollout_coop
-
-        env = AssistiveParallelEnv(artifact)
-        play = lambda k: rollout_coop(env, policy.robot, policy.human, seed + k)  # noqa: E731
-    else:
-        from ..runtime.env import AssistiveEnv
-
-        env = AssistiveEnv(artifact)
-        play = lambda k: rollout(env, policy, seed + k)  # noqa: E731
-    try:
-        runs = [play(k) for k in range(episodes)]
-    finally:
-        env.close()
+    runs = play_episodes(artifact, policy, isinstance(policy, CoopPolicy), episodes, seed)
     returns = [r["return"] for r in runs]
     forces = [r["mean_force_on_human_n"] for r in runs]
     return {"episodes": episodes, "seed": seed, "mean_return": float(np.mean(returns)), "std_return": float(np.std(returns)),

@@ -16,6 +16,7 @@ import json
 from pathlib import Path
 
 from .paper import PAPER, ROBOT_TITLES, TASK_TITLES, TASKS
+from .table import markdown_table
 
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
 PICTURES = "results/cells"  # beside the doc: docs/results/cells/<name>-curve.png and <name>.png
@@ -54,11 +55,6 @@ HEADER = ["Task", "Robot", "Algorithm", "Env steps", "Wall time", "Env steps/s",
           "Force on person (N)", "Paper return", "Paper success (best robot)", "≥ paper"]
 
 
-def _table(rows: list[list[str]]) -> str:
-    lines = ["| " + " | ".join(HEADER) + " |", "|" + "|".join("---" for _ in HEADER) + "|"]
-    return "\n".join(lines + ["| " + " | ".join(r) + " |" for r in rows])
-
-
 def _order(r: dict) -> tuple:
     return (TASKS.index(r["task"]) if r["task"] in TASKS else len(TASKS), r["task"], r["robot"], r["name"])
 
@@ -74,7 +70,7 @@ def results_block(records: list[dict]) -> str:
             parts.append("No cell of this table has been trained here yet.\n")
             continue
         missing = [TASK_TITLES[t] for t in TASKS if t in paper and not any(r["task"] == t for r in rows)]
-        parts.append(_table([_row(r, paper, paper_success) for r in rows]) + "\n")
+        parts.append(markdown_table(HEADER, [_row(r, paper, paper_success) for r in rows]) + "\n")
         if missing:
             parts.append(f"Not trained yet: {', '.join(missing)}.\n")
     claim = []
@@ -106,13 +102,9 @@ def results_block(records: list[dict]) -> str:
 
 def write_pictures(records: list[dict], doc_dir: Path, progress=None) -> list[Path]:
     """Each cell's learning curve and a strip of its first evaluation episode (rendered anew)."""
-    from ..cli.render import record, write_picture
-    from ..policies.pretrained import PREFIX, pretrained_dir
-    from ..registration import cached_artifact_dir
-    from ..runtime.env import AssistiveEnv
+    from ..policies.pretrained import PREFIX, load_trained, pretrained_dir
     from .curves import plot_curves, read_curve
-    from .evaluate import trained_task_spec
-    from ..policies.pretrained import load_trained
+    from .evaluate import compile_for_policy, write_rollout
 
     out_dir = doc_dir / PICTURES
     written = []
@@ -125,12 +117,8 @@ def write_pictures(records: list[dict], doc_dir: Path, progress=None) -> list[Pa
         if r["coop"]:
             continue
         policy, _ = load_trained(PREFIX + r["name"])
-        spec = trained_task_spec(r)
-        env = AssistiveEnv.from_spec(spec, robot=r["robot"], out_dir=cached_artifact_dir(spec, r["robot"]), render_mode="rgb_array")
-        frames, _ = record(env, policy, r["evaluation"]["seed"], 2)
-        env.close()
         png = out_dir / f"{r['name']}.png"
-        write_picture(frames, png, fps=5)
+        write_rollout(compile_for_policy(r).out_dir, policy, False, r["evaluation"]["seed"], png)
         written.append(png)
         if progress:
             progress(r["name"])
