@@ -39,12 +39,9 @@ def _layers(linears) -> list[tuple[np.ndarray, np.ndarray]]:
     return [(m.weight.detach().cpu().numpy().astype(np.float64), m.bias.detach().cpu().numpy().astype(np.float64)) for m in linears]
 
 
-def mlp_from_sb3(checkpoint: Path, algorithm: str, activation: str) -> MLPPolicy:
-    """The deterministic policy of an SB3 checkpoint (SAC's actor mean through tanh; PPO's
-    Gaussian mean, clipped), with PPO's observation normalisation if it used one."""
-    from .sb3 import SB3Policy
-
-    loaded = SB3Policy(checkpoint, algorithm)
+def mlp_from_sb3(loaded, algorithm: str, activation: str) -> MLPPolicy:
+    """The deterministic policy of a loaded SB3 checkpoint (:class:`.sb3.SB3Policy`: SAC's actor
+    mean through tanh; PPO's Gaussian mean, clipped), with PPO's observation normalisation if it used one."""
     model = loaded.model
     low, high = model.action_space.low, model.action_space.high
     if algorithm == "sac":
@@ -125,8 +122,9 @@ def export_run(run_dir: str | Path, out: str | Path | None = None, *, episodes: 
     if info.engine == "sb3":
         from .sb3 import SB3Policy
 
-        policy = mlp_from_sb3(checkpoint, config.algorithm, config.network.activation)
-        worst = check_same_actions(policy, SB3Policy(checkpoint, config.algorithm), rng.normal(0.0, 1.0, (32, policy.obs_dim)))
+        original = SB3Policy(checkpoint, config.algorithm)
+        policy = mlp_from_sb3(original, config.algorithm, config.network.activation)
+        worst = check_same_actions(policy, original, rng.normal(0.0, 1.0, (32, policy.obs_dim)))
     else:
         from ..policies.pretrained import CoopPolicy
         from .rllib import SINGLE_MODULE, RLlibPolicy
