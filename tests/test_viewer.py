@@ -56,7 +56,10 @@ def test_view_page_in_headless_chromium(artifact, tmp_path):
     browser = Browser()
     try:
         browser.open(url)
-        text = browser.wait_for_text("wheelchair", timeout_s=90)  # the Bodies list, filled once the scene is sent
+        # viser sends the panel's parts one message at a time: wait for each part the test reads
+        # (on a loaded machine the Bodies list has arrived seconds before the summary).
+        for needle in ("wheelchair", "seed 0 · person", "success yes", "distance_to_mouth"):
+            text = browser.wait_for_text(needle, timeout_s=90)
         time.sleep(3)  # let software WebGL draw a few frames
         shot = browser.screenshot(tmp_path / "viewer.png")
     finally:
