@@ -158,10 +158,14 @@ def render_people(artifact_dir: Path, width: int = 360, height: int = 480) -> np
             body = m.body(other.body)
             away = (PARK[0] + 10.0 * j, PARK[1], PARK[2])
             world.set_base_frame(world.variant_bodies[other.name], body.position if j == i else away, body.orientation)
-        pos = np.asarray(m.body(variant.body).position)
-        target = pos + [0.0, 0.0, -0.3]
-        eye = target + [0.0, -2.6, 0.35]  # in front of the person, who faces -Y
-        view = pb.computeViewMatrix(eye.tolist(), target.tolist(), [0, 0, 1], physicsClientId=c)
+        body = m.body(variant.body)
+        # The camera sits in front of the person in the person's own base frame (the person faces
+        # its base's -Y, head toward +Z), so a supine person on a bed is seen from above, head up,
+        # and a seated one from the front, wherever the furniture stands.
+        rotation = np.asarray(pb.getMatrixFromQuaternion(body.orientation)).reshape(3, 3)
+        target = np.asarray(body.position) + rotation @ [0.0, 0.0, -0.3]
+        eye = target + rotation @ [0.0, -2.6, 0.35]
+        view = pb.computeViewMatrix(eye.tolist(), target.tolist(), (rotation @ [0, 0, 1]).tolist(), physicsClientId=c)
         proj = pb.computeProjectionMatrixFOV(40, width / height, 0.05, 10, physicsClientId=c)
         rgba = pb.getCameraImage(width, height, view, proj, renderer=pb.ER_TINY_RENDERER, lightDirection=[1, -2, 2], physicsClientId=c)[2]
         image = Image.fromarray(np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3])
