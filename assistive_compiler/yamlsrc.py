@@ -72,13 +72,6 @@ class SourceMap:
         assert self.default is not None
         return self.default
 
-    def merged_over(self, base: "SourceMap") -> "SourceMap":
-        """This map laid over ``base``: entries of ``self`` win; used for ``extends``."""
-        out = SourceMap(dict(base.values), dict(base.keys), self.default or base.default)
-        out.values.update(self.values)
-        out.keys.update(self.keys)
-        return out
-
 
 def _loc(path: str, node: Node) -> Location:
     mark = node.start_mark

@@ -171,6 +171,18 @@ def test_extends_markers_misused_are_located(tmp_path):
                                     "inherited value); move offset_m inside it")
 
 
+def test_a_mistake_inside_replace_is_located_where_it_was_written(tmp_path):
+    """The merged value came from the child's ``$replace``: the error points there, not at the
+    parent's line that the replacement removed."""
+    spec = tmp_path / "task.yaml"
+    spec.write_text("extends: shipped:tasks/feeding.yaml\nsuccess:\n  $replace:\n    term: food_eaten\n"
+                    "    aggregate: final\n    threshold: -0.05\n")
+    status, _, err = cli("validate", str(spec), cwd=tmp_path)
+    assert status == 2 and "Traceback" not in err
+    assert "task.yaml:5:16: success.aggregate: expected one of 'last', 'max', 'min', 'sum', got 'final'" in err, err
+    assert "feeding.yaml" not in err
+
+
 def test_a_derived_spec_drops_a_variant_and_its_offsets(tmp_path):
     spec = tmp_path / "task.yaml"
     spec.write_text("extends: shipped:tasks/feeding.yaml\nperson: {variants: [male_50th]}\n"

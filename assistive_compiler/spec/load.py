@@ -44,26 +44,32 @@ SHIPPED_PREFIX = "shipped:"
 
 class _Merger:
     """``override`` laid over ``base`` with the ``$delete`` / ``$replace`` markers, collecting
-    located problems (``smap`` is the override file's source map)."""
+    located problems (``smap`` is the override file's source map) and the data paths whose
+    inherited content the override removed (so their inherited locations are dropped too)."""
 
     def __init__(self, smap: SourceMap):
         self.smap = smap
         self.problems: list[Problem] = []
+        self.cleared: list[tuple] = []
 
-    def merge(self, base: Any, override: Any, at: tuple = ()) -> Any:
+    def merge(self, base: Any, override: Any, at: tuple = (), path: tuple = ()) -> Any:
+        """``at``: where ``override`` is in its file (markers included); ``path``: where the
+        result goes in the merged data."""
         if not isinstance(override, dict):
             return override
         if REPLACE in override:
             if len(override) > 1:
                 others = ", ".join(sorted(k for k in override if k != REPLACE))
                 self.problems.append(Problem(self.smap.key(at + (REPLACE,)), f"'{REPLACE}' stands alone in its mapping (it replaces the whole inherited value); move {others} inside it"))
-            return self.merge(None, override[REPLACE], at + (REPLACE,))
+            self.cleared.append(path)
+            return self.merge(None, override[REPLACE], at + (REPLACE,), path)
         out = dict(base) if isinstance(base, dict) else {}
         for key in self._deleted(base, override, at):
             out.pop(key, None)
+            self.cleared.append(path + (key,))
         for key, value in override.items():
             if key != DELETE:
-                out[key] = self.merge(out.get(key), value, at + (key,))
+                out[key] = self.merge(out.get(key), value, at + (key,), path + (key,))
         return out
 
     def _deleted(self, base: Any, override: dict, at: tuple) -> list[str]:
@@ -82,15 +88,38 @@ class _Merger:
         return names
 
 
-def deep_merge(base: Any, override: Any, smap: SourceMap | None = None) -> Any:
+def _merged_source_map(smap: SourceMap, base: SourceMap | None, cleared: list[tuple]) -> SourceMap:
+    """Where each value of the merged data was written: the override file's locations, moved out
+    of its ``$replace`` wrappers to the data paths they fill, over the inherited locations that the
+    override did not remove (a replaced or deleted value's inherited locations are dropped, so
+    an error in a ``$replace`` is located in the file that wrote it)."""
+
+    def data_path(path: tuple) -> tuple:
+        return tuple(k for k in path if k != REPLACE)
+
+    def kept(path: tuple) -> bool:
+        return not any(path[:len(c)] == c for c in cleared)
+
+    out = SourceMap(default=smap.default or (base.default if base else None))
+    if base is not None:
+        out.values.update({p: loc for p, loc in base.values.items() if kept(p)})
+        out.keys.update({p: loc for p, loc in base.keys.items() if kept(p)})
+    out.values.update({data_path(p): loc for p, loc in smap.values.items()})
+    out.keys.update({data_path(p): loc for p, loc in smap.keys.items()})
+    return out
+
+
+def deep_merge(base: Any, override: Any, smap: SourceMap | None = None, base_smap: SourceMap | None = None) -> tuple[Any, SourceMap]:
     """``override`` laid over ``base``: mappings merge key by key, anything else is replaced;
-    ``$delete`` / ``$replace`` (see :data:`DELETE`) remove or replace inherited values.
+    ``$delete`` / ``$replace`` (see :data:`DELETE`) remove or replace inherited values. Returns
+    the merged data and where each of its values was written (``smap`` over ``base_smap``).
     Raises :class:`SpecError` for a misused marker."""
-    merger = _Merger(smap or SourceMap(default=Location("<spec>", 1, 1)))
+    smap = smap or SourceMap(default=Location("<spec>", 1, 1))
+    merger = _Merger(smap)
     out = merger.merge(base, override)
     if merger.problems:
         raise SpecError(merger.problems)
-    return out
+    return out, _merged_source_map(smap, base_smap, merger.cleared)
 
 
 def _parent_path(path: Path, ref: str) -> Path:
@@ -104,7 +133,8 @@ def _load_tree(path: Path, chain: tuple[Path, ...]) -> tuple[dict, SourceMap, tu
     files = (path,)
     parent_ref = data.get("extends")
     if parent_ref is None:
-        return deep_merge(None, data, smap), smap, files
+        merged, merged_smap = deep_merge(None, data, smap)
+        return merged, merged_smap, files
     where = smap.value(("extends",))
     if not isinstance(parent_ref, str) or not parent_ref:
         raise SpecError([Problem(where, "extends: expected the path of another spec file")])
@@ -118,8 +148,8 @@ def _load_tree(path: Path, chain: tuple[Path, ...]) -> tuple[dict, SourceMap, tu
     if len(chain) >= MAX_EXTENDS_DEPTH:
         raise SpecError([Problem(where, f"extends is nested more than {MAX_EXTENDS_DEPTH} deep")])
     base_data, base_smap, base_files = _load_tree(parent, chain + (path,))
-    merged = deep_merge(base_data, {k: v for k, v in data.items() if k != "extends"}, smap)
-    return merged, smap.merged_over(base_smap), files + base_files
+    merged, merged_smap = deep_merge(base_data, {k: v for k, v in data.items() if k != "extends"}, smap, base_smap)
+    return merged, merged_smap, files + base_files
 
 
 def load_spec(path: str | Path) -> LoadedSpec:
