@@ -74,6 +74,17 @@ def feeding_location(needle: str, offset: int = 0) -> str:
     return f"{display(FEEDING)}:{line}:{int(column) + offset}"
 
 
+def inherited(section: str, parent: Path, child: Path) -> str:
+    """The note on a problem located at a value ``child`` inherited from ``parent``."""
+    return f" ({section} is inherited from {display(parent)}; override it in {display(child)}, or remove it there with $delete / $replace)"
+
+
+def relative_to_food_note(child: Path) -> str:
+    """The note on a success threshold checked against Feeding's inherited ``relative_to: food``."""
+    return (f" (relative_to: food is inherited from {feeding_location('relative_to: ', len('relative_to: '))}; remove it in "
+            f"{display(child)} with success: {{$delete: [relative_to]}}, or rewrite success whole with success: {{$replace: {{...}}}})")
+
+
 # --------------------------------------------------------------------------------------------
 # the good spec
 
@@ -233,7 +244,7 @@ def test_success_fraction_out_of_range(tmp_path, capsys):
     lines = problems(capsys, path)
     assert len(lines) == 1
     assert lines[0].startswith(f"{display(path)}:{at(text, '1.5')}: ")
-    assert lines[0].endswith("threshold 1.5 is a fraction of 'food' and must lie in (0, 1]")
+    assert lines[0].endswith(f"threshold 1.5 is a fraction of 'food' and must lie in (0, 1]{relative_to_food_note(path)}")
 
 
 def test_success_fraction_out_of_range_message(tmp_path, capsys):
@@ -241,7 +252,7 @@ def test_success_fraction_out_of_range_message(tmp_path, capsys):
     text = EXTENDS + "success: {threshold: 1.5}\n"
     path = write(tmp_path, text)
     [line] = problems(capsys, path)
-    assert line.endswith(": success.threshold: threshold 1.5 is a fraction of 'food' and must lie in (0, 1]")
+    assert line.endswith(f": success.threshold: threshold 1.5 is a fraction of 'food' and must lie in (0, 1]{relative_to_food_note(path)}")
 
 
 def test_success_threshold_absolute_without_relative_to(tmp_path, capsys):
@@ -292,11 +303,35 @@ def test_unknown_robot_on_command_line(tmp_path, capsys):
     rc, out, err = run_cli(capsys, "compile", str(FEEDING), "--robot", "jacco", "--out", str(out_dir))
     assert "Traceback" not in out + err
     assert (rc, out) == (2, "")
-    # The robot is not written in the spec; the message points at the task's default robot.
+    # The robot is not written in the spec; the message points at the list that decides.
     assert err.splitlines() == [
-        f"{feeding_location('default: jaco', len('default: '))}: robot 'jacco' is not supported by task 'feeding'; supported: {one_of(SUPPORTED)} (did you mean 'jaco'?)"
+        f"{feeding_location('supported: [', len('supported: '))}: robot 'jacco' is not supported by task 'feeding'; supported: {one_of(SUPPORTED)} (did you mean 'jaco'?)"
     ]
     assert not out_dir.exists()
+
+
+def test_unsupported_robot_of_a_child_spec_points_at_the_inherited_list_and_says_so(tmp_path, capsys):
+    child = tmp_path / "child.yaml"
+    child.write_text(f"extends: {FEEDING}\nname: feeding_variant\n")
+    rc, out, err = run_cli(capsys, "compile", str(child), "--robot", "kuka", "--out", str(tmp_path / "out"))
+    assert rc == 2 and "Traceback" not in out + err
+    assert err.splitlines() == [
+        f"{feeding_location('supported: [', len('supported: '))}: robot 'kuka' is not supported by task 'feeding_variant'; "
+        f"supported: {one_of(SUPPORTED)} (robot.supported is inherited from {display(FEEDING)}; override it in {display(child)}, "
+        "or remove it there with $delete / $replace)"
+    ]
+
+
+def test_an_inherited_key_that_no_longer_fits_says_where_it_came_from_and_the_remedy(tmp_path, capsys):
+    child = tmp_path / "child.yaml"
+    child.write_text(f"extends: {FEEDING}\nname: feeding_variant\nsuccess: {{threshold: 10}}\n")
+    rc, out, err = run_cli(capsys, "validate", str(child))
+    assert rc == 2 and "Traceback" not in out + err
+    assert err.splitlines() == [
+        f"{display(child)}:3:22: success.threshold: threshold 10 is a fraction of 'food' and must lie in (0, 1] "
+        f"(relative_to: food is inherited from {feeding_location('relative_to: ', len('relative_to: '))}; "
+        f"remove it in {display(child)} with success: {{$delete: [relative_to]}}, or rewrite success whole with success: {{$replace: {{...}}}})"
+    ]
 
 
 def test_unknown_robot_in_supported(tmp_path, capsys):
@@ -488,7 +523,7 @@ def test_only_when_mounted_is_for_the_mount_furniture_and_unreferenced(tmp_path,
     text = f"extends: {BATHING}\nscene:\n  furniture:\n    bed: {{part: bed, position_m: [-0.1, 0, 0], only_when_mounted: true}}\n"
     path = write(tmp_path, text)
     assert sorted(problems(capsys, path)) == sorted([  # one in each file
-        f"{bathing_location('bed]}}')}: furniture 'bed' {CONDITIONAL}",
+        f"{bathing_location('bed]}}')}: furniture 'bed' {CONDITIONAL}{inherited('observations.robot[6].params.b[1]', BATHING, path)}",
         f"{display(path)}:{at(text, 'true')}: furniture 'bed' is only_when_mounted but the robot mounts on 'nightstand' "
         "(robot.mount_on); only the mount furniture can be left out for robots that stand on the floor",
     ])
@@ -588,6 +623,7 @@ def test_searched_mount_needs_furniture_present_only_when_mounted(tmp_path, caps
     assert problems(capsys, path) == [
         f"{bathing_location('mount_base: search', len('mount_base: '))}: mount_base 'search' places furniture 'nightstand' under a "
         "mounted robot's base, so without one it has no place: set scene.furniture.nightstand.only_when_mounted: true"
+        + inherited("robot.mount_base", BATHING, path)
     ]
 
 
@@ -603,9 +639,11 @@ def test_searched_mount_needs_a_mount(tmp_path, capsys):
     path = write(tmp_path, text)
     assert problems(capsys, path) == [
         f"{bathing_location('only_when_mounted: true', len('only_when_mounted: '))}: furniture 'nightstand' is only_when_mounted but "
-        "the robot mounts on nothing (robot.mount_on); only the mount furniture can be left out for robots that stand on the floor",
+        "the robot mounts on nothing (robot.mount_on); only the mount furniture can be left out for robots that stand on the floor"
+        + inherited("scene.furniture.nightstand.only_when_mounted", BATHING, path),
         f"{bathing_location('mount_base: search', len('mount_base: '))}: mount_base 'search' carries the mount furniture under the "
-        "searched base, but robot.mount_on names no furniture; set robot.mount_on or use mount_base: furniture",
+        "searched base, but robot.mount_on names no furniture; set robot.mount_on or use mount_base: furniture"
+        + inherited("robot.mount_base", BATHING, path),
     ]
 
 
@@ -670,3 +708,14 @@ def test_validate_reports_every_file(tmp_path, capsys):
     assert "Traceback" not in out + err
     assert out == f"{good}: ok (task 'feeding', robots: {ROBOTS})\n"
     assert err == f"{display(bad)}:3:15: sim.frame_skip: must be a valid integer, unable to parse string as an integer, got 'five'\n"
+
+
+def test_references_left_dangling_by_a_child_are_reported_where_inherited_with_the_remedy(tmp_path, capsys):
+    """The child removed the food: each inherited use of it is located in the parent and names the child."""
+    child = tmp_path / "child.yaml"
+    child.write_text(f"extends: {FEEDING}\nname: feeding_variant\nparticles: {{$delete: [food]}}\n")
+    rc, out, err = run_cli(capsys, "validate", str(child))
+    assert rc == 2 and "Traceback" not in out + err
+    assert (f"{feeding_location('relative_to: ', len('relative_to: '))}: unknown particle or marker set 'food'; expected one of none "
+            f"(success.relative_to is inherited from {display(FEEDING)}; override it in {display(child)}, "
+            "or remove it there with $delete / $replace)") in err.splitlines()

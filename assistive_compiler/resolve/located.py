@@ -12,6 +12,7 @@ from typing import Any, Iterable
 
 from ..errors import Location, Problem, SpecError, did_you_mean, one_of
 from ..spec.load import LoadedSpec
+from ..spec.validation import inherited_note
 
 
 class Collector:
@@ -31,7 +32,8 @@ class Collector:
 
     def problem(self, path: tuple, message: str, key: bool = False) -> None:
         """Report ``message`` at ``path`` (once: a segment's waypoint is checked wherever it is spliced in)."""
-        problem = Problem(self.key_at(*path) if key else self.at(*path), message)
+        where = self.key_at(*path) if key else self.at(*path)
+        problem = Problem(where, message + inherited_note(self.loaded.smap, where, tuple(path)))
         if problem not in self.problems:
             self.problems.append(problem)
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import Any, Iterable
 
-from ..errors import Problem, SpecError, did_you_mean, one_of
+from ..errors import did_you_mean, one_of
 from ..library import LoadedPart
 from ..spec.models import TaskSpec
 from .located import expected
@@ -25,7 +25,10 @@ def check_supported(s: Scope) -> None:
         if not s.lib.path_of("robots", name):
             s.problem(("robot", "supported", i), f"unknown robot '{name}'; {expected(s.lib.names('robots'), name)}")
     if s.robot_name not in spec.robot.supported:
-        raise SpecError([Problem(s.at("robot", "default"), f"robot '{s.robot_name}' is not supported by task '{spec.name}'; supported: {one_of(spec.robot.supported)}{did_you_mean(s.robot_name, spec.robot.supported)}")])
+        # Located at the list that decides (robot.supported), wherever it was written.
+        s.problem(("robot", "supported"), f"robot '{s.robot_name}' is not supported by task '{spec.name}'; supported: "
+                  f"{one_of(spec.robot.supported)}{did_you_mean(s.robot_name, spec.robot.supported)}")
+        s.fail_if_any()
 
 
 def check_per_robot_keys(s: Scope, path: tuple, names: Iterable[str]) -> None:

@@ -154,9 +154,49 @@ def problems_from_validation(
     for path, errs in grouped.items():
         errs = _pick_union_branch(errs, _value_at(data, path))
         for err, _tags in errs:
-            problems.append(_one(err, path, data, smap, root, prefix))
+            problem = _one(err, path, data, smap, root, prefix)
+            note = inherited_note(smap, problem.location, _problem_path(err, path, prefix))
+            if _strip(err["msg"]).startswith("@"):  # a check across the keys of one mapping
+                field = _problem_path(err, path, ())
+                note += inherited_siblings_note(smap, prefix + field[:-1], _value_at(data, field[:-1]), problem.message, skip=field[-1])
+            problems.append(Problem(problem.location, problem.message + note))
     unique = {(str(p.location), p.message): p for p in problems}
     return list(unique.values())
+
+
+def _problem_path(err: dict, path: DataPath, prefix: DataPath) -> DataPath:
+    """The data path a problem is about (a model-level check names its field: ``@threshold: ...``)."""
+    message = _strip(err["msg"])
+    if err["type"] in ("value_error", "assertion_error") and message.startswith("@"):
+        return prefix + path + tuple(message[1:].partition(": ")[0].split("."))
+    return prefix + path
+
+
+def inherited_note(smap: SourceMap, location: Any, path: DataPath) -> str:
+    """For a problem located in a file the spec extends (not the spec's own file): that the value
+    is inherited and how to change it. Empty for a value the spec wrote itself."""
+    own = smap.default.path if smap.default is not None else None
+    if own is None or location.path == own:
+        return ""
+    return f" ({_section(path)} is inherited from {location.path}; override it in {own}, or remove it there with $delete / $replace)"
+
+
+def inherited_siblings_note(smap: SourceMap, mapping: DataPath, siblings: Any, message: str, skip: Any) -> str:
+    """For a check across the keys of one mapping: each other key whose value the message quotes
+    but that the spec inherited rather than wrote, with where it came from and the remedy, so an
+    inherited key that no longer fits is not mistaken for the child's own."""
+    own = smap.default.path if smap.default is not None else None
+    if own is None or not isinstance(siblings, dict):
+        return ""
+    notes = []
+    for key, value in siblings.items():
+        where = smap.value(mapping + (key,))
+        if key == skip or where.path == own or isinstance(value, (dict, list)) or f"'{value}'" not in message:
+            continue
+        parent = _section(mapping)
+        notes.append(f"{key}: {value} is inherited from {where}; remove it in {own} with {parent}: {{$delete: [{key}]}}, "
+                     f"or rewrite {parent} whole with {parent}: {{$replace: {{...}}}}")
+    return f" ({'; '.join(notes)})" if notes else ""
 
 
 def _value_at(data: Any, path: DataPath) -> Any:
