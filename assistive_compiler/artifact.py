@@ -326,7 +326,8 @@ class Manifest(_Model):
     task: str = Field(description="Task name.")
     title: str = Field(description="Task title.")
     robot_name: str = Field(description="Robot compiled for.")
-    gym_id: str = Field(description="Gymnasium id of this (task, robot).")
+    gym_id: str = Field(description="Gymnasium id that makes this (task, robot): a shipped task's own "
+                                    "(assistive_compiler/FeedingJaco-v1), else assistive_compiler/Task-v1 (with spec= and robot=).")
     input_hash: str = Field(description="sha256 of every input (spec files, parts, templates, compiler source).")
     content_hash: str = Field("", description="sha256 of the output files (URDFs and manifest minus this field).")
     sources: list[str] = Field(description="Spec and part files this was compiled from.")
@@ -345,6 +346,12 @@ class Manifest(_Model):
     garments: list[Garment] = Field(default_factory=list, description="Soft-body garments (their presence makes the world a deformable one).")
     scripted: dict[str, Any] | None = Field(None, description="Scripted baseline: point moved and waypoints (normalised).")
     camera: Camera = Field(default_factory=Camera, description="The task's camera for this robot (renders).")
+
+    @property
+    def label(self) -> str:
+        """A name for logs and plot titles: the shipped task's id (``assistive_compiler/FeedingJaco-v1``),
+        or ``<task> for <robot>`` for any other spec (whose id, ``assistive_compiler/Task-v1``, is shared)."""
+        return self.gym_id if not self.gym_id.endswith("/Task-v1") else f"{self.task} for {self.robot_name}"
 
     def body(self, name: str) -> Body:
         for b in self.bodies:

@@ -82,6 +82,21 @@ class Library:
             found.update(p.stem for p in (root / kind).glob("*.yaml"))
         return sorted(found)
 
+    def searched(self, kind: str) -> str:
+        """Where parts of ``kind`` were looked for, for an unknown-name message: empty when only the
+        shipped parts are in use; else each folder (saying which do not exist) and, for a library
+        root without the folder, the folder below it that has one (a ``--library`` one level too high)."""
+        if all(root == specs_dir().resolve() for root in self.roots):
+            return ""
+        shown, hints = [], []
+        for root in self.roots:
+            folder = root / kind
+            shown.append(f"{display(folder)}/" + ("" if folder.is_dir() else " (no such folder)"))
+            if not folder.is_dir():
+                hints += [f"{display(below.parent)}/ holds {kind}/: use it as the library" for below in sorted(root.glob(f"*/{kind}"))
+                          if any(below.glob("*.yaml"))]
+        return f" (looked in {', '.join(shown)}{''.join('; ' + h for h in hints)})"
+
     def path_of(self, kind: str, name: str) -> Path | None:
         """The file of part ``name``; raises :class:`SpecError` when two libraries define it."""
         found = [root / kind / f"{name}.yaml" for root in self.roots if (root / kind / f"{name}.yaml").is_file()]

@@ -1,4 +1,5 @@
-"""Gymnasium ids for the shipped tasks: ``assistive_compiler/<Task><Robot>-v1``.
+"""Gymnasium ids for the shipped tasks: ``assistive_compiler/<Task><Robot>-v1``, and
+``assistive_compiler/Task-v1`` for any other task spec (``gym.make(TASK_ID, spec=PATH, robot=NAME)``).
 
 Registration reads only each task's name, title and supported robots (and each robot's title)
 with plain YAML, so ``import assistive_compiler`` stays light. An env made by id is compiled on
@@ -17,6 +18,8 @@ import yaml
 from .paths import specs_dir
 
 NAMESPACE = "assistive_compiler"
+TASK_ID = f"{NAMESPACE}/Task-v1"
+"""The id of a task spec that is not shipped: ``gym.make(TASK_ID, spec="my_task.yaml", robot="jaco")``."""
 
 
 def cache_dir() -> Path:
@@ -57,14 +60,33 @@ def shipped_ids() -> dict[str, tuple[Path, str]]:
     return {env_id: (t.spec, robot) for t in shipped_tasks() for robot, env_id in zip(t.robots, t.ids)}
 
 
-def cached_artifact_dir(spec: str | Path, robot: str) -> Path:
+def shipped_gym_id(spec: str | Path, name: str, robot: str) -> str | None:
+    """The registered id of ``spec`` compiled for ``robot`` when ``spec`` is a shipped task file
+    (and still names that task), else None: only shipped tasks have ids of their own."""
+    path = Path(spec).resolve()
+    for task in shipped_tasks():
+        if task.spec.resolve() == path and task.name == name and robot in task.robots:
+            return task.ids[task.robots.index(robot)]
+    return None
+
+
+def cached_artifact_dir(spec: str | Path, robot: str | None) -> Path:
     """Where an env made by name compiles ``spec`` for ``robot``: ``$ASSISTIVE_COMPILER_CACHE/<task>-<robot>``
-    (shared by the Gymnasium id and the co-optimisation name of the same task and robot)."""
-    return cache_dir() / f"{Path(spec).stem}-{robot}"
+    (shared by the Gymnasium id and the co-optimisation name of the same task and robot). A spec that
+    is not shipped gets a folder of its own path's (``<stem>-<path hash>-<robot>``), so two user specs
+    of the same file name do not take turns recompiling one folder."""
+    import hashlib
+
+    path = Path(spec).resolve()
+    label = robot or "default"
+    if path.parent == (specs_dir() / "tasks").resolve():
+        return cache_dir() / f"{path.stem}-{label}"
+    return cache_dir() / f"{path.stem}-{hashlib.sha256(str(path).encode()).hexdigest()[:8]}-{label}"
 
 
-def make_env(spec: str, robot: str, **kwargs):
-    """Entry point of registered ids: compile (cached) into the artifact cache and build the env."""
+def make_env(spec: str, robot: str | None = None, **kwargs):
+    """Entry point of registered ids: compile (cached) into the artifact cache and build the env
+    (``robot`` None: the spec's default robot)."""
     from .runtime.env import AssistiveEnv
 
     return AssistiveEnv.from_spec(spec, robot=robot, out_dir=cached_artifact_dir(spec, robot), **kwargs)
@@ -79,4 +101,6 @@ def register_all() -> list[str]:
             gymnasium.register(id=env_id, entry_point="assistive_compiler.registration:make_env",
                                kwargs={"spec": str(spec), "robot": robot}, disable_env_checker=True)
         ids.append(env_id)
+    if TASK_ID not in gymnasium.registry:  # any other spec: gym.make(TASK_ID, spec=..., robot=...)
+        gymnasium.register(id=TASK_ID, entry_point="assistive_compiler.registration:make_env", disable_env_checker=True)
     return ids

@@ -19,6 +19,7 @@ laughs" anchors that expand exponentially).
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -150,6 +151,21 @@ SAFE_TAGS = frozenset({"str", "int", "float", "bool", "null", "seq", "map", "tim
 """The standard tags a spec may carry (implicitly resolved; ``merge`` is refused by its own check)."""
 
 
+class _Loader(yaml.SafeLoader):
+    """PyYAML's safe loader whose aliases keep their own place: an alias (``*name``) is composed
+    as a shallow copy of its anchored node marked where the alias is written (PyYAML returns the
+    anchored node itself), so a value used through an alias is located at the alias, the place
+    where it is in force, and only the values inside it at the anchor that wrote them."""
+
+    def compose_node(self, parent, index):
+        if self.check_event(yaml.events.AliasEvent):
+            event = self.peek_event()
+            alias = copy.copy(super().compose_node(parent, index))
+            alias.start_mark, alias.end_mark = event.start_mark, event.end_mark
+            return alias
+        return super().compose_node(parent, index)
+
+
 def _construct_scalar(node: ScalarNode) -> Any:
     loader = yaml.SafeLoader("")
     try:
@@ -195,7 +211,7 @@ def loads_located(text: str, shown: str) -> tuple[dict, SourceMap]:
         raise SpecError.at(shown, f"text is {len(text)} characters; a spec file is at most {MAX_FILE_BYTES} bytes")
     try:
         _check_depth(text, shown)
-        documents = list(yaml.compose_all(text, Loader=yaml.SafeLoader))
+        documents = list(yaml.compose_all(text, Loader=_Loader))
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)

@@ -3,6 +3,7 @@ copied with absolute mesh paths, placed by the compile-time base-pose search and
 
 from __future__ import annotations
 
+import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -14,7 +15,7 @@ from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.compile.external_checks import check_with_urdfdom
 from assistive_compiler.errors import SpecError
 from assistive_compiler.library import Library
-from assistive_compiler.paths import specs_dir
+from assistive_compiler.paths import display, specs_dir
 from assistive_compiler.runtime.env import AssistiveEnv
 
 DATA = Path(__file__).parent / "data" / "byo"
@@ -61,7 +62,7 @@ def test_it_runs_behind_gymnasium(compiled):
     for _ in range(20):
         obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
     assert obs.shape == (25,) and np.isfinite(obs).all() and np.isfinite(reward)
-    assert env.manifest.gym_id == "assistive_compiler/FeedingKukaIiwa-v1"
+    assert env.manifest.gym_id == "assistive_compiler/Task-v1"  # not a shipped task: made with spec= and robot=
     env.close()
 
 
@@ -71,8 +72,29 @@ def test_unreachable_goals_fail_naming_robot_and_goal(tmp_path):
     with pytest.raises(SpecError) as info:
         compile_task(bad, "kuka_iiwa", tmp_path / "out", library=library)
     [problem] = info.value.problems
-    assert problem.message.startswith("robot 'kuka_iiwa' reaches the start pose from none of 10 sampled base poses")
+    # Why, and located at the base search in force (the task's here).
+    assert str(problem.location) == f"{display(bad)}:6:16"
+    assert re.fullmatch(r"robot 'kuka_iiwa' reaches the start pose from none of 10 sampled base poses: 10 left it out of reach "
+                        r"\(the closest the end effector came was 2\.\d\d m away\); set robot\.per_robot\.kuka_iiwa\.base_offset_m or "
+                        r"widen robot\.base_search \(x_range_m, y_range_m, yaw_noise_deg\)", problem.message), problem.message
     assert not (tmp_path / "out").exists()
+
+
+def test_a_failed_search_is_located_at_the_per_robot_search_in_force_and_names_what_the_base_hit(tmp_path):
+    """A search that puts the base inside the wheelchair: the samples are blocked, by the wheelchair,
+    and the error points at the robot's own base_search (not the task's, an anchor or a parent)."""
+    library = Library([DATA / "specs", specs_dir()])
+    path = tmp_path / "feeding_kuka.yaml"
+    path.write_text(f"extends: {FEEDING}\nrobot:\n  supported: [jaco, kuka_iiwa]\n  per_robot:\n    kuka_iiwa:\n"
+                    "      base_offset_m: [0.0, 0.0, 0.0]\n"
+                    "      base_search: {attempts: 6, origin_m: [0.0, 0.0, 0.0], x_range_m: [-0.02, 0.02], y_range_m: [-0.02, 0.02]}\n")
+    with pytest.raises(SpecError) as info:
+        compile_task(path, "kuka_iiwa", tmp_path / "out", library=library)
+    [problem] = info.value.problems
+    assert str(problem.location) == f"{display(path)}:7:20"
+    assert problem.message.startswith("robot 'kuka_iiwa' reaches the start pose from none of 6 sampled base poses: 6 put the robot "
+                                      "(arm at rest) against "), problem.message
+    assert "widen robot.per_robot.kuka_iiwa.base_search (x_range_m" in problem.message
 
 
 def test_robot_control_defaults_apply_unless_the_task_sets_them(tmp_path):

@@ -360,3 +360,24 @@ def test_a_closed_pipe_ends_the_cli_quietly():
     stderr = proc.stderr.read().decode()
     assert proc.wait(timeout=60) == 0
     assert "Traceback" not in stderr
+
+
+def test_compile_of_a_spec_that_is_not_shipped_names_the_id_gymnasium_makes_it_with(tmp_path, capsys, monkeypatch):
+    """Only shipped tasks have ids of their own; any other spec is made by ``assistive_compiler/Task-v1``
+    with ``spec=`` and ``robot=`` (the id compile printed before, built from the title, did not exist)."""
+    import gymnasium as gym
+
+    child = tmp_path / "my_feeding.yaml"
+    child.write_text("extends: shipped:tasks/feeding.yaml\nname: my_feeding\n")
+    assert main(["compile", str(child), "--robot", "jaco", "--out", str(tmp_path / "a")]) == 0
+    out = capsys.readouterr().out
+    assert "id assistive_compiler/Task-v1," in out
+    assert f'not a shipped task: gym.make("assistive_compiler/Task-v1", spec="{child}", robot="jaco") makes it' in out
+    monkeypatch.setenv("ASSISTIVE_COMPILER_CACHE", str(tmp_path / "cache"))
+    env = gym.make("assistive_compiler/Task-v1", spec=str(child), robot="jaco")
+    try:
+        obs, _ = env.reset(seed=0)
+        assert env.unwrapped.manifest.task == "my_feeding" and obs.shape == env.observation_space.shape
+        assert (tmp_path / "cache").is_dir() and [p.name.startswith("my_feeding-") for p in (tmp_path / "cache").iterdir()] == [True]
+    finally:
+        env.close()

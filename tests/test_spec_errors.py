@@ -719,3 +719,15 @@ def test_references_left_dangling_by_a_child_are_reported_where_inherited_with_t
     assert (f"{feeding_location('relative_to: ', len('relative_to: '))}: unknown particle or marker set 'food'; expected one of none "
             f"(success.relative_to is inherited from {display(FEEDING)}; override it in {display(child)}, "
             "or remove it there with $delete / $replace)") in err.splitlines()
+
+
+def test_a_value_used_through_an_alias_is_located_at_the_alias_and_its_insides_at_the_anchor():
+    """The robot's own base_search written as ``*wide`` is in force at the alias; a key inside it
+    was written at the anchor."""
+    text = ("search: &wide {attempts: 5, x_range_m: [0, 1]}\n"
+            "robot:\n  per_robot:\n    jaco:\n      base_search: *wide\n")
+    data, smap = loads_located(text, "t.yaml")
+    assert data["robot"]["per_robot"]["jaco"]["base_search"] == {"attempts": 5, "x_range_m": [0, 1]}
+    assert str(smap.value(("robot", "per_robot", "jaco", "base_search"))) == "t.yaml:5:20"
+    assert str(smap.value(("robot", "per_robot", "jaco", "base_search", "attempts"))) == "t.yaml:1:26"
+    assert str(smap.value(("search",))) == "t.yaml:1:9"

@@ -50,7 +50,7 @@ def test_readme_walkthrough_runs_through_the_cli_outside_the_package(tmp_path):
         outputs.append(out)
     assert "ok (task 'long_scratch', robots: jaco, panda)" in outputs[0]
     assert "long_scratch for jaco" in outputs[1]
-    assert "LongScratchJaco" in outputs[2]
+    assert "long_scratch for jaco  policy=scripted" in outputs[2]  # a user's spec has no id of its own (it is made as Task-v1)
     assert (tmp_path / "long_scratch.png").stat().st_size > 10_000
     tool = (tmp_path / "build" / "long_scratch" / "urdf")
     urdf = next(p for p in tool.glob("*.urdf") if "long_scratcher" in p.read_text())
@@ -68,6 +68,10 @@ def test_a_library_outside_the_spec_folder_is_found_with_library_and_the_environ
     assert status == 2 and "unknown tool 'long_scratcher'" in err
     status, out, err = cli("validate", spec, "--library", str(parts), cwd=tmp_path)
     assert status == 0, err
+    # One folder too high: the message names the folders it looked in and the one that has tools/.
+    status, _, err = cli("validate", spec, "--library", str(parts.parent), cwd=tmp_path)
+    assert status == 2 and "unknown tool 'long_scratcher'" in err
+    assert "(looked in elsewhere/tools/ (no such folder), " in err and "; elsewhere/parts/ holds tools/: use it as the library)" in err, err
     status, out, err = cli("validate", spec, cwd=tmp_path, env={LIBRARY_ENV: str(parts)})
     assert status == 0, err
     status, _, err = cli("validate", spec, "--library", str(tmp_path / "nope"), cwd=tmp_path)
@@ -80,7 +84,7 @@ def test_python_make_finds_the_same_parts(tmp_path, monkeypatch):
     project = write_project(tmp_path)
     monkeypatch.chdir(tmp_path)
     env = assistive_compiler.make(project / "specs" / "tasks" / "long_scratch.yaml", "jaco", out_dir=tmp_path / "out")
-    assert env.manifest.gym_id == "assistive_compiler/LongScratchJaco-v1"
+    assert env.manifest.gym_id == "assistive_compiler/Task-v1" and env.manifest.label == "long_scratch for jaco"
     assert any(b.name == "scratcher" and "long_scratcher" in (tmp_path / "out" / b.urdf).read_text() for b in env.manifest.bodies)
     env.close()
 

@@ -74,7 +74,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             return rollout(player, policy, seed)
     weights = {t.name: t.weight for t in env.manifest.reward}
     episodes = []
-    with progress(f"{env.manifest.gym_id} {label}", args.episodes, enabled=not args.quiet) as tracker:
+    with progress(f"{env.manifest.label} {label}", args.episodes, enabled=not args.quiet) as tracker:
         for k in range(args.episodes):
             e = play(args.seed + k)
             episodes.append(e)
@@ -89,7 +89,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                           "mean_return": float(np.mean([e["return"] for e in episodes]))}, indent=1))
         return EXIT_OK
     human = f"  human-policy={args.human_policy}" if args.coop else ""
-    print(f"{env.manifest.gym_id}  policy={args.policy}{human}  episodes={len(episodes)}  seed={args.seed}")
+    print(f"{env.manifest.label}  policy={args.policy}{human}  episodes={len(episodes)}  seed={args.seed}")
     rows = []
     for k, e in enumerate(episodes):
         top = sorted(e["terms"].items(), key=lambda kv: -abs(weights[kv[0]] * kv[1]))[:3]

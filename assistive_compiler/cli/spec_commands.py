@@ -49,11 +49,15 @@ def cmd_compile(args: argparse.Namespace) -> int:
         if failures:
             print("\n".join(failures), file=sys.stderr)
             return EXIT_FAILED
+    from ..registration import TASK_ID
+
     state = "up to date (cache hit)" if result.cache_hit else "compiled"
     print(
         f"{state}: {m.task} for {m.robot_name} -> {result.out_dir}/ "
         f"({len(m.bodies)} bodies, id {m.gym_id}, content {m.content_hash[:12]}) in {result.seconds:.2f} s"
     )
+    if m.gym_id == TASK_ID:  # not a shipped task: say how Gymnasium makes it
+        print(f'  not a shipped task: gym.make("{TASK_ID}", spec="{args.spec}", robot="{m.robot_name}") makes it')
     return EXIT_OK
 
 

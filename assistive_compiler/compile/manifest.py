@@ -27,9 +27,12 @@ from .weld import gripper
 from .task import impairment_joints, policy_joints, rounded
 
 
-def gym_id(task_title: str, robot_title: str) -> str:
-    """``assistive_compiler/<Task><Robot>-v1`` (e.g. FeedingJaco-v1)."""
-    return f"assistive_compiler/{task_title.replace(' ', '')}{robot_title}-v1"
+def gym_id(rt: ResolvedTask) -> str:
+    """The Gymnasium id that makes this env: a shipped task's own (``assistive_compiler/FeedingJaco-v1``),
+    else the id every other spec is made with, ``assistive_compiler/Task-v1`` (with ``spec=`` and ``robot=``)."""
+    from ..registration import TASK_ID, shipped_gym_id
+
+    return shipped_gym_id(rt.loaded.path, rt.spec.name, rt.robot_name) or TASK_ID
 
 
 def build_manifest(rt: ResolvedTask, *, bodies, variants, tools, particles, garments, arm_joints, lower, upper,
@@ -38,7 +41,7 @@ def build_manifest(rt: ResolvedTask, *, bodies, variants, tools, particles, garm
     spec = rt.spec
     robot_part = rt.robot.part
     return Manifest(
-        task=spec.name, title=spec.title, robot_name=rt.robot_name, gym_id=gym_id(spec.title, robot_part.title), input_hash="",
+        task=spec.name, title=spec.title, robot_name=rt.robot_name, gym_id=gym_id(rt), input_hash="",
         sources=[display(f) for f in rt.loaded.files],
         sim=Sim(time_step=spec.sim.time_step_s, frame_skip=spec.sim.frame_skip, episode_steps=spec.sim.episode_steps,
                 gravity=spec.sim.gravity_mps2, sub_steps=spec.sim.solver.sub_steps, solver_iterations=spec.sim.solver.iterations,

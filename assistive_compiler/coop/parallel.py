@@ -59,7 +59,9 @@ class AssistiveParallelEnv(ParallelEnv):
         #: The single-agent env underneath (the same world; its ``step`` is the static person's task).
         self.env = env
         m = env.manifest
-        self.metadata = {**type(self).metadata, "name": coop_name(m.gym_id)}
+        from ..registration import TASK_ID
+
+        self.metadata = {**type(self).metadata, "name": coop_name(m.gym_id) if m.gym_id != TASK_ID else f"{m.task}_{m.robot_name}_human"}
         self.render_mode = render_mode
         self.possible_agents: list[str] = list(AGENTS)
         self.agents: list[str] = []

@@ -23,7 +23,7 @@ def check_supported(s: Scope) -> None:
     spec = s.spec
     for i, name in enumerate(spec.robot.supported):
         if not s.lib.path_of("robots", name):
-            s.problem(("robot", "supported", i), f"unknown robot '{name}'; {expected(s.lib.names('robots'), name)}")
+            s.problem(("robot", "supported", i), f"unknown robot '{name}'; {expected(s.lib.names('robots'), name)}{s.lib.searched('robots')}")
     if s.robot_name not in spec.robot.supported:
         # Located at the list that decides (robot.supported), wherever it was written.
         s.problem(("robot", "supported"), f"robot '{s.robot_name}' is not supported by task '{spec.name}'; supported: "

@@ -56,7 +56,7 @@ class Scope(Collector):
         try:
             return self.lib.get(kind, name)
         except KeyError:
-            self.problem(path, f"unknown {what} '{name}'; {expected(self.lib.names(kind), name)}")
+            self.problem(path, f"unknown {what} '{name}'; {expected(self.lib.names(kind), name)}{self.lib.searched(kind)}")
         except SpecError as exc:
             self.problems.extend(exc.problems)
         return None

@@ -88,7 +88,7 @@ def train(spec: str, *, robot: str | None, config_path: str, coop: bool = False,
     if not quiet:
         from .progress import print_reward_table
 
-        print(f"{manifest.gym_id}{' + human (co-optimisation)' if coop else ''}: {engine} {config.algorithm.upper()}, {config.envs} envs, "
+        print(f"{manifest.label}{' + human (co-optimisation)' if coop else ''}: {engine} {config.algorithm.upper()}, {config.envs} envs, "
               f"{config.total_steps:,} steps -> {display(run.path)}", file=sys.stderr)
         print_reward_table(weights, manifest.task)
     with stop_on_signals() as stop:
@@ -154,7 +154,7 @@ def finish(run: RunDir, manifest, engine: str, config: TrainingConfig, figures: 
         "checkpoint": display(run.latest_checkpoint()[1]) if run.latest_checkpoint() else None,
     }
     if curve:
-        plot_curves({run.path.name: curve}, run.curve_png, title=manifest.gym_id)
+        plot_curves({run.path.name: curve}, run.curve_png, title=manifest.label)
         summary["learning_curve"] = display(run.curve_png)
     run.write_summary(summary)
     return summary

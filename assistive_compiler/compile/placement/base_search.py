@@ -9,6 +9,7 @@ the ``keep`` best sampled base poses ((position, orientation), goals reached, Σ
 from __future__ import annotations
 
 import math
+from collections import Counter
 
 import numpy as np
 
@@ -77,11 +78,15 @@ def search_base(rt: ResolvedTask, arms: list, goals, offset, rng, carry: Carried
     z = (carry.height if carry is not None else rt.robot.part.base_height_m) + (offset[2] if len(offset) > 2 else 0.0)
     found = []
     required_misses = np.zeros(len(goals), dtype=int)
+    blocked: Counter = Counter()  # samples whose base (arm at rest) touched a body, by body
+    misses: list[list] = [[] for _ in goals]  # per goal: why IK missed it, per sample
     for _ in range(search.attempts):
         xy = anchor + [rng.uniform(*search.x_range_m), rng.uniform(*search.y_range_m)]
         yaw = math.radians(search.yaw_deg + rt.robot.part.facing_yaw_deg + rng.uniform(-search.yaw_noise_deg, search.yaw_noise_deg))
         pos, orn = (float(xy[0]), float(xy[1]), float(z)), quat_from_rpy((0.0, 0.0, yaw))
-        if not _base_clear(arms, pos, orn, carry):
+        touched = _base_blocked_by(arms, pos, orn, carry)
+        if touched is not None:
+            blocked[touched] += 1
             continue
         first = goals[0][4]
         if first.frozen:  # a mobile base drives from the sample to where its arm reaches the start pose
@@ -92,6 +97,7 @@ def search_base(rt: ResolvedTask, arms: list, goals, offset, rng, carry: Carried
             if q is None:
                 if required:
                     required_misses[k] += 1
+                    misses[k].append(kin.miss)
                     ok = False
                     break
                 continue
@@ -101,22 +107,59 @@ def search_base(rt: ResolvedTask, arms: list, goals, offset, rng, carry: Carried
             found.append(((pos, orn), reached, score))
     if not found:
         worst = int(np.argmax(required_misses))
-        raise fail(rt, ("robot", "base_search"), f"robot '{rt.robot_name}' reaches {goals[worst][3]} from none of {search.attempts} sampled base poses (set robot.per_robot.{rt.robot_name}.base_offset_m or widen base_search)")
+        own = rt.spec.robot.per_robot.get(rt.robot_name)
+        in_force = ("robot", "per_robot", rt.robot_name, "base_search") if own is not None and own.base_search is not None else ("robot", "base_search")
+        raise fail(rt, in_force, f"robot '{rt.robot_name}' reaches {goals[worst][3]} from none of {search.attempts} sampled base poses: "
+                                 f"{_why(blocked, misses[worst], search.attempts)}; set robot.per_robot.{rt.robot_name}.base_offset_m "
+                                 f"or widen {'.'.join(in_force)} (x_range_m, y_range_m, yaw_noise_deg)")
     found.sort(key=lambda f: (-f[1], -f[2]))
     return found[: search.keep]
 
 
-def _base_clear(arms: list, pos, orn, carry: Carried | None) -> bool:
-    """Place the base (and any carried furniture) at (pos, orn), the arms at rest; whether the
-    robot and the carried furniture clear the person and the other furniture there."""
+def _why(blocked: Counter, misses: list, attempts: int) -> str:
+    """What stopped the samples: bases against a body, then the goal's IK misses by reason (out of
+    reach with the closest approach, a wrong orientation, or reached in collision)."""
+    parts = []
+    if blocked:
+        parts.append(f"{sum(blocked.values())} put the robot (arm at rest) against {_names(blocked)}")
+    kinds = Counter(m.kind for m in misses if m is not None)
+    if kinds["out of reach"]:
+        closest = min(m.distance_m for m in misses if m is not None and m.kind == "out of reach")
+        parts.append(f"{kinds['out of reach']} left it out of reach (the closest the end effector came was {closest:.2f} m away)")
+    if kinds["orientation"]:
+        best = min(m.angle_deg for m in misses if m is not None and m.kind == "orientation")
+        parts.append(f"{kinds['orientation']} reached it only at the wrong orientation (at best {best:.0f}° off, 3° allowed)")
+    if kinds["collision"]:
+        parts.append(f"{kinds['collision']} reached it only in collision with {_names(Counter(m.body for m in misses if m is not None and m.kind == 'collision'))}")
+    others = attempts - sum(blocked.values()) - len(misses)
+    if others > 0:
+        parts.append(f"{others} missed another goal")
+    return "; ".join(parts) or "no sample was tried"
+
+
+def _names(counts: Counter) -> str:
+    return ", ".join(f"{name} ({n})" for name, n in counts.most_common())
+
+
+def _base_blocked_by(arms: list, pos, orn, carry: Carried | None) -> str | None:
+    """Place the base (and any carried furniture) at (pos, orn), the arms at rest; the body that
+    the robot or the carried furniture touches there (its URDF name), or None when they clear the
+    person and the other furniture."""
     arm = arms[0]
+    pc = arm.pc
     arm.place(pos, orn)
     for a in arms:
         a.set_arm(a.rest)
     if carry is not None:
         carry.place(pos, orn)
-        if any(arm.pc.touching(carry.body, o) for o in arm.obstacles if o != carry.body) or arm.pc.touching(carry.body, arm.person):
-            return False
+        for o in arm.obstacles:
+            if o != carry.body and pc.touching(carry.body, o):
+                return pc.body_name(o)
+        if pc.touching(carry.body, arm.person):
+            return "person"
     # The base must clear the scene at the arm's rest pose; its own carried mount is checked per IK solution
     # only (a folded arm may rest against the mount's top, which says nothing about the base pose).
-    return not (any(arm.pc.touching(arm.robot, o) for o in arm.obstacles if carry is None or o != carry.body) or arm.pc.touching(arm.robot, arm.person))
+    for o in arm.obstacles:
+        if (carry is None or o != carry.body) and pc.touching(arm.robot, o):
+            return pc.body_name(o)
+    return "person" if pc.touching(arm.robot, arm.person) else None

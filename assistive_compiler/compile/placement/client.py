@@ -64,6 +64,10 @@ class PlacementClient:
         com_pos, com_orn = p.multiplyTransforms(pos, orn, inertial_pos, inertial_orn)
         p.resetBasePositionAndOrientation(body, com_pos, com_orn, physicsClientId=c)
 
+    def body_name(self, body: int) -> str:
+        """The name a loaded body's URDF gives it (``<robot name=...>``)."""
+        return self.p.getBodyInfo(body, physicsClientId=self.client)[1].decode()
+
     def touching(self, a: int, b: int, margin: float = 0.0) -> bool:
         return bool(self.p.getClosestPoints(a, b, margin, physicsClientId=self.client))
 

@@ -19,6 +19,15 @@ from ..task import start_for
 from .client import PlacementClient
 
 
+class Miss:
+    """Why IK found no configuration for a goal: ``kind`` 'out of reach' (the end effector ended
+    ``distance_m`` from it), 'orientation' (there, but ``angle_deg`` off) or 'collision' (there,
+    but touching ``body``)."""
+
+    def __init__(self, kind: str, distance_m: float = 0.0, angle_deg: float = 0.0, body: str = ""):
+        self.kind, self.distance_m, self.angle_deg, self.body = kind, distance_m, angle_deg, body
+
+
 class ArmKinematics:
     """IK, collision checks and JLWKI for one arm in the compile-time world."""
 
@@ -42,6 +51,7 @@ class ArmKinematics:
         self.groups = [[self.cols[k]] + [self.movable.index(f) for f, lead in self.followers.items() if lead == k] for k in range(len(arm_idx))]
         self.frozen = frozen or []
         self.damping = ik_damping(self.movable, self.frozen)
+        self.miss: Miss | None = None
 
     def place(self, pos, orn) -> None:
         self.pc.place(self.robot, pos, orn)
@@ -59,6 +69,7 @@ class ArmKinematics:
         p, c = self.pc.p, self.pc.client
         orn = tool_orn if tool_orn is not None else (0, 0, 0, 1)
         ee_pos, ee_orn = p.multiplyTransforms(tool_pos, orn, *self.tool_inv)
+        self.miss = None  # why the last call returned None (see :class:`Miss`)
         for attempt in range(tries):
             arm_rest = list(self.rest) if attempt == 0 else list(rng.uniform(self.lower, self.upper))
             rest = [p.getJointState(self.robot, j, physicsClientId=c)[0] for j in self.movable]
@@ -73,14 +84,27 @@ class ArmKinematics:
                 q = [min(max(float(np.mean([sol[k] for k in group])), l), u) for group, l, u in zip(self.groups, self.lower, self.upper)]
                 self.set_arm(q)
             got_pos, got_orn = self.pc.link_pose(self.robot, self.ee_link)
-            if np.linalg.norm(np.subtract(got_pos, ee_pos)) >= 0.01:
+            distance = float(np.linalg.norm(np.subtract(got_pos, ee_pos)))
+            if distance >= 0.01:
+                self._note(Miss("out of reach", distance_m=distance))
                 continue
             if tool_orn is not None and quat_angle(got_orn, ee_orn) >= math.radians(3):
+                self._note(Miss("orientation", angle_deg=math.degrees(quat_angle(got_orn, ee_orn))))
                 continue
-            if self.collides(tool_pos, orn, check_tool=not tool_may_touch):
+            touched = self.collision_with(tool_pos, orn, check_tool=not tool_may_touch)
+            if touched is not None:
+                self._note(Miss("collision", body=touched))
                 continue
             return q
         return None
+
+    def _note(self, miss: "Miss") -> None:
+        """Keep the most telling reason of one ``reach`` call: a collision or a wrong orientation
+        (the tool got there) over out of reach, and the closest of the misses by distance."""
+        rank = {"collision": 0, "orientation": 1, "out of reach": 2}
+        old = self.miss
+        if old is None or rank[miss.kind] < rank[old.kind] or (miss.kind == old.kind == "out of reach" and miss.distance_m < old.distance_m):
+            self.miss = miss
 
     def drive_to(self, base_pos, base_orn, tool_pos, tool_orn) -> tuple[tuple, tuple]:
         """A mobile base's pose near (``base_pos``, ``base_orn``) from which the arm reaches the tool
@@ -104,14 +128,22 @@ class ArmKinematics:
         return tuple(pos), tuple(orn)
 
     def collides(self, tool_pos, tool_orn, check_tool: bool = True) -> bool:
+        return self.collision_with(tool_pos, tool_orn, check_tool) is not None
+
+    def collision_with(self, tool_pos, tool_orn, check_tool: bool = True) -> str | None:
+        """The body the arm (or, with ``check_tool``, the tool at its pose) touches first, by the
+        name its URDF gives it ('robot' → 'person' for the tool), or None when clear."""
         touching = self.pc.touching
-        if any(touching(self.robot, o) for o in self.obstacles) or (self.person is not None and touching(self.robot, self.person)):
-            return True
+        for o in self.obstacles:
+            if touching(self.robot, o):
+                return self.pc.body_name(o)
+        if self.person is not None and touching(self.robot, self.person):
+            return "person"
         for tid in self.tool_ids.values() if check_tool else ():
             self.pc.place(tid, tool_pos, tool_orn)
             if self.person is not None and touching(tid, self.person):
-                return True
-        return False
+                return "person (the tool)"
+        return None
 
     def jlwki(self, q) -> float:
         """Joint-limit-weighted kinematic isotropy at ``q`` (paper §III-D: φ = 0.5, λ = 0.05)."""
