@@ -227,6 +227,22 @@ def test_scripted_per_robot_step_m_replaces_the_look_ahead_of_straight_line_wayp
     assert [w.get("step_m") for w in panda["waypoints"]] == [None, 0.12]
 
 
+def test_scripted_step_m_is_accepted_in_the_task_own_script_too(tmp_path):
+    """step_m in the task's own scripted: section replaces its straight-line waypoints' look-ahead,
+    as it does in a robot's own script (it used to be refused there); a robot's own script keeps
+    its own."""
+    from assistive_compiler.resolve import resolve
+    from assistive_compiler.spec.load import load_spec
+
+    path = tmp_path / "ahead.yaml"
+    path.write_text(f"extends: {TASKS / 'feeding.yaml'}\nscripted:\n  step_m: 0.09\n  waypoints:\n"
+                    "    - {to: mouth, offset_m: [0, -0.1, 0]}\n    - {to: mouth, offset_m: [0, -0.05, 0], step_m: 0.02}\n")
+    loaded = load_spec(path)
+    assert loaded.spec.scripted.step_m == 0.09
+    own = resolve(loaded, "jaco").scripted
+    assert [w.get("step_m") for w in own["waypoints"]] == [None, 0.09]
+
+
 class _capture:
     """Collect what the CLI prints on stderr."""
 

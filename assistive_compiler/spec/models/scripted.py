@@ -122,6 +122,11 @@ class Scripted(Strict):
     repeat_from: int | None = Field(
         None, ge=0, description="After the last waypoint, go on from this index (e.g. to rub back and forth); None holds the last."
     )
+    step_m: float | None = Field(
+        None, gt=0, le=0.5, description="Replaces the step_m of each of these waypoints that has one (those spliced in from "
+        "segments too): how far ahead of the moved point IK aims along a straight line, metres. A robot's own script "
+        "(per_robot.<robot>) uses its own step_m instead. None: each waypoint's own."
+    )
     left: ScriptedArm | None = Field(
         None, description="The left arm's waypoints when the robot acts with both arms (robot.arm: both, a two-arm robot); "
         "move/waypoints then drive the right arm. Ignored on one-arm robots."
