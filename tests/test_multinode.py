@@ -23,6 +23,8 @@ from pathlib import Path
 import pytest
 
 pytest.importorskip("ray", reason='needs the "train" extra (README: Training); CI installs it')
+# Ray clusters run one at a time: under pytest-xdist every Ray test goes to the same worker.
+pytestmark = pytest.mark.xdist_group("ray")
 
 REPO = Path(__file__).resolve().parents[1]
 FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"

@@ -13,6 +13,8 @@ import pytest
 from PIL import Image
 
 pytest.importorskip("ray", reason='needs the "train" extra (README: Training); CI installs it')
+# Ray clusters run one at a time: under pytest-xdist every Ray test goes to the same worker.
+pytestmark = pytest.mark.xdist_group("ray")
 
 from assistive_compiler.cli import main
 from assistive_compiler.training.evaluate import evaluate

@@ -11,6 +11,7 @@ byte-identical output. The stages, in order, are listed in :mod:`assistive_compi
 from __future__ import annotations
 
 import hashlib
+import errno
 import os
 import shutil
 import tempfile
@@ -136,6 +137,13 @@ def _replace_dir(new: Path, out: Path) -> None:
         old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
         os.rmdir(old)
         os.rename(out, old)
-    os.rename(new, out)
+    try:
+        os.rename(new, out)
+    except OSError as exc:
+        # Another process (a vector env's workers making the same id at once, parallel tests) put
+        # the same compile there first: keep its result (the same inputs give the same files).
+        if exc.errno not in (errno.ENOTEMPTY, errno.EEXIST) or not (out / "manifest.json").is_file():
+            raise
+        shutil.rmtree(new, ignore_errors=True)
     if old is not None:
         shutil.rmtree(old, ignore_errors=True)
