@@ -74,6 +74,62 @@ def _wait_for_port(port: int, seconds: float = 60) -> None:
     raise TimeoutError(f"nothing listens on port {port} after {seconds} s")
 
 
+class Cluster:
+    """A Ray head without CPUs and worker nodes with 2 CPUs each, every worker in a private mount
+    namespace where ``hidden`` (the driver's run directories and cache) is an empty tmpfs. Its own
+    processes only, stopped by their process groups."""
+
+    def __init__(self, root: Path):
+        self.root, self.hidden = root, root / "hidden"
+        home = root / "home"
+        (home / ".ray").mkdir(parents=True)
+        (home / ".ray" / "auth_token").write_text("c" * 64)
+        self.hidden.mkdir()
+        self.env = {k: v for k, v in os.environ.items() if not k.startswith("RAY_")}
+        self.env.update(HOME=str(home), RAY_AUTH_MODE="token")
+        self.port = _free_port()
+        self.address = f"127.0.0.1:{self.port}"
+        self.ray_cli = [sys.executable, "-m", "ray.scripts.scripts", "start", "--block", "--object-store-memory=150000000"]
+        self.temp = tempfile.mkdtemp(prefix="rayt-", dir="/tmp")  # short (Unix socket paths); keeps the address file out of /tmp/ray
+        self.log = root / "ray.log"
+        self.procs: list[subprocess.Popen] = []
+        self._start(self.ray_cli + ["--head", f"--port={self.port}", "--num-cpus=0", "--include-dashboard=false", f"--temp-dir={self.temp}"])
+        _wait_for_port(self.port)
+
+    @property
+    def driver_env(self) -> dict:
+        return {**self.env, "ASSISTIVE_COMPILER_CACHE": str(self.hidden / "cache")}
+
+    def _start(self, command: list[str]) -> subprocess.Popen:
+        with self.log.open("a") as out:
+            proc = subprocess.Popen(command, env=self.env if command[0] != "unshare" else {**self.env, "ASSISTIVE_COMPILER_CACHE": str(self.hidden / "worker-cache")},
+                                    stdout=out, stderr=out, start_new_session=True)
+        self.procs.append(proc)
+        return proc
+
+    def add_worker(self) -> subprocess.Popen:
+        """A worker node with 2 CPUs that cannot see ``hidden``; returns once the head counts it."""
+        worker_cmd = " ".join(self.ray_cli + [f"--address={self.address}", "--num-cpus=2"])
+        worker = self._start(["unshare", "--mount", "--propagation", "private", "sh", "-c",
+                              f"mount -t tmpfs tmpfs {self.hidden} && exec {worker_cmd}"])
+        _wait_for_worker_node(self.port, self.env, self.log)
+        return worker
+
+    def kill(self, proc: subprocess.Popen) -> None:
+        """The node dies at once: SIGKILL to its whole process group (raylet and its workers)."""
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=60)
+
+    def stop(self) -> None:
+        for proc in reversed(self.procs):
+            if proc.poll() is None:
+                os.killpg(proc.pid, signal.SIGTERM)
+        for proc in self.procs:
+            proc.wait(timeout=60)
+        forget_cluster(self.port)
+        shutil.rmtree(self.temp, ignore_errors=True)
+
+
 @pytest.fixture(scope="module")
 def cluster(tmp_path_factory):
     """(address, hidden folder, env for the driver): a head node without CPUs and a worker node
@@ -82,42 +138,16 @@ def cluster(tmp_path_factory):
     reason = _namespaces_work(root)
     if reason:
         pytest.skip(reason)
-    home, hidden = root / "home", root / "hidden"
-    (home / ".ray").mkdir(parents=True)
-    (home / ".ray" / "auth_token").write_text("c" * 64)
-    hidden.mkdir()
-    env = {k: v for k, v in os.environ.items() if not k.startswith("RAY_")}
-    env.update(HOME=str(home), RAY_AUTH_MODE="token")
-    port = _free_port()
-    ray_cli = [sys.executable, "-m", "ray.scripts.scripts", "start", "--block", "--object-store-memory=150000000"]
-    temp = tempfile.mkdtemp(prefix="rayt-", dir="/tmp")  # short (Unix socket paths); keeps the address file out of /tmp/ray
-    log = root / "ray.log"
-    with log.open("w") as out:
-        head = subprocess.Popen(ray_cli + ["--head", f"--port={port}", "--num-cpus=0", "--include-dashboard=false", f"--temp-dir={temp}"], env=env,
-                                stdout=out, stderr=out,
-                                start_new_session=True)
-        procs = [head]
-        try:
-            _wait_for_port(port)
-            worker_cmd = " ".join(ray_cli + [f"--address=127.0.0.1:{port}", "--num-cpus=2"])
-            worker_env = {**env, "ASSISTIVE_COMPILER_CACHE": str(hidden / "worker-cache")}
-            worker = subprocess.Popen(["unshare", "--mount", "--propagation", "private", "sh", "-c",
-                                       f"mount -t tmpfs tmpfs {hidden} && exec {worker_cmd}"],
-                                      env=worker_env, stdout=out, stderr=out, start_new_session=True)
-            procs.append(worker)
-            _wait_for_worker_node(port, env, log)
-            yield f"127.0.0.1:{port}", hidden, {**env, "ASSISTIVE_COMPILER_CACHE": str(hidden / "cache")}
-        finally:
-            for proc in reversed(procs):
-                os.killpg(proc.pid, signal.SIGTERM)
-            for proc in procs:
-                proc.wait(timeout=60)
-            forget_cluster(port)
-            shutil.rmtree(temp, ignore_errors=True)
+    c = Cluster(root)
+    try:
+        c.add_worker()
+        yield c.address, c.hidden, c.driver_env
+    finally:
+        c.stop()
 
 
 def _wait_for_worker_node(port: int, env: dict, log: Path, seconds: float = 90) -> None:
-    """Until the head counts 2 CPUs (the worker node's); fails with the nodes' log otherwise."""
+    """Until the head counts 2 CPUs (a worker node's); fails with the nodes' log otherwise."""
     probe = ("import ray, time, sys\n"
              f"ray.init(address='127.0.0.1:{port}', log_to_driver=False)\n"
              f"deadline = time.time() + {seconds}\n"
@@ -149,3 +179,46 @@ def test_train_on_a_worker_that_cannot_see_the_drivers_files(cluster, coop, tmp_
                                 env=env, capture_output=True, text=True, timeout=300, cwd=REPO)
     assert evaluation.returncode == 0, evaluation.stderr[-3000:]
     assert json.loads(evaluation.stdout)["coop"] is coop
+
+
+@pytest.mark.slow
+def test_a_worker_node_lost_mid_run_stops_with_a_checkpoint_and_resume_finishes(tmp_path):
+    """The only worker node dies (SIGKILL to its raylet and env runners) during a run: training
+    stops with a checkpoint and says why instead of waiting for a node; with a new worker node,
+    --resume goes on from that checkpoint and finishes."""
+    reason = _namespaces_work(tmp_path)
+    if reason:
+        pytest.skip(reason)
+    c = Cluster(tmp_path)
+    try:
+        worker = c.add_worker()
+        config = tmp_path / "long.yaml"
+        config.write_text(TINY.replace("total_steps: 200", "total_steps: 1000000"))
+        out = c.hidden / "run"
+        command = [sys.executable, "-m", "assistive_compiler.cli", "train", str(FEEDING), "--robot", "jaco", "--config", str(config),
+                   "--engine", "rllib", "--address", c.address, "--out", str(out), "--quiet", "--json"]
+        driver = subprocess.Popen(command, env=c.driver_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO)
+        try:
+            deadline = time.time() + 240
+            while not list((out / "checkpoints").glob("step_*")) and time.time() < deadline and driver.poll() is None:
+                time.sleep(1)
+            assert list((out / "checkpoints").glob("step_*")), "no checkpoint before the node was killed"
+            c.kill(worker)
+            stdout, stderr = driver.communicate(timeout=240)
+        finally:
+            if driver.poll() is None:
+                driver.kill()
+        assert driver.returncode == 130, stderr[-3000:]
+        assert "stopped: all 2 env runners were lost (the node they ran on died or left the cluster); checkpoint written: " \
+               "start a worker node again and run the same command with --resume" in stderr, stderr[-3000:]
+        summary = json.loads(stdout)
+        assert summary["interrupted"] and 200 <= summary["steps"] < 1_000_000
+        stopped_at = summary["steps"]
+        assert (out / "checkpoints" / f"step_{stopped_at:010d}" / "COMPLETE").is_file()
+
+        c.add_worker()
+        resumed = _train(c.address, out, c.driver_env, config, "--resume", "--steps", str(stopped_at + 200))
+        assert resumed.returncode == 0, resumed.stderr[-3000:]
+        assert json.loads(resumed.stdout)["steps"] >= stopped_at + 200
+    finally:
+        c.stop()

@@ -50,7 +50,8 @@ def cmd_train(args: argparse.Namespace) -> int:
                     address=args.address, quiet=args.quiet)
     print(json.dumps(summary, indent=1) if args.json else _summary_line(summary))
     if summary["interrupted"]:
-        print("interrupted: checkpoint written; continue with the same command and --resume", file=sys.stderr)
+        print(f"stopped: {summary['stopped_because']}" if summary.get("stopped_because") else
+              "interrupted: checkpoint written; continue with the same command and --resume", file=sys.stderr)
         return EXIT_INTERRUPTED
     return EXIT_OK
 

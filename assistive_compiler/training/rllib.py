@@ -15,6 +15,8 @@ filter); ``ppo.normalize_*`` are SB3's.
 
 from __future__ import annotations
 
+import math
+
 import os
 import socket
 import sys
@@ -237,7 +239,8 @@ def build_config(run: RunDir, config: TrainingConfig, weights: dict[str, float],
 
 def _record(progress: Progress, result: dict, weights: dict[str, float]) -> None:
     task = result.get("env_runners", {}).get("task", {})
-    n = int(task.get("episodes", 0))
+    episodes = float(task.get("episodes", 0) or 0)
+    n = int(episodes) if math.isfinite(episodes) else 0  # NaN: an iteration without episodes after a restore
     if n:
         terms = {name: task.get("terms", {}).get(name, 0.0) / n for name in weights}
         progress.episodes_summary(n, task["return"] / n, task["success"] / n, terms)
@@ -261,19 +264,28 @@ def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, coo
     if latest:
         algo.restore_from_path(str((latest[1] / "algo").resolve()))
     progress = Progress(run, weights, config.total_steps, start_steps, quiet=quiet)
-    steps, interrupted = start_steps, False
+    steps, interrupted, lost = start_steps, False, None
     every = config.checkpoint_every_steps
     next_checkpoint = (steps // every + 1) * every
     try:
         while steps < config.total_steps and not stop:
-            result = algo.train()
+            try:
+                result = algo.train()
+            except Exception:  # an iteration whose env runners all died under it (their node went away)
+                lost = env_runners_lost(algo, config)
+                if lost is None:
+                    raise
+                break
             steps += int(result["env_runners"]["num_env_steps_sampled"])
+            lost = env_runners_lost(algo, config)
+            if lost is not None:  # none left to sample with: stop here, resumable, rather than wait for a node
+                break
             _record(progress, result, weights)
             progress.update(steps)
             if steps >= next_checkpoint and steps < config.total_steps:
                 save_checkpoint(run, algo, steps)
                 next_checkpoint = (steps // every + 1) * every
-        interrupted = bool(stop)
+        interrupted = bool(stop) or lost is not None
     except KeyboardInterrupt:  # a second Ctrl-C: stop at once
         interrupted = True
     finally:
@@ -282,9 +294,23 @@ def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, coo
         rate = (steps - start_steps) / max(1e-9, wall - progress.wall_before)
         progress.close()
         algo.stop()
-    if not quiet and interrupted:
+    if not quiet and interrupted and lost is None:
         print("interrupted: checkpoint written", file=sys.stderr)
-    return {"steps": int(steps), "wall_s": wall, "steps_per_s_including_learning": rate, "interrupted": interrupted}
+    return {"steps": int(steps), "wall_s": wall, "steps_per_s_including_learning": rate, "interrupted": interrupted,
+            **({"stopped_because": lost} if lost is not None else {})}
+
+
+def env_runners_lost(algo, config: TrainingConfig) -> str | None:
+    """Why training cannot go on, when every remote env runner is gone (their node died or was
+    stopped): RLlib would wait for a node to restart them on (up to its restore timeout, 30 min).
+    None while one is healthy: RLlib then samples with those and restarts the others where it can."""
+    group = getattr(algo, "env_runner_group", None)
+    if config.envs <= 1 or group is None:
+        return None
+    if group.num_healthy_remote_env_runners() > 0:
+        return None
+    return (f"all {group.num_remote_env_runners()} env runners were lost (the node they ran on died or left the cluster); "
+            "checkpoint written: start a worker node again and run the same command with --resume")
 
 
 # --------------------------------------------------------------------------------------------
