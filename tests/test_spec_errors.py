@@ -408,8 +408,18 @@ def test_unknown_person_link(tmp_path, capsys):
         path,
         f"{at(text, 'person.haed')}: unknown link 'haed' of person; expected one of 'chest', 'head', 'head_x_link', "
         "'head_y_link', 'left_ankle', 'left_ankle_x_link', 'left_ankle_y_link', 'left_elbow', 'left_elbow_link', "
-        "'left_hip', 'left_hip_x_link', 'left_hip_y_link', ... (43 in all) (did you mean 'head'?)",
+        "'left_hip', 'left_hip_x_link', 'left_hip_y_link', ... (43 in all) (did you mean 'head'?); "
+        "all 43 links of the person and their frames: docs/person.md",
     )
+
+
+def test_a_body_part_by_its_everyday_name_names_the_link_that_is_it(tmp_path, capsys):
+    """There is no right_hand link: the hand is right_wrist (limbs are named after their top joint),
+    not the spelling-nearest 'right_ankle'."""
+    text = EXTENDS + "targets:\n  mouth:\n    link: person.right_hand\n"
+    path = write(tmp_path, text)
+    check(capsys, path, f"{at(text, 'person.right_hand')}: unknown link 'right_hand' of person; the hand is link 'right_wrist' "
+                        "(limb links are named after the joint at their top); all 43 links of the person and their frames: docs/person.md")
 
 
 def test_unknown_robot_link_in_term_param(tmp_path, capsys):
@@ -563,7 +573,7 @@ def test_scripted_per_robot_waypoints_are_checked_where_written(tmp_path, capsys
     path = write(tmp_path, text)
     lines = problems(capsys, path)
     assert len(lines) == 1 and lines[0].startswith(f"{display(path)}:{at(text, 'person.right_elbw')}: ") \
-        and "unknown link 'right_elbw' of person" in lines[0] and lines[0].endswith("(did you mean 'right_elbow'?)")
+        and "unknown link 'right_elbw' of person" in lines[0] and "(did you mean 'right_elbow'?); all 43 links of the person" in lines[0]
 
 
 SHIPPED_SEGMENTS = "'forearm_level', 'lane_40', 'onto_forearm', 'side_lanes'"  # the shipped bed-bathing spec's scripted.segments

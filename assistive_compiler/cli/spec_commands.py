@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from pathlib import Path
 
 from ..errors import SpecError
 from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, add_library_argument, print_problems
@@ -142,3 +143,21 @@ def add_commands(sub) -> None:
     p.add_argument("--terms", action="store_true", help="list registered terms and their parameters instead")
     p.add_argument("--training", action="store_true", help="print the JSON Schema of a training config (specs/training/*.yaml) instead")
     p.set_defaults(func=cmd_schema)
+
+    p = sub.add_parser("person-reference", help="write the person model's reference page (links, frames, joints and limits)")
+    p.add_argument("--out", default="docs/person.md", help="output Markdown file (default docs/person.md); '-' prints it")
+    p.set_defaults(func=cmd_person_reference)
+
+
+def cmd_person_reference(args: argparse.Namespace) -> int:
+    from ..person.reference_page import person_reference_markdown
+
+    text = person_reference_markdown()
+    if args.out == "-":
+        print(text, end="")
+        return EXIT_OK
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(text)
+    print(f"wrote {args.out}")
+    return EXIT_OK

@@ -127,7 +127,10 @@ class Scope(Collector):
             return {"body": body, "link": self.reference_link(body)}
         links = self.links_of(body)
         if link not in links:
-            self.problem(path, f"unknown link '{link}' of {body}; {expected(links, link)}")
+            if body == "person":
+                self.problem(path, unknown_person_link(link, links))
+            else:
+                self.problem(path, f"unknown link '{link}' of {body}; {expected(links, link)}")
             return None
         return {"body": body, "link": links[link]}
 
@@ -193,3 +196,24 @@ class Scope(Collector):
         if kind == "markers":
             return self.declared(value, path, "markers", "marker set")
         return value  # frame: a literal pydantic already checked
+
+
+PERSON_PART_LINKS = {"hand": "wrist", "palm": "wrist", "fingers": "wrist", "forearm": "elbow", "upper_arm": "shoulder",
+                     "arm": "shoulder", "thigh": "hip", "leg": "hip", "shin": "knee", "calf": "knee", "lower_leg": "knee",
+                     "foot": "ankle", "heel": "ankle", "toes": "ankle"}
+"""Body parts by their everyday names → the person link that is that part (a limb link is named
+after the joint at its top, the reference's naming: the hand is ``right_wrist``)."""
+
+
+def unknown_person_link(link: str, links) -> str:
+    """The message for ``person.<link>`` that is not a link: the link that is that body part when
+    ``link`` names one (``right_hand`` → ``right_wrist``), else the closest names; and where all 43
+    links and their frames are listed."""
+    where = f"; all {len(links)} links of the person and their frames: docs/person.md"
+    side, _, part = link.partition("_") if link.startswith(("right_", "left_")) else ("", "", link)
+    if part in PERSON_PART_LINKS:
+        names = [f"{side}_{PERSON_PART_LINKS[part]}"] if side else [f"right_{PERSON_PART_LINKS[part]}", f"left_{PERSON_PART_LINKS[part]}"]
+        if all(n in links for n in names):
+            return (f"unknown link '{link}' of person; the {part.replace('_', ' ')} is link {' or '.join(repr(n) for n in names)} "
+                    f"(limb links are named after the joint at their top){where}")
+    return f"unknown link '{link}' of person; {expected(links, link)}{where}"

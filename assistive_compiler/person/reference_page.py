@@ -1,0 +1,163 @@
+"""The person model's reference page (``docs/person.md``): every link with its collision shape and
+frame, every joint with its axis and limits, per variant where sizes differ.
+
+Written by ``assistive-compiler person-reference``; ``tests/test_person_reference.py`` keeps the
+page equal to what the code renders, so link names, frames and limits in the docs are always the
+model's. Everything is read from the person template rendered with each variant's measurements
+(the same URDF the compiler emits), nothing from a table of its own.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+
+PAGE_VARIANTS = ("male_50th", "female_50th")
+"""The variants whose sizes the page lists (the shipped tasks' two); the others scale the same way."""
+
+
+@dataclass(frozen=True)
+class _Shape:
+    kind: str  # capsule, sphere, box
+    text: str
+
+
+def _vec(text: str | None) -> tuple[float, float, float]:
+    return tuple(float(v) for v in (text or "0 0 0").split())  # type: ignore[return-value]
+
+
+def _cm(v: float) -> str:
+    return f"{v * 100:.1f}"
+
+
+def _xyz_cm(xyz) -> str:
+    return "(" + ", ".join(_cm(v) for v in xyz) + ")"
+
+
+def _render(name: str) -> ET.Element:
+    from ..compile.render import render_template
+    from ..library import PERSON_TEMPLATE_RELPATH, Library
+
+    part = Library().get("people", name).part
+    return ET.fromstring(render_template(PERSON_TEMPLATE_RELPATH, part.measurements().xacro_args()))
+
+
+def _shapes(link: ET.Element) -> list[_Shape]:
+    """A link's collision shapes, a capsule (a cylinder and its two end spheres) as one."""
+    cylinders, spheres, boxes = [], [], []
+    for col in link.findall("collision"):
+        origin = col.find("origin")
+        xyz = _vec(origin.get("xyz") if origin is not None else None)
+        geom = col.find("geometry")
+        for g in geom:  # type: ignore[union-attr]
+            if g.tag == "cylinder":
+                cylinders.append((float(g.get("radius")), float(g.get("length")), xyz))
+            elif g.tag == "sphere":
+                spheres.append((float(g.get("radius")), xyz))
+            elif g.tag == "box":
+                boxes.append((_vec(g.get("size")), xyz))
+    out = [_Shape("capsule", f"capsule r {_cm(r)}, length {_cm(l)}, centre {_xyz_cm(c)}") for r, l, c in cylinders]
+    if not cylinders:  # a capsule's end spheres are part of it; a lone sphere is the shape
+        out += [_Shape("sphere", f"sphere r {_cm(r)}, centre {_xyz_cm(c)}") for r, c in spheres]
+    out += [_Shape("box", f"box {_xyz_cm(size)}, centre {_xyz_cm(c)}") for size, c in boxes]
+    return out
+
+
+def _axis_name(axis) -> str:
+    names = {(1.0, 0.0, 0.0): "x", (0.0, 1.0, 0.0): "y", (0.0, 0.0, 1.0): "z",
+             (-1.0, 0.0, 0.0): "−x", (0.0, -1.0, 0.0): "−y", (0.0, 0.0, -1.0): "−z"}
+    return names.get(tuple(float(a) for a in axis), str(axis))
+
+
+def _direction(xyz) -> str:
+    """Which way a point lies from a frame's origin, in words (the person's zero pose)."""
+    words = {0: ("left", "right"), 1: ("back", "front"), 2: ("up", "down")}
+    parts = [f"{_cm(abs(v))} cm {words[k][0 if v > 0 else 1]}" for k, v in enumerate(xyz) if abs(v) >= 0.0005]
+    return ", ".join(parts) or "at the origin"
+
+
+def person_reference_markdown() -> str:
+    """The page, as Markdown."""
+    roots = {name: _render(name) for name in PAGE_VARIANTS}
+    first = roots[PAGE_VARIANTS[0]]
+    links = [el.get("name") for el in first.findall("link")]
+    joints = first.findall("joint")
+    parent_joint = {j.find("child").get("link"): j for j in joints}
+    children: dict[str, list[ET.Element]] = {}
+    for j in joints:
+        children.setdefault(j.find("parent").get("link"), []).append(j)
+    by_variant = {name: {el.get("name"): el for el in root.findall("link")} for name, root in roots.items()}
+    joints_by_variant = {name: {el.get("name"): el for el in root.findall("joint")} for name, root in roots.items()}
+    shown = " / ".join(PAGE_VARIANTS)
+
+    lines = [
+        "# The person model",
+        "",
+        "<!-- written by `assistive-compiler person-reference`; tests/test_person_reference.py keeps it equal to the code -->",
+        "",
+        "Every link and joint of the person (`templates/person/person.urdf.xacro`, rendered with each",
+        "variant's measurements in `specs/people/`), as a spec refers to them: a point is",
+        "`person.<link>` (its frame's origin), a target is `{link: person.<link>, offset_m: [x, y, z]}`",
+        "(the offset in that link's frame, metres), a marker or surface target covers",
+        "`surface_of: [person.<link>]` (a link with a capsule).",
+        "",
+        "**Frames.** At the person's zero pose every link frame is parallel to the person's base frame:",
+        "**+x is the person's left, −y is the way the person faces (front), +z is up** (toward the head).",
+        "A joint sits at its child link's frame origin; a limb's capsule hangs from its joint along −z",
+        "(the upper arm from the shoulder toward the elbow, the shin from the knee toward the ankle), so",
+        "a point along a limb has a negative z in its frame. Seated and supine postures rotate the frames",
+        "with the joints; a task's `person.posture` and `joints_deg` set them.",
+        "",
+        "**Names follow the reference's model: a limb link is named after the joint at its top.**",
+        "`right_shoulder` is the upper arm, `right_elbow` the forearm, `right_wrist` the hand,",
+        "`right_hip` the thigh, `right_knee` the shin, `right_ankle` the foot (the same on the left);",
+        "`head`, `neck`, `chest`, `waist`, `stomach` and `*_pecs` (the shoulder girdle) are what they say.",
+        "Offsets along a limb are negative z in its frame: the middle of male_50th's right forearm is",
+        "`{link: person.right_elbow, offset_m: [0, 0, -0.128]}` (the capsule's centre in the table below),",
+        "and its wrist joint is 29.0 cm down that frame (`right_wrist_x`).",
+        "",
+        f"Sizes are centimetres for the variants {shown} (each variant scales its own segments:",
+        "`render-person SPEC` draws them). Links without a shape are the joint links of a",
+        "multi-axis joint (shoulder, hip, ankle ...): they carry mass but no collision shape.",
+        "",
+        "## Links",
+        "",
+        "| link | joint that moves it | collision shape | next joints, from this frame's origin |",
+        "|---|---|---|---|",
+    ]
+    for name in links:
+        joint = parent_joint.get(name)
+        moved_by = f"`{joint.get('name')}` ({joint.get('type')})" if joint is not None else "— (root)"
+        shapes = [" / ".join(s.text for s in _shapes(by_variant[v][name])) for v in PAGE_VARIANTS]
+        shape_text = shapes[0] if len(set(shapes)) == 1 else "<br>".join(f"{v}: {s}" for v, s in zip(PAGE_VARIANTS, shapes))
+        nexts = []
+        for child in children.get(name, []):
+            xyz = [_vec(joints_by_variant[v][child.get("name")].find("origin").get("xyz")) for v in PAGE_VARIANTS]
+            where = _direction(xyz[0]) + (f" ({_direction(xyz[1])})" if _direction(xyz[1]) != _direction(xyz[0]) else "")
+            nexts.append(f"`{child.get('name')}`: {where}")
+        lines.append(f"| `{name}` | {moved_by} | {shape_text or 'none'} | {'<br>'.join(nexts) or '—'} |")
+    lines += [
+        "",
+        "## Joints",
+        "",
+        "Limits are the model's (degrees; a fixed joint is held at its angle). The policy, impairments",
+        "and `joints_deg` move only the revolute ones.",
+        "",
+        "| joint | type | axis | parent → child | limits (°) |",
+        "|---|---|---|---|---|",
+    ]
+    for j in joints:
+        limit = j.find("limit")
+        axis_el = j.find("axis")
+        axis = _axis_name(_vec(axis_el.get("xyz"))) if axis_el is not None else "—"
+        if limit is not None and j.get("type") == "revolute":
+            limits = f"[{math.degrees(float(limit.get('lower'))):.0f}, {math.degrees(float(limit.get('upper'))):.0f}]"
+        elif j.get("type") == "fixed":
+            rpy = _vec(j.find("origin").get("rpy"))
+            limits = f"fixed at {math.degrees(max(rpy, key=abs)):.0f}" if any(rpy) else "fixed"
+        else:
+            limits = "—"
+        lines.append(f"| `{j.get('name')}` | {j.get('type')} | {axis} | `{j.find('parent').get('link')}` → "
+                     f"`{j.find('child').get('link')}` | {limits} |")
+    return "\n".join(lines) + "\n"
