@@ -108,5 +108,5 @@ def test_every_command_group_registers_its_commands():
 
     sub = next(a for a in build_parser()._actions if a.dest == "command")
     assert set(sub.choices) == {"validate", "compile", "list", "schema", "run", "demo", "render", "render-person", "bench", "compare",
-                                "view", "collect", "train", "evaluate", "table", "export", "results", "person-reference"}
+                                "view", "collect", "train", "evaluate", "table", "export", "results", "person-reference", "describe"}
     assert all(callable(m.add_commands) for m in COMMAND_MODULES)

@@ -31,10 +31,10 @@ import sys
 from typing import Callable, Sequence
 
 from ..errors import SpecError, UsageError
-from . import bench, collect, compare, evaluate, render, results, run, spec_commands, table, train, view
+from . import bench, collect, compare, describe, evaluate, render, results, run, spec_commands, table, train, view
 from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, print_problems, use_library_dirs
 
-COMMAND_MODULES = (spec_commands, run, render, bench, compare, view, collect, train, evaluate, table, results)
+COMMAND_MODULES = (spec_commands, run, render, describe, bench, compare, view, collect, train, evaluate, table, results)
 
 __all__ = ["COMMAND_MODULES", "EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_OK", "build_parser", "main"]
 

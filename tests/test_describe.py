@@ -1,0 +1,55 @@
+"""``describe``: the scene after a reset as the physics has it (positions, frame axes, targets)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pybullet as pb
+
+from assistive_compiler.cli import main
+from assistive_compiler.describe import axis_direction
+from assistive_compiler.runtime.env import AssistiveEnv
+from conftest import FEEDING
+
+
+def test_axis_direction_in_words():
+    assert axis_direction([0, 0, -1]) == "-z" and axis_direction([0.99, 0.1, 0]) == "+x"
+    assert axis_direction([0.7071, 0, -0.7071]) == "(0.71, 0.00, -0.71)"
+
+
+def test_describe_reports_the_scene_as_pybullet_has_it(artifact, capsys):
+    assert main(["describe", str(FEEDING), "--robot", "jaco", "--seed", "3", "--out-dir", str(artifact), "--json"]) == 0
+    scene = json.loads(capsys.readouterr().out)
+    env = AssistiveEnv(artifact)
+    try:
+        env.reset(seed=3)
+        w = env.world
+        assert scene["person"]["variant"] == w.active_variant.name and scene["person"]["faces"] == "-y"
+        person = next(b for b in scene["bodies"] if b["name"] == w.active_variant.body)
+        handle = w.bodies[w.active_variant.body]
+        # The links the artifact simulates (Feeding moves only the head: the rest is merged into the chest).
+        assert [link["name"] for link in person["links"]] == ["chest", "neck", "head_x_link", "head_y_link", "head"]
+        head_link = next(link for link in person["links"] if link["name"] == "head")
+        state = pb.getLinkState(handle.id, handle.links["head"], computeForwardKinematics=1, physicsClientId=w.client)
+        assert np.allclose(head_link["position_m"], state[4], atol=1e-4)
+        mouth = next(t for t in scene["targets"] if t["name"] == "mouth")
+        assert mouth["on"] == "person.head" and not mouth["drawn_on_surface"]
+        head = pb.getLinkState(handle.id, handle.links["head"], computeForwardKinematics=1, physicsClientId=w.client)
+        assert 0.05 < np.linalg.norm(np.subtract(mouth["position_m"], head[4])) < 0.2  # the mouth offset from the head frame
+        parked = [b for b in scene["bodies"] if b["kind"] == "person" and not b["shown"]]
+        assert len(parked) == 1 and parked[0]["links"] == []
+        assert scene["robot_links"]["end_effector"] == "j2s7s300_end_effector"
+        assert scene["tools"][0]["body"] == "spoon" and scene["particles"][0]["count"] == 8
+    finally:
+        env.close()
+
+
+def test_describe_prints_a_table_per_body(artifact, capsys):
+    assert main(["describe", str(FEEDING), "--robot", "jaco", "--out-dir", str(artifact)]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("feeding for jaco: person ")
+    assert "target mouth: (" in out and "(on person.head)" in out
+    assert "\nwheelchair (furniture, 3 links)\n" in out
+    assert ": parked, not this episode's person" in out
+    assert "5 links; the person's other links are static in this task and merged into these (all 43 and their frames: docs/person.md)" in out
