@@ -241,3 +241,15 @@ def test_errors_cross_process_boundaries_with_their_locations():
     assert str(pickle.loads(pickle.dumps(UsageError("--address: no Ray cluster")))) == "--address: no Ray cluster"
     lint = LintError([LintProblem("robot.urdf", "link 'base'", "mass must be positive")])
     assert pickle.loads(pickle.dumps(lint)).problems == lint.problems
+
+
+@pytest.mark.parametrize("text,message", [
+    (None, "nope.json:1:1: --reference-json: file not found (lines printed by the reference harness's measure.py ag ENV)"),
+    ('{"env": "FeedingJaco", "steps_per_s": 3', "nope.json:1:40: --reference-json: not JSON (Expecting ',' delimiter)"),
+    ('{"env": "FeedingJaco"}\n', "nope.json:1:1: --reference-json: each entry needs 'env' and 'steps_per_s' (measure.py's output)"),
+])
+def test_bench_reference_json_mistakes_are_located_before_measuring(tmp_path, text, message):
+    if text is not None:
+        (tmp_path / "nope.json").write_text(text)
+    status, _, err = cli("bench", str(FEEDING), "--reference-json", "nope.json", cwd=tmp_path)
+    assert status == 2 and "Traceback" not in err and message in err, err

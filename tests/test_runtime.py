@@ -498,9 +498,10 @@ def test_cli_run_json(artifact, capsys):
 
 @pytest.mark.slow
 def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, tmp_path):
-    """bench puts the reference's measured rate beside ours (performance-anchors: Feeding Jaco 248
-    env steps/s), at the spec's solver settings and at the reference's (issue 17): measured again
-    where they differ, one figure where they are the same; with several specs it prints a table."""
+    """bench puts the reference's measured rate beside ours (Feeding Jaco 348 env steps/s, measured
+    side by side, with the date and conditions said), at the spec's solver settings and at the
+    reference's: measured again where they differ, one figure where they are the same; with several
+    specs it prints a table. --reference-json takes figures measured beside ours instead."""
     from assistive_compiler.cli import main
 
     fewer = tmp_path / "feeding_fewer_iterations.yaml"  # a user's spec of the reference's task, at settings of its own
@@ -509,8 +510,9 @@ def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, 
     assert rc == 0
     feeding, fewer_r = json.loads(capsys.readouterr().out)
     reference = {"sub_steps": 0, "iterations": 50, "contact_breaking_threshold_m": 0.02}
-    assert feeding["reference_env_steps_per_s"] == fewer_r["reference_env_steps_per_s"] == 248
-    assert feeding["vs_reference"] == round(feeding["env_steps_per_s"] / 248, 2)
+    assert feeding["reference_env_steps_per_s"] == fewer_r["reference_env_steps_per_s"] == 348
+    assert feeding["reference_figure"].startswith("measured side by side on 2026-11-27: quiet 2-core machine")
+    assert feeding["vs_reference"] == round(feeding["env_steps_per_s"] / 348, 2)
     # The shipped Feeding runs at the reference's settings: one measurement, reported for both.
     assert feeding["solver"] == feeding["reference_solver"] == reference
     assert feeding["reference_solver_is_shipped"] is True
@@ -521,15 +523,26 @@ def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, 
     assert fewer_r["reference_solver"] == reference and fewer_r["reference_solver_is_shipped"] is False
     assert fewer_r["env_steps_per_s_reference_solver"] > 0
     assert fewer_r["env_steps_per_s_reference_solver"] != fewer_r["env_steps_per_s"]
-    assert fewer_r["vs_reference_at_reference_solver"] == round(fewer_r["env_steps_per_s_reference_solver"] / 248, 2)
+    assert fewer_r["vs_reference_at_reference_solver"] == round(fewer_r["env_steps_per_s_reference_solver"] / 348, 2)
     rc = main(["bench", str(SPEC), str(fewer), "--robot", "jaco", "--steps", "10", "--repeats", "1", "--resets", "2"])
     out = capsys.readouterr().out
     assert out.splitlines()[0].split() == ["task", "robot", "env_steps_per_s", "env_steps_per_s_reference_solver", "raw_physics_steps_per_s",
                                            "env_over_raw", "reset_ms_median", "reference_env_steps_per_s", "vs_reference",
                                            "vs_reference_at_reference_solver"]
     rows = [line.split() for line in out.splitlines() if line.split()[:1] == ["feeding"]]
-    assert len(rows) == 2 and all(r[1] == "jaco" and r[7] == "248" for r in rows)
+    assert len(rows) == 2 and all(r[1] == "jaco" and r[7] == "348" for r in rows)
     assert float(rows[0][2]) == float(rows[0][3])  # shipped = reference settings: the same figure in both columns
+    assert "reference_env_steps_per_s of feeding/jaco, feeding/jaco: measured side by side on 2026-11-27" in out
+    # Figures measured beside ours: the harness's lines, the reference on its fork (gravity emulation's share removed).
+    lines = tmp_path / "reference.jsonl"
+    lines.write_text('{"side": "ag", "env": "FeedingJaco", "steps_per_s": 300.0, "gravity_shim_share": 0.25}\n'
+                     '{"side": "ag", "env": "FeedingJaco", "steps_per_s": 330.0, "gravity_shim_share": 0.25}\n'
+                     '{"side": "ours", "env": "FeedingJaco", "steps_per_s": 900.0}\n')
+    rc = main(["bench", str(SPEC), "--robot", "jaco", "--steps", "10", "--repeats", "1", "--resets", "2", "--json", "--reference-json", str(lines)])
+    beside = json.loads(capsys.readouterr().out)
+    assert rc == 0 and beside["reference_env_steps_per_s"] == 420.0  # median of 400 and 440
+    assert beside["reference_figure"] == f"{lines}: measured beside ours with the reference harness"
+    assert beside["vs_reference"] == round(beside["env_steps_per_s"] / 420.0, 2)
 
 
 @pytest.mark.slow

@@ -20,6 +20,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from ..errors import SpecError
 from .common import EXIT_OK, add_library_argument
 
 _CHILD = r"""
@@ -38,16 +39,43 @@ print(json.dumps({"import_s": import_s, "heavy_modules_on_import": heavy,
 """
 
 
-#: Env steps/s of the reference implementation (Assistive Gym v1.0 on stock pybullet, random actions,
-#: 200-step episodes, one process, a 2-core shared machine like ours), per (task, robot) it was
-#: was measured for. Dressing does not run on stock pybullet.
-REFERENCE_STEPS_PER_S = {
-    ("scratch_itch", "jaco"): 423, ("scratch_itch", "pr2"): 188, ("scratch_itch", "sawyer"): 428, ("scratch_itch", "baxter"): 312,
-    ("bed_bathing", "jaco"): 156,
-    ("feeding", "jaco"): 248, ("feeding", "pr2"): 135, ("feeding", "sawyer"): 237, ("feeding", "baxter"): 199,
-    ("drinking", "jaco"): 37,
-    ("arm_manipulation", "jaco"): 216,
+SIDE_BY_SIDE = ("measured side by side on 2026-11-27: quiet 2-core machine, one core each, interleaved fresh processes, "
+                "the reference at its own solver settings on stock pybullet with its fork-only gravity emulation's time removed "
+                "(the reference harness); random actions")
+LOADED_ONCE = ("measured once, not side by side, on a shared 2-core machine under load (stock pybullet, random actions, "
+               "200-step episodes): lower than the reference does on a quiet machine, so the ratio overstates ours there")
+
+#: Env steps/s of the reference implementation (Assistive Gym v1.0) per (task, robot), with how each
+#: figure was taken (the ratio is only as good as that). Dressing does not run on stock pybullet.
+#: ``--reference-json`` replaces them with figures measured beside ours.
+REFERENCE_STEPS_PER_S: dict[tuple[str, str], tuple[float, str]] = {
+    ("feeding", "jaco"): (348, SIDE_BY_SIDE), ("scratch_itch", "jaco"): (620, SIDE_BY_SIDE), ("drinking", "jaco"): (44, SIDE_BY_SIDE),
+    ("bed_bathing", "jaco"): (170, SIDE_BY_SIDE), ("arm_manipulation", "jaco"): (338, SIDE_BY_SIDE),
+    ("scratch_itch", "pr2"): (188, LOADED_ONCE), ("scratch_itch", "sawyer"): (428, LOADED_ONCE), ("scratch_itch", "baxter"): (312, LOADED_ONCE),
+    ("feeding", "pr2"): (135, LOADED_ONCE), ("feeding", "sawyer"): (237, LOADED_ONCE), ("feeding", "baxter"): (199, LOADED_ONCE),
 }
+
+
+def load_reference_json(path: str) -> dict[str, float]:
+    """Reference figures measured beside ours: the reference harness's ``measure.py ag ENV`` lines
+    (a JSON list or one JSON object per line). Env name (``FeedingJaco``) -> env steps/s of the
+    reference on its own pybullet fork (``steps_per_s / (1 - gravity_shim_share)``), median over
+    the lines of that env. Located errors for a file that is not such lines."""
+    text = Path(path).read_text() if Path(path).is_file() else None
+    if text is None:
+        raise SpecError.at(path, "--reference-json: file not found (lines printed by the reference harness's measure.py ag ENV)")
+    try:
+        rows = json.loads(text) if text.lstrip().startswith("[") else [json.loads(line) for line in text.splitlines() if line.strip()]
+    except json.JSONDecodeError as exc:
+        raise SpecError.at(path, f"--reference-json: not JSON ({exc.msg})", exc.lineno, exc.colno) from None
+    figures: dict[str, list[float]] = {}
+    for k, row in enumerate(rows):
+        if not isinstance(row, dict) or not {"env", "steps_per_s"} <= set(row):
+            raise SpecError.at(path, "--reference-json: each entry needs 'env' and 'steps_per_s' (measure.py's output)", k + 1)
+        if row.get("side", "ag") != "ag":
+            continue  # our own side's lines, if the file holds both
+        figures.setdefault(str(row["env"]), []).append(float(row["steps_per_s"]) / (1.0 - float(row.get("gravity_shim_share", 0.0))))
+    return {env: statistics.median(v) for env, v in figures.items()}
 
 
 def _median_p95(values: list[float]) -> tuple[float, float]:
@@ -135,7 +163,8 @@ def measure_steps_paired(envs: dict, steps: int, repeats: int, seed: int) -> dic
     return out
 
 
-def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, seed: int = 0) -> dict:
+def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, seed: int = 0,
+          reference_json: dict[str, float] | None = None, reference_file: str | None = None) -> dict:
     """Speed figures of one (task, robot), all taken in this one run (medians over repeats).
 
     Env steps/s is measured at the spec's solver settings and, where they differ, at the reference
@@ -169,7 +198,13 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
     env_med = statistics.median(env_rates)
     raw_med = statistics.median(raw_rates)
     reset_med, reset_p95 = _median_p95(reset_ms)
-    reference = REFERENCE_STEPS_PER_S.get((m.task, m.robot_name))
+    env_name = m.gym_id.rpartition("/")[2].removesuffix("-v1")
+    if reference_json is not None:
+        reference = reference_json.get(env_name)
+        reference_figure = f"{reference_file}: measured beside ours with the reference harness" if reference is not None else None
+        reference = round(reference, 1) if reference is not None else None
+    else:
+        reference, reference_figure = REFERENCE_STEPS_PER_S.get((m.task, m.robot_name), (None, None))
     ref_solver = reference_solver(m.task)
     # At the reference's solver settings: measured on the variant's artifact, or the same figure when
     # the spec already uses them (None: the reference has no such task).
@@ -179,6 +214,7 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
         "obs_size": sum(t.size for t in m.observations["robot"]), "action_size": m.robot.action_size,
         "env_steps_per_s": round(env_med, 1),
         "reference_env_steps_per_s": reference,
+        "reference_figure": reference_figure,
         "vs_reference": round(env_med / reference, 2) if reference is not None else None,
         "solver": solver_settings(loaded),
         "reference_solver": ref_solver,
@@ -233,6 +269,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from .output import cell, print_table, progress
 
     results = []
+    reference_json = load_reference_json(args.reference_json) if args.reference_json else None
     pairs = [(spec, robot) for spec in args.specs for robot in bench_robots(args)]
     with progress("bench", len(pairs)) as tracker:
         for spec, robot in pairs:
@@ -241,7 +278,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
                 tracker.done(f"{r['name']}: {r['multi_agent_env_steps_per_s']} multi-agent env steps/s, "
                              f"{r['multi_over_single']} x single-agent ({spec})")
             else:
-                r = bench(spec, robot, args.steps, args.resets, args.repeats, args.seed)
+                r = bench(spec, robot, args.steps, args.resets, args.repeats, args.seed, reference_json, args.reference_json)
                 tracker.done(f"{r['gym_id']}: {r['env_steps_per_s']} env steps/s ({spec})")
             results.append(r)
     if args.json:
@@ -255,6 +292,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
     # Several tasks or robots: one row per spec x robot (taken one after the other in this run; medians over repeats).
     columns = BENCH_COOP_TABLE if args.coop else BENCH_TABLE
     print_table(columns, [[cell(r[k]) for k in columns] for r in results], left=("task", "robot"))
+    if not args.coop:
+        for figure in sorted({r["reference_figure"] for r in results if r["reference_figure"]}):
+            rows = ", ".join(f"{r['task']}/{r['robot']}" for r in results if r["reference_figure"] == figure)
+            print(f"reference_env_steps_per_s of {rows}: {figure}")
     return EXIT_OK
 
 
@@ -270,4 +311,7 @@ def add_commands(sub) -> None:
     p.add_argument("--resets", type=int, default=100)
     p.add_argument("--coop", action="store_true", help="multi-agent (PettingZoo, both agents acting) vs single-agent env steps/s, in one run")
     p.add_argument("--json", action="store_true")
+    p.add_argument("--reference-json", dest="reference_json", metavar="FILE",
+                   help="reference figures measured beside ours: the lines the reference harness's 'measure.py ag ENV' printed "
+                        "(default: the stored figures, each reported with the date and conditions it was measured under)")
     p.set_defaults(func=cmd_bench)
