@@ -53,3 +53,28 @@ def test_describe_prints_a_table_per_body(artifact, capsys):
     assert "\nwheelchair (furniture, 3 links)\n" in out
     assert ": parked, not this episode's person" in out
     assert "5 links; the person's other links are static in this task and merged into these (all 43 and their frames: docs/person.md)" in out
+
+
+def test_render_frames_draws_labelled_axes_and_changes_nothing_else(artifact):
+    """--frames paints the end effector's, tools' and targets' axes (x red, y green, z blue) with
+    their names; without it the picture is the plain render, and the episode is the same."""
+    from assistive_compiler.runtime.camera import AXIS_COLOURS, labelled_frames, render_rgb
+
+    env = AssistiveEnv(artifact)
+    try:
+        env.reset(seed=0)
+        names = [label for label, _, _ in labelled_frames(env)]
+        assert names == ["robot.j2s7s300_end_effector", "spoon.bowl", "spoon.handle_end", "spoon.tip", "mouth"]
+        plain = render_rgb(env)
+        obs_before = env.snap.position(env.snap.point({"target": "mouth"})).copy()
+        env.show_frames = True
+        framed = render_rgb(env)
+        assert np.array_equal(env.snap.position(env.snap.point({"target": "mouth"})), obs_before)
+        changed = np.any(framed != plain, axis=2)
+        assert 200 < changed.sum() < 0.05 * changed.size  # lines and labels, not a repaint
+        for colour in AXIS_COLOURS:
+            assert np.all(framed == colour, axis=2).sum() > 5, colour
+        env.show_frames = False
+        assert np.array_equal(render_rgb(env), plain)
+    finally:
+        env.close()

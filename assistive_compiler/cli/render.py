@@ -126,6 +126,7 @@ def cmd_render(args: argparse.Namespace) -> int:
     check_picture_path(out)
     view = parse_camera(args.camera)
     env = make_env(args.spec, args.robot, args.out_dir, render_mode="rgb_array", render_size=(args.width, args.height), camera=view)
+    env.show_frames = args.frames
     target, act = make_player(args.policy, env, seed=args.seed)  # a co-optimised pair: the person acts too
     frames, summary = record(target, act, args.seed, args.every)
     fps = args.fps or control_hz(env.manifest) / args.every
@@ -201,6 +202,8 @@ def add_commands(sub) -> None:
     p.add_argument("--width", type=int, default=480)
     p.add_argument("--height", type=int, default=360)
     p.add_argument("--out-dir", dest="out_dir", help="artifact directory")
+    p.add_argument("--frames", action="store_true", help="draw the end effector's, tools' and targets' frames "
+                                                         "(x red, y green, z blue, 6 cm) with their names")
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("render-person", help="draw the person variants a spec declares, side by side (PNG)")

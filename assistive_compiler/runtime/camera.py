@@ -65,7 +65,76 @@ def render_rgb(env, width: int = 480, height: int = 360, view: dict | None = Non
     for g in w.garments:
         draw_mesh(image, depth, w.garment_nodes(g), g.faces, g.rgba, view_m, proj)
     draw_spheres(image, depth, overlay_spheres(env), view_m, proj)
+    if getattr(env, "show_frames", False):
+        draw_frames(image, labelled_frames(env), view_m, proj)
     return image
+
+
+FRAME_AXIS_M = 0.06
+"""Length of each drawn frame axis, m."""
+AXIS_COLOURS = ((230, 40, 40), (40, 190, 40), (50, 90, 240))
+"""x red, y green, z blue (the usual convention)."""
+
+
+def labelled_frames(env) -> list[tuple[str, np.ndarray, np.ndarray | None]]:
+    """(label, world position m, 3×3 rotation or None) of what a spec refers to most: the robot's
+    end effector, each tool's named links, each target (a point: no axes)."""
+    from .world import rotation_matrix
+
+    m, w, snap = env.manifest, env.world, env.snap
+    out = []
+    ee = m.robot.links.get("end_effector")
+    if ee is not None:
+        pos, orn = w.link_frame(w.robot, w.robot.links[ee])
+        out.append((f"robot.{ee}", np.asarray(pos), rotation_matrix(orn)))
+    for tool in m.tools:
+        handle = w.bodies[tool.body]
+        for name, link in sorted(tool.links.items()):
+            if name == "base" and link in tool.links.values() and list(tool.links.values()).count(link) > 1:
+                continue  # the base is also a named link: drawn once, by its name
+            pos, orn = w.link_frame(handle, handle.links[link])
+            out.append((f"{tool.body}.{name}", np.asarray(pos), rotation_matrix(orn)))
+    for name in m.targets:
+        out.append((name, np.asarray(snap.position(snap.point({"target": name}))), None))
+    return out
+
+
+def draw_frames(image: np.ndarray, frames, view_m, proj) -> None:
+    """Draw each frame's axes (x red, y green, z blue, :data:`FRAME_AXIS_M` long) and its label onto
+    ``image`` in place, over everything (an annotation, not part of the scene)."""
+    from PIL import Image, ImageDraw
+
+    height, width = image.shape[:2]
+    to_clip = clip_transform(view_m, proj)
+    picture = Image.fromarray(image)
+    draw = ImageDraw.Draw(picture)
+    labels: list[tuple[np.ndarray, list[str]]] = []  # frames within 1.5 cm share one label
+    for label, pos, _ in frames:
+        near = next((entry for entry in labels if np.linalg.norm(entry[0] - pos) < 0.015), None)
+        if near is None:
+            labels.append((np.asarray(pos, dtype=float), [label]))
+        else:
+            near[1].append(label)
+    for label, pos, rot in frames:
+        ends = [pos] + ([pos + FRAME_AXIS_M * rot[:, k] for k in range(3)] if rot is not None else [])
+        px, w = to_pixels(np.asarray(ends), to_clip, width, height)
+        if (w <= NEAR_M).any():
+            continue
+        origin = tuple(px[0])
+        for k in range(1, len(ends)):
+            draw.line([origin, tuple(px[k])], fill=AXIS_COLOURS[k - 1], width=2)
+        if rot is None:
+            draw.ellipse([origin[0] - 3, origin[1] - 3, origin[0] + 3, origin[1] + 3], outline=(0, 0, 0), width=1)
+    for pos, names in labels:  # on a white box, readable over a dark robot
+        px, w = to_pixels(np.asarray([pos]), to_clip, width, height)
+        if w[0] <= NEAR_M:
+            continue
+        text = " / ".join(names)
+        at = (float(px[0, 0]) + 5, float(px[0, 1]) + 3)
+        box = draw.textbbox(at, text)
+        draw.rectangle([box[0] - 1, box[1] - 1, box[2] + 1, box[3] + 1], fill=(255, 255, 255))
+        draw.text(at, text, fill=(0, 0, 0))
+    image[...] = np.asarray(picture)
 
 
 def clip_transform(view_m, proj) -> np.ndarray:

@@ -111,6 +111,8 @@ class AssistiveEnv(gym.Env):
         ``manifest``: the artifact's manifest when the caller has just compiled or checked it
         (``compile_task``'s result); otherwise it is read and every file checked against it."""
         self.camera = camera
+        #: Renders draw the end effector's, tools' and targets' frames with labels (``render --frames``).
+        self.show_frames = False
         self.artifact_dir = Path(artifact_dir)
         self.manifest = m = manifest if manifest is not None else Manifest.read(self.artifact_dir, verify=True)
         if render_mode not in (None, "rgb_array"):
