@@ -137,6 +137,29 @@ def person_reference_markdown() -> str:
             where = _direction(xyz[0]) + (f" ({_direction(xyz[1])})" if _direction(xyz[1]) != _direction(xyz[0]) else "")
             nexts.append(f"`{child.get('name')}`: {where}")
         lines.append(f"| `{name}` | {moved_by} | {shape_text or 'none'} | {'<br>'.join(nexts) or '—'} |")
+    from .landmarks import LANDMARKS, landmark_offsets
+
+    from ..compile.render import render_template
+    from ..library import PERSON_TEMPLATE_RELPATH, Library
+
+    marks = {v: landmark_offsets(render_template(PERSON_TEMPLATE_RELPATH, Library().get("people", v).part.measurements().xacro_args()))
+             for v in PAGE_VARIANTS}
+    lines += [
+        "",
+        "## Landmarks",
+        "",
+        "Named points placed from each variant's own shapes (`assistive_compiler/person/landmarks.py`),",
+        "used as `person.<landmark>` wherever a point is (a waypoint's `to`, a term's point), or as a",
+        "target's `link` (its `offset_m` then starts at the landmark). The joints are points already:",
+        "`person.right_elbow` is the elbow joint (the forearm's frame origin), `person.right_knee` the knee,",
+        "`person.right_shoulder` the shoulder, `person.right_wrist` the wrist.",
+        "",
+        f"| landmark | link | where | offset in the link frame (cm), {shown} |",
+        "|---|---|---|---|",
+    ]
+    for name, lm in LANDMARKS.items():
+        where = " / ".join(_xyz_cm(marks[v][name][1]) for v in PAGE_VARIANTS)
+        lines.append(f"| `person.{name}` | `{lm.link}` | {lm.description} | {where} |")
     lines += [
         "",
         "## Joints",

@@ -18,6 +18,7 @@ from ..errors import Problem, SpecError
 from ..library import Library
 from ..spec.load import LoadedSpec
 from . import bodies, person, robot as robot_section, scripted, terms
+from .landmarks import with_landmarks
 from .resolved import ResolvedTask, ResolvedTerm
 from .scope import GARMENT_HELD_LINK, RESERVED_BODIES, ROBOT_SEMANTIC_LINKS, Scope
 
@@ -40,7 +41,9 @@ def _load_parts(s: Scope) -> None:
 
 def resolve(loaded: LoadedSpec, robot: str | None = None, library: Library | None = None) -> ResolvedTask:
     """Resolve ``loaded`` for ``robot`` (default: the spec's default robot)."""
-    s = Scope(loaded, library or Library.for_spec(loaded.path), robot or loaded.spec.robot.default)
+    library = library or Library.for_spec(loaded.path)
+    loaded = with_landmarks(loaded, library)  # person.<landmark> references become targets
+    s = Scope(loaded, library, robot or loaded.spec.robot.default)
     spec = s.spec
     robot_section.check_supported(s)
     _load_parts(s)

@@ -209,7 +209,10 @@ def unknown_person_link(link: str, links) -> str:
     """The message for ``person.<link>`` that is not a link: the link that is that body part when
     ``link`` names one (``right_hand`` → ``right_wrist``), else the closest names; and where all 43
     links and their frames are listed."""
-    where = f"; all {len(links)} links of the person and their frames: docs/person.md"
+    from ..person.landmarks import LANDMARKS
+
+    where = (f"; all {len(links)} links of the person and their frames: docs/person.md; landmarks: "
+             + ", ".join(LANDMARKS))
     side, _, part = link.partition("_") if link.startswith(("right_", "left_")) else ("", "", link)
     if part in PERSON_PART_LINKS:
         names = [f"{side}_{PERSON_PART_LINKS[part]}"] if side else [f"right_{PERSON_PART_LINKS[part]}", f"left_{PERSON_PART_LINKS[part]}"]

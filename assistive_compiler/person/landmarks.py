@@ -1,0 +1,158 @@
+"""Named landmarks on the person: points such as the mouth, the chin or a palm, each on one link,
+placed from that link's collision shapes so that it scales with every person variant.
+
+A spec uses one wherever it uses a point, as ``person.<landmark>`` (a waypoint's ``to``, a term's
+point parameter, a camera), or as the ``link`` of a target, whose ``offset_m`` then starts from the
+landmark. The joints are points already: a limb link's frame sits at the joint at its top, so
+``person.right_elbow`` is the elbow joint, ``person.right_knee`` the knee, ``person.right_shoulder``
+the shoulder (see docs/person.md).
+
+Offsets are in the landmark's link frame, metres, at the person's zero pose: +x the person's left,
+-y the front, +z up (toward the head); limbs hang along -z.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from typing import Callable
+
+Vec3 = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Landmark:
+    """A named point: the link it is on and how its offset follows from that link's shapes."""
+
+    link: str
+    description: str
+    offset: Callable[["LinkShapes"], Vec3]
+
+
+@dataclass(frozen=True)
+class LinkShapes:
+    """A link's collision spheres and capsules (link frame, m): (centre, radius) and (centre, radius,
+    length, axis index 0/1/2)."""
+
+    spheres: tuple[tuple[Vec3, float], ...]
+    capsules: tuple[tuple[Vec3, float, float, int], ...]
+
+
+def _front_at(shapes: LinkShapes, z: float) -> float:
+    """The most forward (-y) surface point of a link's spheres at height ``z`` (x = 0)."""
+    ys = [c[1] - math.sqrt(r * r - (z - c[2]) ** 2) for c, r in shapes.spheres if abs(z - c[2]) < r]
+    return min(ys)
+
+
+def _jaw(shapes: LinkShapes) -> tuple[Vec3, float]:
+    """The head's smaller sphere (the face and jaw; the larger is the cranium)."""
+    return min(shapes.spheres, key=lambda s: s[1])
+
+
+def _mouth(s: LinkShapes) -> Vec3:
+    (cx, cy, cz), r = _jaw(s)
+    return (0.0, _front_at(s, cz), cz)
+
+
+def _chin(s: LinkShapes) -> Vec3:
+    (cx, cy, cz), r = _jaw(s)
+    a = math.radians(45)
+    return (0.0, cy - r * math.cos(a), cz - r * math.sin(a))
+
+
+def _nose(s: LinkShapes) -> Vec3:
+    (cx, cy, cz), r = _jaw(s)
+    z = cz + 0.6 * r
+    return (0.0, _front_at(s, z), z)
+
+
+def _cheek(sign: float) -> Callable[[LinkShapes], Vec3]:
+    def offset(s: LinkShapes) -> Vec3:
+        (cx, cy, cz), r = _jaw(s)
+        a = math.radians(50)  # around the face from the front, toward the side
+        return (sign * r * math.sin(a), cy - r * math.cos(a), cz + 0.2 * r)
+    return offset
+
+
+def _hand(s: LinkShapes) -> tuple[Vec3, float]:
+    return max(s.spheres, key=lambda sphere: sphere[1])
+
+
+def _palm(toward_body: float) -> Callable[[LinkShapes], Vec3]:
+    """The palm's centre: on the hand's surface on the side that faces the body at the zero pose."""
+    def offset(s: LinkShapes) -> Vec3:
+        (cx, cy, cz), r = _hand(s)
+        return (cx + toward_body * r, cy, cz)
+    return offset
+
+
+def _fingertips(s: LinkShapes) -> Vec3:
+    (cx, cy, cz), r = _hand(s)
+    return (cx, cy, cz - r)
+
+
+def _foot(s: LinkShapes) -> tuple[Vec3, float, float]:
+    centre, radius, length, axis = s.capsules[0]
+    return centre, radius, length
+
+
+def _heel(s: LinkShapes) -> Vec3:
+    (cx, cy, cz), r, length = _foot(s)
+    return (cx, cy + length / 2.0, cz - r)
+
+
+def _toes(s: LinkShapes) -> Vec3:
+    (cx, cy, cz), r, length = _foot(s)
+    return (cx, cy - length / 2.0, cz)
+
+
+LANDMARKS: dict[str, Landmark] = {
+    "mouth": Landmark("head", "the front of the face at the jaw's centre height (the lips)", _mouth),
+    "chin": Landmark("head", "the jaw's front-bottom, 45° below its front", _chin),
+    "nose": Landmark("head", "the front of the face 0.6 jaw radii above the mouth", _nose),
+    "right_cheek": Landmark("head", "the face's right side, 50° round from the front", _cheek(-1.0)),
+    "left_cheek": Landmark("head", "the face's left side, 50° round from the front", _cheek(1.0)),
+    "right_palm": Landmark("right_wrist", "the right hand's surface toward the body (the palm's centre at the zero pose)", _palm(1.0)),
+    "left_palm": Landmark("left_wrist", "the left hand's surface toward the body (the palm's centre at the zero pose)", _palm(-1.0)),
+    "right_fingertips": Landmark("right_wrist", "the right hand's far end", _fingertips),
+    "left_fingertips": Landmark("left_wrist", "the left hand's far end", _fingertips),
+    "right_heel": Landmark("right_ankle", "the bottom of the right foot's back end", _heel),
+    "left_heel": Landmark("left_ankle", "the bottom of the left foot's back end", _heel),
+    "right_toes": Landmark("right_ankle", "the centre of the right foot's front end", _toes),
+    "left_toes": Landmark("left_ankle", "the centre of the left foot's front end", _toes),
+}
+"""Every landmark by name (``person.<name>`` in a spec)."""
+
+
+def _vec(text: str | None) -> Vec3:
+    return tuple(float(v) for v in (text or "0 0 0").split())  # type: ignore[return-value]
+
+
+def link_shapes(urdf_xml: str) -> dict[str, LinkShapes]:
+    """Each link's collision spheres and capsules (a capsule: a cylinder, its end spheres dropped)."""
+    out: dict[str, LinkShapes] = {}
+    for link in ET.fromstring(urdf_xml).findall("link"):
+        spheres, capsules = [], []
+        for col in link.findall("collision"):
+            origin = col.find("origin")
+            xyz = _vec(origin.get("xyz") if origin is not None else None)
+            rpy = _vec(origin.get("rpy") if origin is not None else None)
+            for g in col.find("geometry") or ():
+                if g.tag == "sphere":
+                    spheres.append((xyz, float(g.get("radius"))))
+                elif g.tag == "cylinder":
+                    axis = 1 if abs(rpy[0]) > 1e-6 else (0 if abs(rpy[1]) > 1e-6 else 2)  # rolled: along y; pitched: along x
+                    capsules.append((xyz, float(g.get("radius")), float(g.get("length")), axis))
+        if capsules:  # the end spheres of a capsule are not shapes of their own here
+            spheres = [s for s in spheres if not any(abs(s[1] - c[1]) < 1e-9 for c in capsules)]
+        out[link.get("name")] = LinkShapes(tuple(spheres), tuple(capsules))
+    return out
+
+
+def landmark_offsets(urdf_xml: str) -> dict[str, tuple[str, Vec3]]:
+    """Every landmark of the person ``urdf_xml`` (one variant): name -> (link, offset in the link
+    frame, m, rounded to 0.1 mm)."""
+    shapes = link_shapes(urdf_xml)
+    return {name: (lm.link, tuple(round(v, 4) + 0.0 for v in lm.offset(shapes[lm.link])))  # type: ignore[misc]
+            for name, lm in LANDMARKS.items()}
