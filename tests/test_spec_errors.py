@@ -74,6 +74,10 @@ def feeding_location(needle: str, offset: int = 0) -> str:
     return f"{display(FEEDING)}:{line}:{int(column) + offset}"
 
 
+LANDMARKS_TAIL = "; landmarks: mouth, chin, nose, right_cheek, left_cheek, right_palm, left_palm, right_fingertips, left_fingertips, " \
+                 "right_heel, left_heel, right_toes, left_toes"
+
+
 def inherited(section: str, parent: Path, child: Path) -> str:
     """The note on a problem located at a value ``child`` inherited from ``parent``."""
     return f" ({section} is inherited from {display(parent)}; override it in {display(child)}, or remove it there with $delete / $replace)"
@@ -409,7 +413,7 @@ def test_unknown_person_link(tmp_path, capsys):
         f"{at(text, 'person.haed')}: unknown link 'haed' of person; expected one of 'chest', 'head', 'head_x_link', "
         "'head_y_link', 'left_ankle', 'left_ankle_x_link', 'left_ankle_y_link', 'left_elbow', 'left_elbow_link', "
         "'left_hip', 'left_hip_x_link', 'left_hip_y_link', ... (43 in all) (did you mean 'head'?); "
-        "all 43 links of the person and their frames: docs/person.md",
+        f"all 43 links of the person and their frames: docs/person.md{LANDMARKS_TAIL}",
     )
 
 
@@ -419,7 +423,8 @@ def test_a_body_part_by_its_everyday_name_names_the_link_that_is_it(tmp_path, ca
     text = EXTENDS + "targets:\n  mouth:\n    link: person.right_hand\n"
     path = write(tmp_path, text)
     check(capsys, path, f"{at(text, 'person.right_hand')}: unknown link 'right_hand' of person; the hand is link 'right_wrist' "
-                        "(limb links are named after the joint at their top); all 43 links of the person and their frames: docs/person.md")
+                        "(limb links are named after the joint at their top), and person points on it: person.right_palm, "
+                        f"person.right_fingertips; all 43 links of the person and their frames: docs/person.md{LANDMARKS_TAIL}")
 
 
 def test_unknown_robot_link_in_term_param(tmp_path, capsys):

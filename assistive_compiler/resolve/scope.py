@@ -205,6 +205,11 @@ PERSON_PART_LINKS = {"hand": "wrist", "palm": "wrist", "fingers": "wrist", "fore
 after the joint at its top, the reference's naming: the hand is ``right_wrist``)."""
 
 
+PERSON_PART_LANDMARKS = {"hand": ("palm", "fingertips"), "palm": ("palm",), "fingers": ("fingertips",), "foot": ("heel", "toes"),
+                         "heel": ("heel",), "toes": ("toes",)}
+"""Body parts → the landmarks on them (``person.right_palm`` ...)."""
+
+
 def unknown_person_link(link: str, links) -> str:
     """The message for ``person.<link>`` that is not a link: the link that is that body part when
     ``link`` names one (``right_hand`` → ``right_wrist``), else the closest names; and where all 43
@@ -217,6 +222,8 @@ def unknown_person_link(link: str, links) -> str:
     if part in PERSON_PART_LINKS:
         names = [f"{side}_{PERSON_PART_LINKS[part]}"] if side else [f"right_{PERSON_PART_LINKS[part]}", f"left_{PERSON_PART_LINKS[part]}"]
         if all(n in links for n in names):
+            points = [f"person.{side}_{lm}" for lm in PERSON_PART_LANDMARKS.get(part, ())] if side else []
+            on_it = f", and person points on it: {', '.join(points)}" if points else ""
             return (f"unknown link '{link}' of person; the {part.replace('_', ' ')} is link {' or '.join(repr(n) for n in names)} "
-                    f"(limb links are named after the joint at their top){where}")
+                    f"(limb links are named after the joint at their top){on_it}{where}")
     return f"unknown link '{link}' of person; {expected(links, link)}{where}"
