@@ -107,12 +107,13 @@ class Cluster:
         self.procs.append(proc)
         return proc
 
-    def add_worker(self) -> subprocess.Popen:
-        """A worker node with 2 CPUs that cannot see ``hidden``; returns once the head counts it."""
-        worker_cmd = " ".join(self.ray_cli + [f"--address={self.address}", "--num-cpus=2"])
+    def add_worker(self, cpus: int = 2, cluster_cpus: int = 2) -> subprocess.Popen:
+        """A worker node with ``cpus`` CPUs that cannot see ``hidden``; returns once the head counts
+        ``cluster_cpus`` in all."""
+        worker_cmd = " ".join(self.ray_cli + [f"--address={self.address}", f"--num-cpus={cpus}"])
         worker = self._start(["unshare", "--mount", "--propagation", "private", "sh", "-c",
                               f"mount -t tmpfs tmpfs {self.hidden} && exec {worker_cmd}"])
-        _wait_for_worker_node(self.port, self.env, self.log)
+        _wait_for_worker_node(self.port, self.env, self.log, cpus=cluster_cpus)
         return worker
 
     def kill(self, proc: subprocess.Popen) -> None:
@@ -146,14 +147,14 @@ def cluster(tmp_path_factory):
         c.stop()
 
 
-def _wait_for_worker_node(port: int, env: dict, log: Path, seconds: float = 90) -> None:
-    """Until the head counts 2 CPUs (a worker node's); fails with the nodes' log otherwise."""
+def _wait_for_worker_node(port: int, env: dict, log: Path, seconds: float = 90, cpus: int = 2) -> None:
+    """Until the head counts ``cpus`` CPUs (the worker nodes'); fails with the nodes' log otherwise."""
     probe = ("import ray, time, sys\n"
              f"ray.init(address='127.0.0.1:{port}', log_to_driver=False)\n"
              f"deadline = time.time() + {seconds}\n"
-             "while ray.cluster_resources().get('CPU', 0) < 2 and time.time() < deadline:\n"
+             f"while ray.cluster_resources().get('CPU', 0) < {cpus} and time.time() < deadline:\n"
              "    time.sleep(1)\n"
-             "sys.exit(0 if ray.cluster_resources().get('CPU', 0) >= 2 else 1)\n")
+             f"sys.exit(0 if ray.cluster_resources().get('CPU', 0) >= {cpus} else 1)\n")
     result = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True, timeout=seconds + 60)
     assert result.returncode == 0, f"the worker node did not join: {log.read_text()[-2000:]}"
 
@@ -220,5 +221,39 @@ def test_a_worker_node_lost_mid_run_stops_with_a_checkpoint_and_resume_finishes(
         resumed = _train(c.address, out, c.driver_env, config, "--resume", "--steps", str(stopped_at + 200))
         assert resumed.returncode == 0, resumed.stderr[-3000:]
         assert json.loads(resumed.stdout)["steps"] >= stopped_at + 200
+    finally:
+        c.stop()
+
+
+@pytest.mark.slow
+def test_a_run_goes_on_with_the_env_runners_left_when_one_of_two_nodes_dies(tmp_path):
+    """Two worker nodes of one CPU each, one env runner on each: the first dies mid-run, and
+    training goes on with the other's samples to the end of the run."""
+    reason = _namespaces_work(tmp_path)
+    if reason:
+        pytest.skip(reason)
+    c = Cluster(tmp_path)
+    try:
+        first = c.add_worker(cpus=1, cluster_cpus=1)
+        c.add_worker(cpus=1, cluster_cpus=2)
+        config = tmp_path / "longer.yaml"
+        config.write_text(TINY.replace("total_steps: 200", "total_steps: 1400"))
+        out = c.hidden / "run"
+        command = [sys.executable, "-m", "assistive_compiler.cli", "train", str(FEEDING), "--robot", "jaco", "--config", str(config),
+                   "--engine", "rllib", "--address", c.address, "--out", str(out), "--quiet", "--json"]
+        driver = subprocess.Popen(command, env=c.driver_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO)
+        try:
+            deadline = time.time() + 240
+            while not list((out / "checkpoints").glob("step_*")) and time.time() < deadline and driver.poll() is None:
+                time.sleep(1)
+            assert driver.poll() is None, "the run ended before the node was killed"
+            c.kill(first)
+            stdout, stderr = driver.communicate(timeout=300)
+        finally:
+            if driver.poll() is None:
+                driver.kill()
+        assert driver.returncode == 0 and stdout.startswith("{"), (stdout[:3000], stderr[-3000:])
+        summary = json.loads(stdout)
+        assert summary["steps"] >= 1400 and not summary["interrupted"]
     finally:
         c.stop()

@@ -6,6 +6,7 @@ itself never imports."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import sys
 from pathlib import Path
@@ -45,9 +46,12 @@ def cmd_train(args: argparse.Namespace) -> int:
         return EXIT_FAILED
     from ..training.train import train
 
-    summary = train(args.spec, robot=args.robot, config_path=training_config_path(args.config), coop=args.coop, engine=engine,
-                    steps=args.steps, seed=args.seed, envs=args.envs, out=args.out, resume=args.resume,
-                    address=args.address, quiet=args.quiet)
+    # With --json, stdout holds the summary alone: whatever training prints (and Ray's forwarded
+    # cluster messages, e.g. "node ... marked dead") goes to stderr meanwhile.
+    with contextlib.redirect_stdout(sys.stderr) if args.json else contextlib.nullcontext():
+        summary = train(args.spec, robot=args.robot, config_path=training_config_path(args.config), coop=args.coop, engine=engine,
+                        steps=args.steps, seed=args.seed, envs=args.envs, out=args.out, resume=args.resume,
+                        address=args.address, quiet=args.quiet)
     print(json.dumps(summary, indent=1) if args.json else _summary_line(summary))
     if summary["interrupted"]:
         print(f"stopped: {summary['stopped_because']}" if summary.get("stopped_because") else
