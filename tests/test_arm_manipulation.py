@@ -240,9 +240,12 @@ def _errors(tmp_path, capsys, text: str) -> list[str]:
 
 def test_start_left_in_a_one_arm_task_is_refused(tmp_path, capsys):
     text = f"extends: {FEEDING}\nrobot:\n  start_left: {{tool_position_m: [0, 0, 1]}}\n"
+    line, column = at(FEEDING.read_text(), "arm: right").split(":")
     assert _errors(tmp_path, capsys, text) == [
         f"{at(text, '{tool_')}: robot.start_left: start_left is the left arm's start in a task acting with both arms, "
-        "but this task's arm is 'right'; remove it or set arm: both"]
+        "but this task's arm is 'right'; remove it or set arm: both (arm: right is inherited from "
+        f"{display(FEEDING)}:{line}:{int(column) + len('arm: ')}; remove it in {display(tmp_path / 'spec.yaml')} with "
+        "robot: {$delete: [arm]}, or rewrite robot whole with robot: {$replace: {...}})"]
 
 
 def test_a_tool_in_a_hand_the_task_does_not_act_with_is_refused(tmp_path, capsys):

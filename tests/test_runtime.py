@@ -555,7 +555,8 @@ def test_cli_bench_takes_several_robots_one_row_per_spec_and_robot(capsys):
     assert rc == 0
     rows = json.loads(capsys.readouterr().out)
     assert [(r["task"], r["robot"], r["action_size"]) for r in rows] == [("feeding", "jaco", 7), ("feeding", "stretch", 5)]
-    assert rows[0]["reference_env_steps_per_s"] == 248 and rows[1]["reference_env_steps_per_s"] is None  # not measured for Stretch
+    assert rows[0]["reference_env_steps_per_s"] == 348 and rows[1]["reference_env_steps_per_s"] is None  # not measured for Stretch
+    assert rows[1]["reference_figure"] is None
     for r in rows:
         assert r["env_over_raw"] == pytest.approx(r["env_steps_per_s"] / r["raw_physics_steps_per_s"], abs=2e-3)
 
