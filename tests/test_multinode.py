@@ -182,6 +182,26 @@ def test_train_on_a_worker_that_cannot_see_the_drivers_files(cluster, coop, tmp_
     assert json.loads(evaluation.stdout)["coop"] is coop
 
 
+def _train_and_kill_a_node_mid_run(c: Cluster, config: Path, out: Path, node: subprocess.Popen):
+    """Start ``train --address`` in the background, SIGKILL ``node`` once the run's first checkpoint
+    is written (the run still going), and wait for the driver: (driver, stdout, stderr)."""
+    command = [sys.executable, "-m", "assistive_compiler.cli", "train", str(FEEDING), "--robot", "jaco", "--config", str(config),
+               "--engine", "rllib", "--address", c.address, "--out", str(out), "--quiet", "--json"]
+    driver = subprocess.Popen(command, env=c.driver_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO)
+    try:
+        deadline = time.time() + 240
+        while not list((out / "checkpoints").glob("step_*")) and time.time() < deadline and driver.poll() is None:
+            time.sleep(1)
+        assert list((out / "checkpoints").glob("step_*")), "no checkpoint before the node was killed"
+        assert driver.poll() is None, "the run ended before the node was killed"
+        c.kill(node)
+        stdout, stderr = driver.communicate(timeout=300)
+    finally:
+        if driver.poll() is None:
+            driver.kill()
+    return driver, stdout, stderr
+
+
 @pytest.mark.slow
 def test_a_worker_node_lost_mid_run_stops_with_a_checkpoint_and_resume_finishes(tmp_path):
     """The only worker node dies (SIGKILL to its raylet and env runners) during a run: training
@@ -196,19 +216,7 @@ def test_a_worker_node_lost_mid_run_stops_with_a_checkpoint_and_resume_finishes(
         config = tmp_path / "long.yaml"
         config.write_text(TINY.replace("total_steps: 200", "total_steps: 1000000"))
         out = c.hidden / "run"
-        command = [sys.executable, "-m", "assistive_compiler.cli", "train", str(FEEDING), "--robot", "jaco", "--config", str(config),
-                   "--engine", "rllib", "--address", c.address, "--out", str(out), "--quiet", "--json"]
-        driver = subprocess.Popen(command, env=c.driver_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO)
-        try:
-            deadline = time.time() + 240
-            while not list((out / "checkpoints").glob("step_*")) and time.time() < deadline and driver.poll() is None:
-                time.sleep(1)
-            assert list((out / "checkpoints").glob("step_*")), "no checkpoint before the node was killed"
-            c.kill(worker)
-            stdout, stderr = driver.communicate(timeout=240)
-        finally:
-            if driver.poll() is None:
-                driver.kill()
+        driver, stdout, stderr = _train_and_kill_a_node_mid_run(c, config, out, worker)
         assert driver.returncode == 130, stderr[-3000:]
         assert "stopped: all 2 env runners were lost (the node they ran on died or left the cluster); checkpoint written: " \
                "start a worker node again and run the same command with --resume" in stderr, stderr[-3000:]
@@ -239,19 +247,7 @@ def test_a_run_goes_on_with_the_env_runners_left_when_one_of_two_nodes_dies(tmp_
         config = tmp_path / "longer.yaml"
         config.write_text(TINY.replace("total_steps: 200", "total_steps: 1400"))
         out = c.hidden / "run"
-        command = [sys.executable, "-m", "assistive_compiler.cli", "train", str(FEEDING), "--robot", "jaco", "--config", str(config),
-                   "--engine", "rllib", "--address", c.address, "--out", str(out), "--quiet", "--json"]
-        driver = subprocess.Popen(command, env=c.driver_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO)
-        try:
-            deadline = time.time() + 240
-            while not list((out / "checkpoints").glob("step_*")) and time.time() < deadline and driver.poll() is None:
-                time.sleep(1)
-            assert driver.poll() is None, "the run ended before the node was killed"
-            c.kill(first)
-            stdout, stderr = driver.communicate(timeout=300)
-        finally:
-            if driver.poll() is None:
-                driver.kill()
+        driver, stdout, stderr = _train_and_kill_a_node_mid_run(c, config, out, first)
         assert driver.returncode == 0 and stdout.startswith("{"), (stdout[:3000], stderr[-3000:])
         summary = json.loads(stdout)
         assert summary["steps"] >= 1400 and not summary["interrupted"]
