@@ -126,6 +126,11 @@ class Library:
             self._cache[key] = loaded
         return self._cache[key]
 
+    def person_urdf(self, name: str) -> str:
+        """The person template rendered with variant ``name``'s measurements (URDF XML); raises like
+        :meth:`get` for an unknown or broken variant."""
+        return render_template(PERSON_TEMPLATE_RELPATH, self.get("people", name).part.measurements().xacro_args())
+
     def default_urdf(self, kind: str, name: str) -> UrdfInfo:
         """Links and joints of the part rendered with its own parameters."""
         return self._urdf_of(kind, self.get(kind, name))
@@ -133,8 +138,7 @@ class Library:
     def _urdf_of(self, kind: str, loaded: LoadedPart) -> UrdfInfo:
         part = loaded.part
         if kind == "people":
-            m = part.measurements()
-            return urdf_info(render_template(PERSON_TEMPLATE_RELPATH, m.xacro_args()))
+            return urdf_info(self.person_urdf(part.name))
         if getattr(part, "urdf", None):
             return self._urdf_file_info(loaded)
         params = dict(part.template.params) | dict(getattr(part, "mount_params", {}) or {})

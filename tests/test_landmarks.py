@@ -8,9 +8,8 @@ import pybullet as pb
 import pytest
 
 from assistive_compiler.compile.compiler import compile_task
-from assistive_compiler.compile.render import render_template
 from assistive_compiler.errors import SpecError
-from assistive_compiler.library import PERSON_TEMPLATE_RELPATH, Library
+from assistive_compiler.library import Library
 from assistive_compiler.person.landmarks import LANDMARKS, landmark_offsets
 from assistive_compiler.quat import quat_rotate
 from assistive_compiler.runtime.env import AssistiveEnv
@@ -18,8 +17,7 @@ from conftest import FEEDING
 
 
 def offsets(variant: str) -> dict:
-    part = Library().get("people", variant).part
-    return landmark_offsets(render_template(PERSON_TEMPLATE_RELPATH, part.measurements().xacro_args()))
+    return landmark_offsets(Library().person_urdf(variant))
 
 
 def test_landmarks_follow_each_variants_body():

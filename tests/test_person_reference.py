@@ -5,8 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from assistive_compiler.cli import main
-from assistive_compiler.compile.render import render_template, urdf_info
-from assistive_compiler.library import PERSON_TEMPLATE_RELPATH, Library
+from assistive_compiler.compile.render import urdf_info
+from assistive_compiler.library import Library
 from assistive_compiler.person.reference_page import person_reference_markdown
 
 PAGE = Path(__file__).resolve().parents[1] / "docs" / "person.md"
@@ -17,8 +17,7 @@ def test_the_person_page_is_what_the_code_renders():
 
 
 def test_the_page_lists_every_link_and_joint_with_the_models_limits():
-    part = Library().get("people", "male_50th").part
-    info = urdf_info(render_template(PERSON_TEMPLATE_RELPATH, part.measurements().xacro_args()))
+    info = urdf_info(Library().person_urdf("male_50th"))
     text = PAGE.read_text()
     assert len(info.links) == 43
     for link in info.links:

@@ -10,8 +10,8 @@ byte-identical output. The stages, in order, are listed in :mod:`assistive_compi
 
 from __future__ import annotations
 
-import hashlib
 import errno
+import hashlib
 import os
 import shutil
 import tempfile

@@ -125,7 +125,8 @@ LANDMARKS: dict[str, Landmark] = {
 """Every landmark by name (``person.<name>`` in a spec)."""
 
 
-def _vec(text: str | None) -> Vec3:
+def vec3(text: str | None) -> Vec3:
+    """A URDF ``xyz`` / ``rpy`` attribute as three floats (absent: zeros)."""
     return tuple(float(v) for v in (text or "0 0 0").split())  # type: ignore[return-value]
 
 
@@ -136,8 +137,8 @@ def link_shapes(urdf_xml: str) -> dict[str, LinkShapes]:
         spheres, capsules = [], []
         for col in link.findall("collision"):
             origin = col.find("origin")
-            xyz = _vec(origin.get("xyz") if origin is not None else None)
-            rpy = _vec(origin.get("rpy") if origin is not None else None)
+            xyz = vec3(origin.get("xyz") if origin is not None else None)
+            rpy = vec3(origin.get("rpy") if origin is not None else None)
             for g in col.find("geometry") or ():
                 if g.tag == "sphere":
                     spheres.append((xyz, float(g.get("radius"))))

@@ -11,20 +11,11 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+
+from .landmarks import LANDMARKS, LinkShapes, landmark_offsets, link_shapes, vec3
 
 PAGE_VARIANTS = ("male_50th", "female_50th")
 """The variants whose sizes the page lists (the shipped tasks' two); the others scale the same way."""
-
-
-@dataclass(frozen=True)
-class _Shape:
-    kind: str  # capsule, sphere, box
-    text: str
-
-
-def _vec(text: str | None) -> tuple[float, float, float]:
-    return tuple(float(v) for v in (text or "0 0 0").split())  # type: ignore[return-value]
 
 
 def _cm(v: float) -> str:
@@ -35,33 +26,11 @@ def _xyz_cm(xyz) -> str:
     return "(" + ", ".join(_cm(v) for v in xyz) + ")"
 
 
-def _render(name: str) -> ET.Element:
-    from ..compile.render import render_template
-    from ..library import PERSON_TEMPLATE_RELPATH, Library
-
-    part = Library().get("people", name).part
-    return ET.fromstring(render_template(PERSON_TEMPLATE_RELPATH, part.measurements().xacro_args()))
-
-
-def _shapes(link: ET.Element) -> list[_Shape]:
-    """A link's collision shapes, a capsule (a cylinder and its two end spheres) as one."""
-    cylinders, spheres, boxes = [], [], []
-    for col in link.findall("collision"):
-        origin = col.find("origin")
-        xyz = _vec(origin.get("xyz") if origin is not None else None)
-        geom = col.find("geometry")
-        for g in geom:  # type: ignore[union-attr]
-            if g.tag == "cylinder":
-                cylinders.append((float(g.get("radius")), float(g.get("length")), xyz))
-            elif g.tag == "sphere":
-                spheres.append((float(g.get("radius")), xyz))
-            elif g.tag == "box":
-                boxes.append((_vec(g.get("size")), xyz))
-    out = [_Shape("capsule", f"capsule r {_cm(r)}, length {_cm(l)}, centre {_xyz_cm(c)}") for r, l, c in cylinders]
-    if not cylinders:  # a capsule's end spheres are part of it; a lone sphere is the shape
-        out += [_Shape("sphere", f"sphere r {_cm(r)}, centre {_xyz_cm(c)}") for r, c in spheres]
-    out += [_Shape("box", f"box {_xyz_cm(size)}, centre {_xyz_cm(c)}") for size, c in boxes]
-    return out
+def _shape_text(shapes: LinkShapes) -> str:
+    """A link's collision shapes in words (a capsule as one shape, its end spheres part of it)."""
+    out = [f"capsule r {_cm(r)}, length {_cm(length)}, centre {_xyz_cm(c)}" for c, r, length, _axis in shapes.capsules]
+    out += [f"sphere r {_cm(r)}, centre {_xyz_cm(c)}" for c, r in shapes.spheres]
+    return " / ".join(out)
 
 
 def _axis_name(axis) -> str:
@@ -79,7 +48,12 @@ def _direction(xyz) -> str:
 
 def person_reference_markdown() -> str:
     """The page, as Markdown."""
-    roots = {name: _render(name) for name in PAGE_VARIANTS}
+    from ..library import Library
+
+    library = Library()
+    urdfs = {name: library.person_urdf(name) for name in PAGE_VARIANTS}
+    roots = {name: ET.fromstring(text) for name, text in urdfs.items()}
+    shapes_by_variant = {name: link_shapes(text) for name, text in urdfs.items()}
     first = roots[PAGE_VARIANTS[0]]
     links = [el.get("name") for el in first.findall("link")]
     joints = first.findall("joint")
@@ -87,7 +61,6 @@ def person_reference_markdown() -> str:
     children: dict[str, list[ET.Element]] = {}
     for j in joints:
         children.setdefault(j.find("parent").get("link"), []).append(j)
-    by_variant = {name: {el.get("name"): el for el in root.findall("link")} for name, root in roots.items()}
     joints_by_variant = {name: {el.get("name"): el for el in root.findall("joint")} for name, root in roots.items()}
     shown = " / ".join(PAGE_VARIANTS)
 
@@ -129,21 +102,15 @@ def person_reference_markdown() -> str:
     for name in links:
         joint = parent_joint.get(name)
         moved_by = f"`{joint.get('name')}` ({joint.get('type')})" if joint is not None else "— (root)"
-        shapes = [" / ".join(s.text for s in _shapes(by_variant[v][name])) for v in PAGE_VARIANTS]
+        shapes = [_shape_text(shapes_by_variant[v][name]) for v in PAGE_VARIANTS]
         shape_text = shapes[0] if len(set(shapes)) == 1 else "<br>".join(f"{v}: {s}" for v, s in zip(PAGE_VARIANTS, shapes))
         nexts = []
         for child in children.get(name, []):
-            xyz = [_vec(joints_by_variant[v][child.get("name")].find("origin").get("xyz")) for v in PAGE_VARIANTS]
+            xyz = [vec3(joints_by_variant[v][child.get("name")].find("origin").get("xyz")) for v in PAGE_VARIANTS]
             where = _direction(xyz[0]) + (f" ({_direction(xyz[1])})" if _direction(xyz[1]) != _direction(xyz[0]) else "")
             nexts.append(f"`{child.get('name')}`: {where}")
         lines.append(f"| `{name}` | {moved_by} | {shape_text or 'none'} | {'<br>'.join(nexts) or '—'} |")
-    from .landmarks import LANDMARKS, landmark_offsets
-
-    from ..compile.render import render_template
-    from ..library import PERSON_TEMPLATE_RELPATH, Library
-
-    marks = {v: landmark_offsets(render_template(PERSON_TEMPLATE_RELPATH, Library().get("people", v).part.measurements().xacro_args()))
-             for v in PAGE_VARIANTS}
+    marks = {v: landmark_offsets(urdfs[v]) for v in PAGE_VARIANTS}
     lines += [
         "",
         "## Landmarks",
@@ -173,11 +140,11 @@ def person_reference_markdown() -> str:
     for j in joints:
         limit = j.find("limit")
         axis_el = j.find("axis")
-        axis = _axis_name(_vec(axis_el.get("xyz"))) if axis_el is not None else "—"
+        axis = _axis_name(vec3(axis_el.get("xyz"))) if axis_el is not None else "—"
         if limit is not None and j.get("type") == "revolute":
             limits = f"[{math.degrees(float(limit.get('lower'))):.0f}, {math.degrees(float(limit.get('upper'))):.0f}]"
         elif j.get("type") == "fixed":
-            rpy = _vec(j.find("origin").get("rpy"))
+            rpy = vec3(j.find("origin").get("rpy"))
             limits = f"fixed at {math.degrees(max(rpy, key=abs)):.0f}" if any(rpy) else "fixed"
         else:
             limits = "—"

@@ -13,7 +13,7 @@ import dataclasses
 from typing import Any, Iterator
 
 from ..errors import SpecError
-from ..library import PERSON_TEMPLATE_RELPATH, Library
+from ..library import Library
 from ..person.landmarks import LANDMARKS
 from ..spec.load import LoadedSpec
 from ..spec.models.bodies import Target
@@ -43,16 +43,14 @@ def with_landmarks(loaded: LoadedSpec, library: Library) -> LoadedSpec:
     spec = loaded.spec
     if not used:
         return loaded
-    from ..compile.render import render_template
     from ..person.landmarks import landmark_offsets
 
     offsets: dict[str, dict[str, tuple]] = {}  # variant -> landmark -> (link, offset)
     for variant in spec.person.variants:
         try:
-            part = library.get("people", variant).part
+            offsets[variant] = landmark_offsets(library.person_urdf(variant))
         except (KeyError, SpecError):  # an unknown or broken variant: resolution reports it
             return loaded
-        offsets[variant] = landmark_offsets(render_template(PERSON_TEMPLATE_RELPATH, part.measurements().xacro_args()))
     targets = dict(spec.targets)
     for name in used:
         link = LANDMARKS[name].link

@@ -90,7 +90,7 @@ def labelled_frames(env) -> list[tuple[str, np.ndarray, np.ndarray | None]]:
     for tool in m.tools:
         handle = w.bodies[tool.body]
         for name, link in sorted(tool.links.items()):
-            if name == "base" and link in tool.links.values() and list(tool.links.values()).count(link) > 1:
+            if name == "base" and list(tool.links.values()).count(link) > 1:
                 continue  # the base is also a named link: drawn once, by its name
             pos, orn = w.link_frame(handle, handle.links[link])
             out.append((f"{tool.body}.{name}", np.asarray(pos), rotation_matrix(orn)))

@@ -88,8 +88,9 @@ class ArmKinematics:
             if distance >= 0.01:
                 self._note(Miss("out of reach", distance_m=distance))
                 continue
-            if tool_orn is not None and quat_angle(got_orn, ee_orn) >= math.radians(3):
-                self._note(Miss("orientation", angle_deg=math.degrees(quat_angle(got_orn, ee_orn))))
+            angle = quat_angle(got_orn, ee_orn) if tool_orn is not None else 0.0
+            if angle >= math.radians(3):
+                self._note(Miss("orientation", angle_deg=math.degrees(angle)))
                 continue
             touched = self.collision_with(tool_pos, orn, check_tool=not tool_may_touch)
             if touched is not None:
@@ -126,9 +127,6 @@ class ArmKinematics:
         pos, orn = p.multiplyTransforms(base_pos, base_orn, (x, y, 0.0), p.getQuaternionFromEuler((0.0, 0.0, yaw)))
         self.place(pos, orn)
         return tuple(pos), tuple(orn)
-
-    def collides(self, tool_pos, tool_orn, check_tool: bool = True) -> bool:
-        return self.collision_with(tool_pos, tool_orn, check_tool) is not None
 
     def collision_with(self, tool_pos, tool_orn, check_tool: bool = True) -> str | None:
         """The body the arm (or, with ``check_tool``, the tool at its pose) touches first, by the
