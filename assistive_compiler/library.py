@@ -74,6 +74,7 @@ class Library:
             unique.setdefault(Path(root).resolve(), Path(root).resolve())
         self.roots = list(unique)
         self._cache: dict[tuple[str, str], LoadedPart] = {}
+        self._person_urdfs: dict[str, str] = {}
 
     def names(self, kind: str) -> list[str]:
         """All part names of ``kind`` (e.g. 'robots')."""
@@ -129,7 +130,9 @@ class Library:
     def person_urdf(self, name: str) -> str:
         """The person template rendered with variant ``name``'s measurements (URDF XML); raises like
         :meth:`get` for an unknown or broken variant."""
-        return render_template(PERSON_TEMPLATE_RELPATH, self.get("people", name).part.measurements().xacro_args())
+        if name not in self._person_urdfs:  # resolving for every supported robot asks again for the same variant
+            self._person_urdfs[name] = render_template(PERSON_TEMPLATE_RELPATH, self.get("people", name).part.measurements().xacro_args())
+        return self._person_urdfs[name]
 
     def default_urdf(self, kind: str, name: str) -> UrdfInfo:
         """Links and joints of the part rendered with its own parameters."""
