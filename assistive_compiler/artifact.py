@@ -80,6 +80,15 @@ class MarkerPoint(_Model):
     offset: Vec3 = Field(description="Position in the link frame, m.")
 
 
+class SurfacePoint(_Model):
+    """One point a surface target may be drawn at: on a link's surface, with its frame."""
+
+    link: str = Field(description="URDF link it is on.")
+    offset: Vec3 = Field(description="Position in the link frame, m.")
+    normal: Vec3 = Field(description="Outward surface normal, link frame (unit).")
+    axis: Vec3 = Field(description="A direction along the surface, link frame (unit): a limb's axis away from its joint, else toward +z.")
+
+
 class PersonVariant(_Model):
     """One person body the task may draw at reset."""
 
@@ -94,6 +103,10 @@ class PersonVariant(_Model):
     target_offsets: dict[str, Vec3] = Field(description="Offset of each person-attached target in its link, m.")
     surfaces: dict[str, list[Capsule]] = Field(
         default_factory=dict, description="Per surface-drawn target: the limbs (capsules, link frame) a reset draws its point on."
+    )
+    surface_points: dict[str, list[SurfacePoint]] = Field(
+        default_factory=dict, description="Per surface-drawn target not drawn on plain capsules (a sphere link such as the "
+        "head, or a region): the points a reset draws from, a link uniformly, then a point of it uniformly."
     )
     markers: dict[str, list[MarkerPoint]] = Field(default_factory=dict, description="Per marker set: every marker of this body.")
     starts: list[StartState] = Field(description="Robot starts for this variant; reset() draws one.")

@@ -98,8 +98,9 @@ def _first_scratch_waypoint_replaced(by: str) -> str:
 
 def test_surface_target_specs_are_checked(tmp_path):
     spec = (TASKS / "scratch_itch.yaml").read_text().replace(
-        "surface_of: [person.right_shoulder, person.right_elbow]", "surface_of: [person.right_shoulder, person.head]")
-    assert "'person.head' is not a person limb with a capsule" in _rejected_at(tmp_path, spec, "surface_of: [person.right_shoulder, person.head]")
+        "surface_of: [person.right_shoulder, person.right_elbow]", "surface_of: [person.right_shoulder, person.head_x_link]")
+    err = _rejected_at(tmp_path, spec, "surface_of: [person.right_shoulder, person.head_x_link]")
+    assert "'person.head_x_link' is not a person link with a collision shape; expected one of 'person.chest'" in err
 
 
 def test_facing_a_normal_needs_a_surface_target(tmp_path):

@@ -14,12 +14,13 @@ import math
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 
-from ..artifact import Camera, Capsule, Drive, Manifest, MarkerPoint, MarkerSet, Person, PersonVariant, Robot, Sim, StartState, Success, Target, TermUse
+from ..artifact import (Camera, Capsule, Drive, Manifest, MarkerPoint, MarkerSet, Person, PersonVariant, Robot, Sim, StartState, Success,
+                        SurfacePoint, Target, TermUse)
 from ..paths import display
-from ..quat import capsule_axes
+from ..person.surface import SURFACE_TARGET_SPACING_M, link_surface
 from ..resolve import ResolvedTask
+from ..resolve.bodies import surface_region
 from ..spec.models import scalar_bounds
 from ..terms.registry import SizeContext, terms
 from .render import urdf_info
@@ -139,16 +140,18 @@ def person_variant(rt: ResolvedTask, variant: str, urdf: Path, measurements, pos
     for tname, target in rt.spec.targets.items():
         if rt.points.get(tname, {}).get("body") == "person":
             offsets[tname] = rounded(tuple(target.offset_by_variant.get(variant, target.offset_m)))
-    limbs = urdf_info(urdf.read_text()).capsules
-    surfaces = {t: [_capsule(limbs, link) for link in ref["surface_links"]] for t, ref in rt.points.items() if "surface_links" in ref}
-    marker_points = {name: _marker_points(limbs, ms["links"], ms["spacing_m"]) for name, ms in rt.markers.items()}
+    info = urdf_info(urdf.read_text())
+    drawn = {t: ref for t, ref in rt.points.items() if "surface_links" in ref}
+    surfaces = {t: [_capsule(info.capsules, link) for link in ref["surface_links"]] for t, ref in drawn.items() if _drawn_on_capsules(rt, ref)}
+    surface_points = {t: _surface_points(rt, info, variant, ref) for t, ref in drawn.items() if not _drawn_on_capsules(rt, ref)}
+    marker_points = {name: _marker_points(rt, info, variant, ms) for name, ms in rt.markers.items()}
     initial = {j: rounded(posture[j]) for j in movable}
     randomize = {j: rounded(tuple(math.radians(a) for a in person_spec.randomize_deg[j].uniform)) for j in movable if j in person_spec.randomize_deg}
     m = measurements
     return PersonVariant(name=variant, body=f"person_{variant}", sex=m.sex, mass_kg=rounded(m.mass_kg),
                          standing_height_m=rounded(m.standing_height_m), movable_joints=movable,
                          initial_angles=initial, randomize=randomize, target_offsets=offsets, starts=starts,
-                         surfaces=surfaces, markers=marker_points)
+                         surfaces=surfaces, surface_points=surface_points, markers=marker_points)
 
 
 def _capsule(limbs: dict, link: str) -> Capsule:
@@ -156,21 +159,23 @@ def _capsule(limbs: dict, link: str) -> Capsule:
     return Capsule(link=link, start=rounded(cap.start), end=rounded(cap.end), radius=rounded(cap.radius))
 
 
-def _marker_points(limbs: dict, links: list[str], spacing: float) -> list[MarkerPoint]:
-    """The reference's capsule_points: on each limb, int(L/spacing) rings at L·(i+1)/(n+1) from the
-    joint end, each with int(2πr/spacing) points spacing/r radians apart (male arm: 81 + 48)."""
-    out: list[MarkerPoint] = []
-    for link in links:
-        cap = limbs[link]
-        start, r = np.asarray(cap.start), cap.radius
-        length, axis, u, v = capsule_axes(cap.start, cap.end)
-        rings, per_ring = int(length / spacing), int(2 * math.pi * r / spacing)
-        for i in range(rings):
-            centre = start + axis * length * (i + 1) / (rings + 1)
-            for k in range(per_ring):
-                a = k * spacing / r
-                out.append(MarkerPoint(link=link, offset=rounded(tuple(centre + r * (math.cos(a) * u + math.sin(a) * v)))))
-    return out
+def _marker_points(rt: ResolvedTask, info, variant: str, ms: dict) -> list[MarkerPoint]:
+    """The markers of one set on one variant: each link's surface points ``spacing_m`` apart
+    (:func:`~assistive_compiler.person.surface.link_surface`), in its region."""
+    region = surface_region(rt.spec, ms["region"], variant)
+    return [MarkerPoint(link=p.link, offset=rounded(p.offset)) for link in ms["links"]
+            for p in link_surface(info, link, ms["spacing_m"], region)]
+
+
+def _surface_points(rt: ResolvedTask, info, variant: str, ref: dict) -> list[SurfacePoint]:
+    region = surface_region(rt.spec, ref.get("region"), variant)
+    return [SurfacePoint(link=p.link, offset=rounded(p.offset), normal=rounded(p.normal), axis=rounded(p.axis))
+            for link in ref["surface_links"] for p in link_surface(info, link, SURFACE_TARGET_SPACING_M, region)]
+
+
+def _drawn_on_capsules(rt: ResolvedTask, ref: dict) -> bool:
+    """A surface target drawn as the reference draws an itch: plain capsules, no region."""
+    return "region" not in ref and all(l in rt.person_urdf.capsules and l not in rt.person_urdf.spheres for l in ref["surface_links"])
 
 
 def impairment_json(rt: ResolvedTask, choice) -> dict[str, Any]:

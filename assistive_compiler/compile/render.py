@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import re
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 from typing import Mapping
@@ -98,6 +98,14 @@ class Capsule:
 
 
 @dataclass(frozen=True)
+class Sphere:
+    """A collision sphere of a link in the link frame: its centre and radius (m)."""
+
+    centre: tuple[float, float, float]
+    radius: float
+
+
+@dataclass(frozen=True)
 class UrdfInfo:
     """Names declared by a URDF, for cross-reference checks."""
 
@@ -106,6 +114,13 @@ class UrdfInfo:
     joints: dict[str, JointInfo]
     capsules: dict[str, Capsule]
     root_tag: str = "robot"
+    spheres: dict[str, tuple[Sphere, ...]] = field(default_factory=dict)
+    """Each link's collision spheres that are not the end caps of its capsule."""
+
+    @property
+    def surface_links(self) -> tuple[str, ...]:
+        """Links with a collision capsule or sphere (what markers and surface targets may cover)."""
+        return tuple(l for l in self.links if l in self.capsules or l in self.spheres)
 
     @property
     def movable_joints(self) -> dict[str, JointInfo]:
@@ -134,7 +149,29 @@ def urdf_info(urdf_xml: str) -> UrdfInfo:
             el.get("name", ""), jtype, el.find("parent").get("link", ""), child, lower, upper, axis  # type: ignore[union-attr]
         )
     roots = [l for l in links if l not in children]
-    return UrdfInfo(roots[0] if roots else "", links, joints, _capsules(root), root.tag)
+    capsules = _capsules(root)
+    return UrdfInfo(roots[0] if roots else "", links, joints, capsules, root.tag, _spheres(root, capsules))
+
+
+def _spheres(root: ET.Element, capsules: dict[str, Capsule]) -> dict[str, tuple[Sphere, ...]]:
+    """Each link's collision spheres, leaving out the two that cap its capsule's cylinder."""
+    out: dict[str, tuple[Sphere, ...]] = {}
+    for link in root.findall("link"):
+        name, cap = link.get("name", ""), capsules.get(link.get("name", ""))
+        found = []
+        for col in link.findall("collision"):
+            sphere = col.find("geometry/sphere")
+            if sphere is None:
+                continue
+            origin = col.find("origin")
+            centre = tuple(float(v) for v in (origin.get("xyz", "0 0 0") if origin is not None else "0 0 0").split())
+            radius = float(sphere.get("radius", "0"))
+            if cap is not None and abs(radius - cap.radius) < 1e-9 and min(math.dist(centre, cap.start), math.dist(centre, cap.end)) < 1e-6:
+                continue
+            found.append(Sphere(centre, radius))  # type: ignore[arg-type]
+        if found:
+            out[name] = tuple(found)
+    return out
 
 
 def _rpy_matrix(r: float, p: float, y: float) -> list[list[float]]:

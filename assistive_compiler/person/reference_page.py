@@ -73,7 +73,7 @@ def person_reference_markdown() -> str:
         "variant's measurements in `specs/people/`), as a spec refers to them: a point is",
         "`person.<link>` (its frame's origin), a target is `{link: person.<link>, offset_m: [x, y, z]}`",
         "(the offset in that link's frame, metres), a marker or surface target covers",
-        "`surface_of: [person.<link>]` (a link with a capsule).",
+        "`surface_of: [person.<link>]` (any link with a shape below, optionally a `region` of it).",
         "",
         "**Frames.** At the person's zero pose every link frame is parallel to the person's base frame:",
         "**+x is the person's left, −y is the way the person faces (front), +z is up** (toward the head).",

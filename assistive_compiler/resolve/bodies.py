@@ -1,7 +1,7 @@
 """The body sections: body names, ``targets``, ``markers``, ``particles`` and ``garments``.
 
 Checks that every furniture, tool, particle set and garment has a name of its own (not ``robot``
-or ``person``), that targets sit on known links (``surface_of``: person limbs with a capsule) and
+or ``person``), that targets sit on known links (``surface_of``: person links with a collision shape, optionally a region of them) and
 their per-variant offsets name the task's person variants, that marker sets are cleared by a tool
 link, that particle sets attach to, rest in and are lost beyond known bodies (containers are
 tools whose part declares one), and that a garment's grip, held node set and colliders exist.
@@ -11,9 +11,11 @@ sets.
 
 from __future__ import annotations
 
-from typing import Any
+import math
+from typing import Any, Literal
 
 from ..errors import did_you_mean, one_of
+from ..person.surface import SURFACE_TARGET_SPACING_M, Region, link_surface
 from .located import expected
 from .scope import RESERVED_BODIES, Scope
 
@@ -40,9 +42,12 @@ def targets(s: Scope) -> dict[str, dict[str, Any]]:
     out: dict[str, dict[str, Any]] = {}
     for name, target in spec.targets.items():
         if target.surface_of:
-            links = s.limbs(target.surface_of, ("targets", name, "surface_of"))
-            if links:
-                out[name] = {"body": "person", "link": links[0], "surface_links": links}
+            links = s.surface_links(target.surface_of, ("targets", name, "surface_of"))
+            region = region_of(s, target.region, links, ("targets", name, "region"))
+            if region and links:
+                region = _non_empty(s, region, links, SURFACE_TARGET_SPACING_M, ("targets", name, "region"))
+            if links and region is not False:
+                out[name] = {"body": "person", "link": links[0], "surface_links": links} | ({"region": region} if region else {})
             continue
         p = s.point(target.link, ("targets", name, "link"), allow_target=False)
         for variant in target.offset_by_variant:
@@ -61,15 +66,89 @@ def markers(s: Scope) -> dict[str, dict[str, Any]]:
         base = ("markers", name)
         if name in s.body_names or name in spec.targets:
             s.problem(base, f"marker set name '{name}' is already used by a body or target", key=True)
-        links = s.limbs(ms.surface_of, base + ("surface_of",))
+        links = s.surface_links(ms.surface_of, base + ("surface_of",))
+        region = region_of(s, ms.region, links, base + ("region",))
         tool = s.point(ms.cleared_by.tool, base + ("cleared_by", "tool"), allow_target=False)
         if tool is not None and tool["body"] not in spec.tools:
             s.problem(base + ("cleared_by", "tool"), f"markers are cleared by a tool link; '{ms.cleared_by.tool}' is not on a tool (tools: {one_of(spec.tools)})")
             tool = None
-        if links and tool:
+        if region and links:
+            region = _non_empty(s, region, links, ms.spacing_m, base + ("region",))
+        if links and tool and region is not False:
             out[name] = {"links": links, "tool": tool, "radius_m": ms.cleared_by.radius_m, "spacing_m": ms.spacing_m,
-                         "show_rgba": ms.show_rgba}
+                         "show_rgba": ms.show_rgba, "region": region}
     return out
+
+
+def surface_region(spec, region: dict[str, Any] | None, variant: str) -> Region | None:
+    """A resolved region (:func:`region_of`) on person ``variant``, in its link's frame."""
+    if region is None:
+        return None
+    centre = None
+    if region["near"] is not None:
+        target = region["near"]["target"]
+        t = spec.targets[target] if target else None
+        centre = tuple(t.offset_by_variant.get(variant, t.offset_m)) if t else (0.0, 0.0, 0.0)
+    return Region(centre=centre, radius=region["radius_m"], facing=tuple(region["facing"]) if region["facing"] else None,
+                  max_angle=region["max_angle_rad"], along=tuple(region["along"]) if region["along"] else None)
+
+
+def _non_empty(s: Scope, region: dict[str, Any], links: list[str], spacing: float, path: tuple) -> dict[str, Any] | Literal[False]:
+    """``region``, or False and a problem when it keeps no point of the links on some person variant."""
+    for variant in s.spec.person.variants:
+        info = s.lib.default_urdf("people", variant)
+        kept = sum(len(link_surface(info, l, spacing, surface_region(s.spec, region, variant))) for l in links)
+        if not kept:
+            total = sum(len(link_surface(info, l, spacing)) for l in links)
+            s.problem(path, f"the region keeps none of the {total} surface points of {', '.join('person.' + l for l in links)} "
+                            f"({spacing * 100:g} cm apart) on {variant}; widen it (radius_m, max_angle_deg, along)")
+            return False
+    return region
+
+
+def region_of(s: Scope, region, links: list[str], path: tuple) -> dict[str, Any] | None | Literal[False]:
+    """A surface region resolved for the runtime: ``near`` as ``{"link", "target"}`` (the target whose
+    per-variant offset is the centre; None: the link's origin), ``facing`` as a unit vector,
+    ``max_angle_rad`` and ``along``. None when there is no region, False when it has a problem."""
+    if region is None:
+        return None
+    out: dict[str, Any] = {"radius_m": region.radius_m, "along": list(region.along) if region.along else None,
+                           "max_angle_rad": math.radians(region.max_angle_deg) if region.facing is not None else None,
+                           "facing": None, "near": None}
+    ok = True
+    if region.facing is not None:
+        n = math.sqrt(sum(v * v for v in region.facing))
+        out["facing"] = [v / n for v in region.facing]
+    if region.near is not None:
+        p = s.point(region.near, path + ("near",))
+        if p is None:
+            return False
+        target = p.get("target")
+        if target is not None:
+            t = s.spec.targets[target]
+            if t.surface_of:
+                s.problem(path + ("near",), f"'{region.near}' is drawn anew at every reset; a region is fixed on the link: give a landmark, a fixed target or a link")
+                return False
+            p = s.point(t.link, ("targets", target, "link"), allow_target=False)
+            if p is None:
+                return False
+        if p["body"] != "person" or (links and p["link"] not in links):
+            on = f"person.{p['link']}" if p["body"] == "person" else f"{p['body']}.{p['link']}"
+            s.problem(path + ("near",), f"'{region.near}' is on {on}; a region is centred on a covered link "
+                                        f"({', '.join('person.' + l for l in links)}), in that link's frame")
+            return False
+        if len(links) > 1:
+            s.problem(path + ("near",), f"a region near a point covers one link, the point's (person.{p['link']}); "
+                                        f"surface_of names {len(links)}: give only person.{p['link']}")
+            return False
+        out["near"] = {"link": p["link"], "target": target}
+    if region.along is not None:
+        no_capsule = [l for l in links if l not in s.person_urdf.capsules]
+        if no_capsule:
+            s.problem(path + ("along",), f"'along' is a fraction of a limb's capsule; person.{no_capsule[0]} has none "
+                                         f"(capsule links: {one_of(['person.' + l for l in s.person_urdf.capsules])})")
+            ok = False
+    return out if ok else False
 
 
 def check_particles(s: Scope) -> None:

@@ -17,7 +17,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..compile.render import UrdfInfo
-from ..errors import SpecError, one_of
+from ..errors import SpecError
 from ..library import Library, LoadedPart
 from ..spec.load import LoadedSpec
 from .located import Collector, expected
@@ -134,16 +134,16 @@ class Scope(Collector):
             return None
         return {"body": body, "link": links[link]}
 
-    def limbs(self, refs: list[str], path: tuple) -> list[str]:
-        """URDF names of person limbs with a capsule (a cylinder collision shape)."""
+    def surface_links(self, refs: list[str], path: tuple) -> list[str]:
+        """URDF names of person links with a collision shape (capsule or sphere) to cover."""
         out = []
         for i, ref in enumerate(refs):
             p = self.point(ref, path + (i,), allow_target=False)
             if p is None:
                 continue
-            if p["body"] != "person" or p["link"] not in self.person_urdf.capsules:
-                pool = sorted(self.person_urdf.capsules)
-                self.problem(path + (i,), f"'{ref}' is not a person limb with a capsule; expected one of {one_of(['person.' + l for l in pool])}")
+            if p["body"] != "person" or p["link"] not in self.person_urdf.surface_links:
+                pool = ["person." + l for l in self.person_urdf.surface_links]
+                self.problem(path + (i,), f"'{ref}' is not a person link with a collision shape; {expected(pool, ref, limit=21)}")
                 continue
             out.append(p["link"])
         return out

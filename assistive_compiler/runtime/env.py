@@ -100,6 +100,15 @@ def draw_surface_point(capsules, rng: np.random.Generator) -> tuple[str, np.ndar
     return cap.link, start + axis * along + cap.radius * normal, normal, axis
 
 
+def draw_listed_point(points, rng: np.random.Generator):
+    """One of a surface target's listed points (``PersonVariant.surface_points``): a link uniformly,
+    then one of its points uniformly (so a small link is drawn as often as a large one, as on capsules)."""
+    links = list(dict.fromkeys(p.link for p in points))
+    link = links[int(rng.integers(len(links)))]
+    on_link = [p for p in points if p.link == link]
+    return on_link[int(rng.integers(len(on_link)))]
+
+
 class AssistiveEnv(gym.Env):
     """A compiled assistive task as a Gymnasium environment (robot acting, person static)."""
 
@@ -208,6 +217,9 @@ class AssistiveEnv(gym.Env):
         for name, capsules in variant.surfaces.items():  # e.g. the itch: a new spot every episode
             link, point, normal, axis = draw_surface_point(capsules, rng)
             self.snap.place_target(name, link, point, normal, axis)
+        for name, points in variant.surface_points.items():  # the same on spheres or in a region
+            p = draw_listed_point(points, rng)
+            self.snap.place_target(name, p.link, np.asarray(p.offset), np.asarray(p.normal), np.asarray(p.axis))
         self.markers.reset(variant)
         for reset_term in self._term_resets:
             reset_term()

@@ -10,6 +10,39 @@ from pydantic import Field, field_validator, model_validator
 from .common import Name, Ref, Rgba, Strict, Vec3
 
 
+class Region(Strict):
+    """Part of a link's surface: markers or a surface target are kept only where every criterion
+    given holds. Directions and offsets are in the link's own frame (docs/person.md: +x the
+    person's left, -y their front, +z up at the zero pose; limbs hang along -z)."""
+
+    near: Ref | None = Field(
+        None, description="A point on the covered link (a landmark such as person.mouth, a target on it, or the link "
+        "itself): keep the surface within radius_m of it, straight-line distance."
+    )
+    radius_m: float | None = Field(None, gt=0, le=1, description="Radius around near, metres.")
+    facing: Vec3 | None = Field(
+        None, description="Keep the surface whose outward normal is within max_angle_deg of this direction (link frame; "
+        "e.g. [0, -1, 0]: the side facing the person's front at the zero pose)."
+    )
+    max_angle_deg: float = Field(60.0, gt=0, le=180, description="Largest angle between the outward normal and facing, degrees.")
+    along: tuple[float, float] | None = Field(
+        None, description="On a limb's capsule: keep the part between these fractions of its length from the joint end "
+        "(e.g. [0.5, 1.0]: the half away from the joint; the shin's lower half)."
+    )
+
+    @model_validator(mode="after")
+    def _criteria(self) -> "Region":
+        if (self.near is None) != (self.radius_m is None):
+            raise ValueError("give 'near' and 'radius_m' together (the surface within radius_m of the point near)")
+        if self.near is None and self.facing is None and self.along is None:
+            raise ValueError("a region needs at least one of 'near' (with radius_m), 'facing' or 'along'")
+        if self.facing is not None and sum(v * v for v in self.facing) < 1e-12:
+            raise ValueError("@facing: a direction must not be zero")
+        if self.along is not None and not 0 <= self.along[0] < self.along[1] <= 1:
+            raise ValueError("@along: two fractions of the capsule's length, 0 <= from < to <= 1")
+        return self
+
+
 class Target(Strict):
     """A named point attached to a link: e.g. the mouth is the head link plus an offset; or a point
     drawn on a limb's surface at every reset (e.g. an itch on the right arm)."""
@@ -17,10 +50,12 @@ class Target(Strict):
     link: Ref | None = Field(None, description="The link it is attached to, e.g. person.head (or give surface_of).")
     surface_of: list[Ref] = Field(
         default_factory=list,
-        description="Person limbs (capsule links, e.g. person.right_shoulder = the upper arm) to draw the point on at "
-        "every reset: a limb uniformly, then the distance from its joint U(r, L) along the capsule and the azimuth "
-        "U(0, 2π) (the reference's itch target).",
+        description="Person links with a collision shape (e.g. person.right_shoulder = the upper arm, person.head) to "
+        "draw the point on at every reset, a link uniformly. On a limb's capsule with no region: the distance from its "
+        "joint U(r, L) along the capsule and the azimuth U(0, 2π) (the reference's itch target); otherwise a point "
+        "uniformly from the link's surface points 1 cm apart (in region, when given).",
     )
+    region: Region | None = Field(None, description="With surface_of: draw only from this part of the surface.")
     offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Offset in the link frame, metres.")
     offset_by_variant: dict[Name, Vec3] = Field(
         default_factory=dict, description="Per person-variant offsets replacing offset_m (e.g. female mouth)."
@@ -33,6 +68,8 @@ class Target(Strict):
             raise ValueError("give exactly one of 'link' (a fixed point) or 'surface_of' (a point drawn on limbs at every reset)")
         if self.surface_of and (self.offset_m != (0.0, 0.0, 0.0) or self.offset_by_variant):
             raise ValueError("@surface_of: a target drawn on a surface takes no offset_m or offset_by_variant")
+        if self.region is not None and not self.surface_of:
+            raise ValueError("@region: a region limits a point drawn on a surface; give surface_of with it")
         return self
 
 
@@ -44,12 +81,16 @@ class ClearedBy(Strict):
 
 
 class Markers(Strict):
-    """Points laid out in rings around person limbs (e.g. spots to wipe in bed bathing): rings every
-    ``spacing_m`` along each capsule, points every ``spacing_m`` around each ring (the reference's
-    capsule_points). Each is cleared once per episode."""
+    """Points laid out over person links (e.g. spots to wipe in bed bathing), each cleared once per
+    episode. On a limb's capsule: rings every ``spacing_m`` along it, points every ``spacing_m``
+    around each ring (the reference's capsule_points); on a sphere (the head, a hand): points about
+    ``spacing_m`` apart all over it; optionally only in a region."""
 
-    surface_of: list[Ref] = Field(min_length=1, description="Person limbs (capsule links) to cover, e.g. person.right_shoulder.")
-    spacing_m: float = Field(0.03, gt=0.005, le=0.5, description="Distance between rings and between points on a ring, metres.")
+    surface_of: list[Ref] = Field(
+        min_length=1, description="Person links with a collision shape to cover, e.g. person.right_shoulder, person.head."
+    )
+    region: Region | None = Field(None, description="Only this part of the surface (e.g. around the mouth).")
+    spacing_m: float = Field(0.03, gt=0.005, le=0.5, description="Distance between markers (between rings and along a ring), metres.")
     cleared_by: ClearedBy = Field(description="What clears a marker.")
     show_rgba: Rgba | None = Field(None, description="Draw the markers not yet cleared as small spheres in renders.")
 
