@@ -274,12 +274,25 @@ def test_training_needs_only_the_declared_train_extra(tmp_path):
     assert RunDir(out).latest_checkpoint()[0] == 800 and (out / "curve.csv").is_file()
 
 
+PPO_OFTEN = """algorithm: ppo
+network: {hidden: [32, 32], activation: tanh}
+ppo: {rollout_steps: 200, minibatch_size: 50, epochs: 2}
+total_steps: 1000000
+envs: 1
+seed: 0
+checkpoint_every_steps: 400
+eval_episodes: 2
+"""
+
+
 def test_a_driver_killed_outright_leaves_a_resumable_run(tmp_path):
     """SIGKILL (no chance to checkpoint) at any moment, a checkpoint write included: checkpoints are
     written into a hidden partial directory and renamed into place, run files are replaced
     atomically, and --resume continues from the newest complete checkpoint with a clean curve."""
     out = tmp_path / "killed"
-    cmd = [sys.executable, "-m", "assistive_compiler.cli", "train", str(REACH), "--config", "ppo_quick", "--envs", "1",
+    config = tmp_path / "ppo_often.yaml"  # checkpoints every 400 steps (ppo_quick's 10,000 took ~50 s each here)
+    config.write_text(PPO_OFTEN)
+    cmd = [sys.executable, "-m", "assistive_compiler.cli", "train", str(REACH), "--config", str(config), "--envs", "1",
            "--steps", "1000000", "--out", str(out), "--quiet"]
     proc = subprocess.Popen(cmd + [], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.time() + 180
