@@ -30,11 +30,12 @@ from typing import Generic, Iterable, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
-from .compile.render import UrdfInfo, render_template, urdf_info
+from .compile.render import render_template
 from .errors import Problem, SpecError
 from .paths import display, specs_dir, templates_dir
 from .spec.parts import FurniturePart, PersonPart, RobotPart, ToolPart
 from .spec.validation import problems_from_validation
+from .urdf import UrdfInfo, urdf_info
 from .yamlsrc import load_located
 
 P = TypeVar("P", bound=BaseModel)

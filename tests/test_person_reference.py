@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from assistive_compiler.cli import main
-from assistive_compiler.compile.render import urdf_info
+from assistive_compiler.urdf import urdf_info
 from assistive_compiler.library import Library
 from assistive_compiler.person.reference_page import person_reference_markdown
 

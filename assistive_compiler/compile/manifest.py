@@ -23,7 +23,7 @@ from ..resolve import ResolvedTask
 from ..resolve.bodies import surface_region
 from ..spec.models import scalar_bounds
 from ..terms.registry import SizeContext, terms
-from .render import urdf_info
+from ..urdf import urdf_info
 from .weld import gripper
 from .task import impairment_joints, policy_joints, rounded
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..resolve import ResolvedTask
 from .merge import Pose, origin_pose, parse_vector, reindent, write_origin
-from .render import urdf_info
+from ..urdf import urdf_info
 from .task import fail
 
 _MOTION_TAGS = ("axis", "limit", "dynamics", "calibration", "safety_controller", "mimic")

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..compile.render import Capsule, Sphere, UrdfInfo
+from ..urdf import Capsule, Sphere, UrdfInfo
 from ..quat import capsule_axes
 
 Vec3 = tuple[float, float, float]

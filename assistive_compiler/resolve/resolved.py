@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..compile.render import UrdfInfo
+from ..urdf import UrdfInfo
 from ..library import LoadedPart
 from ..spec.load import LoadedSpec
 from ..spec.models import TaskSpec

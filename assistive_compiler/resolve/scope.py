@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..compile.render import UrdfInfo
+from ..urdf import UrdfInfo
 from ..errors import SpecError
 from ..library import Library, LoadedPart
 from ..spec.load import LoadedSpec
