@@ -97,6 +97,21 @@ def test_evaluate_command_json_and_render(reach_run, tmp_path, capsys):
     assert json.loads((reach_run / "evaluation.json").read_text())["seed"] == 3
 
 
+def test_evaluate_picks_an_earlier_checkpoint_and_keeps_the_runs_evaluation(reach_run, capsys):
+    saved = (reach_run / "evaluation.json").read_text() if (reach_run / "evaluation.json").is_file() else None
+    steps = list(RunDir(reach_run).complete_checkpoints())
+    assert len(steps) == 3 and steps[-1] >= 30000  # every 10,000 env steps, at the end of an 800-step batch
+    assert main(["evaluate", str(reach_run), "--checkpoint", str(steps[0]), "--episodes", "2", "--json"]) == 0
+    early = json.loads(capsys.readouterr().out)
+    assert early["trained_steps"] == steps[0] and early["checkpoint"].endswith(f"step_{steps[0]:010d}")
+    newest = evaluate(reach_run, episodes=2)
+    assert newest["trained_steps"] == steps[-1] and newest["per_episode"] != early["per_episode"]
+    assert ((reach_run / "evaluation.json").read_text() if (reach_run / "evaluation.json").is_file() else None) == saved
+    assert main(["evaluate", str(reach_run), "--checkpoint", "12345"]) == 2
+    have = ", ".join(f"{s:,}" for s in steps)
+    assert capsys.readouterr().err.strip().endswith(f"no complete checkpoint at 12,345 env steps; it has {have}")
+
+
 def test_table_from_a_real_run(reach_run, tmp_path, capsys):
     out = tmp_path / "results.md"
     assert main(["table", str(reach_run), "--out", str(out)]) == 0

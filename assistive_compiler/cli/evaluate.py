@@ -24,6 +24,9 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         print("evaluate: give a run directory, or --policy pretrained:<task>-<robot> (or a run directory)", file=sys.stderr)
         return EXIT_BAD_INPUT
     if source.startswith(PREFIX) or (Path(source) / POLICY_FILE).is_file():  # shipped or exported: NumPy only
+        if args.checkpoint is not None:
+            print(f"evaluate: --checkpoint picks a checkpoint of a run directory; {source} is an exported policy (one checkpoint)", file=sys.stderr)
+            return EXIT_BAD_INPUT
         result = evaluate_exported(source, episodes=args.episodes or 100, seed=args.seed, render=args.render)
         print(json.dumps(result, indent=1) if args.json else format_report(result))
         return EXIT_OK
@@ -32,8 +35,9 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         return EXIT_FAILED
     from ..training.evaluate import evaluate, save_evaluation
 
-    result = evaluate(source, episodes=args.episodes, seed=args.seed, render=args.render)
-    save_evaluation(run, result)
+    result = evaluate(source, episodes=args.episodes, seed=args.seed, render=args.render, checkpoint_steps=args.checkpoint)
+    if args.checkpoint is None or args.checkpoint == run.latest_checkpoint()[0]:
+        save_evaluation(run, result)  # evaluation.json (what `table` reads) is always the newest checkpoint's
     print(json.dumps(result, indent=1) if args.json else format_report(result))
     return EXIT_OK
 
@@ -45,5 +49,7 @@ def add_commands(sub) -> None:
     p.add_argument("--episodes", type=int, help="episodes (default: the run config's eval_episodes; the paper: 100)")
     p.add_argument("--seed", type=int, default=0, help="seed of the first episode (episode k: seed + k)")
     p.add_argument("--render", metavar="OUT", help="also write one rollout as OUT (.gif, or .png for a strip)")
+    p.add_argument("--checkpoint", type=int, metavar="STEPS", help="a run's checkpoint at this many env steps (default: the "
+                   "newest), e.g. to compare two runs at the same budget")
     p.add_argument("--json", action="store_true", help="print JSON (with every episode)")
     p.set_defaults(func=cmd_evaluate)

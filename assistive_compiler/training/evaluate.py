@@ -27,6 +27,17 @@ def latest_checkpoint(run: RunDir) -> tuple[int, Path]:
     return found
 
 
+def checkpoint_at(run: RunDir, steps: int | None) -> tuple[int, Path]:
+    """The run's complete checkpoint at ``steps`` env steps (None: the newest)."""
+    if steps is None:
+        return latest_checkpoint(run)
+    done = run.complete_checkpoints()
+    if steps not in done:
+        have = ", ".join(f"{s:,}" for s in done) or "none yet"
+        raise UsageError(f"{display(run.path)}: no complete checkpoint at {steps:,} env steps; it has {have}")
+    return steps, done[steps]
+
+
 def load_policy(info: RunInfo, checkpoint: Path):
     """The run's policy as ``obs -> action`` (co-optimised runs: ``(robot_obs, human_obs) -> (a_r, a_h)``)."""
     if info.engine == "sb3":
@@ -122,11 +133,13 @@ def _figures(results: list[dict]) -> dict:
             "mean_force_on_human_n": mean_f, "std_force_on_human_n": std_f}
 
 
-def evaluate(run_dir: str | Path, episodes: int | None = None, seed: int = 0, render: str | None = None) -> dict:
-    """Evaluate the run's newest checkpoint; optionally write a rollout (``render``: .gif or .png)."""
+def evaluate(run_dir: str | Path, episodes: int | None = None, seed: int = 0, render: str | None = None,
+             checkpoint_steps: int | None = None) -> dict:
+    """Evaluate the run's checkpoint at ``checkpoint_steps`` env steps (None: the newest); optionally
+    write a rollout (``render``: .gif or .png)."""
     run = RunDir(run_dir)
     info = run.info()
-    steps, checkpoint = latest_checkpoint(run)
+    steps, checkpoint = checkpoint_at(run, checkpoint_steps)
     episodes = episodes or info.training_config.eval_episodes
     policy = load_policy(info, checkpoint)
     results = play_episodes(run.artifact, policy, info.coop, episodes, seed)

@@ -119,10 +119,18 @@ class RunDir:
 
     def latest_checkpoint(self) -> tuple[int, Path] | None:
         """(env steps, directory) of the newest complete checkpoint, or None."""
-        done = sorted(p for p in self.checkpoints.glob("step_*") if (p / "COMPLETE").is_file()) if self.checkpoints.is_dir() else []
+        done = self.complete_checkpoints()
         if not done:
             return None
-        return int(done[-1].name.split("_")[1]), done[-1]
+        steps = max(done)
+        return steps, done[steps]
+
+    def complete_checkpoints(self) -> dict[int, Path]:
+        """Every complete checkpoint: env steps -> directory, oldest first."""
+        if not self.checkpoints.is_dir():
+            return {}
+        done = sorted(p for p in self.checkpoints.glob("step_*") if (p / "COMPLETE").is_file())
+        return {int(p.name.split("_")[1]): p for p in done}
 
     def begin_checkpoint(self, steps: int) -> Path:
         """A fresh, empty directory to write the checkpoint at ``steps`` into: a hidden partial one
