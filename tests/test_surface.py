@@ -1,6 +1,6 @@
 """Markers and surface targets on any person link with a collision shape, in a region of it
-(``person/surface.py``, ``markers.<set>.region``, ``targets.<name>.region``), and the two examples
-written with them (mouth wiping, leg bathing)."""
+(``person/surface.py``, ``markers.<set>.region``, ``targets.<name>.region``), and the examples
+written with them and with the landmarks (handover, mouth wiping, leg bathing)."""
 
 from __future__ import annotations
 
@@ -17,6 +17,7 @@ from assistive_compiler.person.landmarks import landmark_offsets
 from assistive_compiler.person.surface import Region, link_surface
 from assistive_compiler.runtime.env import AssistiveEnv
 
+HANDOVER = specs_dir() / "examples" / "handover.yaml"
 MOUTH_WIPING = specs_dir() / "examples" / "mouth_wiping.yaml"
 LEG_BATHING = specs_dir() / "examples" / "leg_bathing.yaml"
 
@@ -170,9 +171,10 @@ def test_a_surface_target_on_the_head_is_drawn_in_its_region_anew_each_episode(t
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("example", [MOUTH_WIPING, LEG_BATHING], ids=["mouth_wiping", "leg_bathing"])
-def test_the_surface_examples_succeed_with_their_scripted_baselines(tmp_path, example):
-    """Each succeeds on at least 0.6 of seeds 0-19 on Jaco (mouth wiping 17 of 20, leg bathing 20)."""
+@pytest.mark.parametrize("example", [HANDOVER, MOUTH_WIPING, LEG_BATHING], ids=["handover", "mouth_wiping", "leg_bathing"])
+def test_the_examples_succeed_with_their_scripted_baselines(tmp_path, example):
+    """The examples written with landmarks and surface regions each succeed on at least 0.6 of seeds
+    0-19 on Jaco (handover 20 of 20, mouth wiping 17, leg bathing 20)."""
     from assistive_compiler.episode import rollout
     from assistive_compiler.policies import make_policy
 
