@@ -111,6 +111,15 @@ class PersonVariant(_Model):
     markers: dict[str, list[MarkerPoint]] = Field(default_factory=dict, description="Per marker set: every marker of this body.")
     starts: list[StartState] = Field(description="Robot starts for this variant; reset() draws one.")
 
+    @model_serializer(mode="wrap")
+    def _without_empty_additions(self, handler):
+        """``surface_points`` came after artifacts were first written: left out while empty, so an
+        artifact compiled before it still matches its content hash (runs keep their artifact)."""
+        data = handler(self)
+        if not data.get("surface_points"):
+            data.pop("surface_points", None)
+        return data
+
 
 class Person(_Model):
     """The person: variants, control and impairments."""
