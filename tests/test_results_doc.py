@@ -39,3 +39,20 @@ def test_the_block_reports_the_papers_figures_beside_ours():
                           f"{e['mean_force_on_human_n']:.2f}"]
     assert cells[9:11] == ["83.8", "88%"]  # the paper's Table I: Jaco's Feeding return, the best robot's success
     assert "### Table II (active person, co-optimisation)" in block
+
+
+def test_the_claim_pairs_a_coop_cell_with_the_static_cell_of_its_algorithm():
+    """§V-B: a co-optimised PPO cell is set beside the static PPO cell (not the SAC one), with
+    each cell's budget."""
+    import copy
+
+    records = shipped_records()
+    static_ppo = next(r for r in records if r["name"] == "feeding-jaco-ppo")
+    coop = copy.deepcopy(static_ppo)
+    coop.update(name="feeding-jaco-coop", coop=True, trained_steps=360_000)
+    coop["evaluation"] = {**coop["evaluation"], "success_rate": 0.81}
+    block = results_block(records + [coop])
+    claim = block[block.index("### The paper's claim"):block.index("### Each cell")]
+    static_cell = f"{100 * static_ppo['evaluation']['success_rate']:.0f}% ({static_ppo['trained_steps']:,} steps)"
+    assert f"| Feeding | Jaco | PPO | {static_cell} | 81% (360,000 steps) |" in claim
+    assert "Not measured yet" in results_block([r for r in records if not r["coop"]])
