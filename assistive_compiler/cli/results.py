@@ -50,8 +50,9 @@ def add_commands(sub) -> None:
     from ..training.export import EVAL_SEED
 
     p = sub.add_parser("export", help="a run's newest checkpoint as a shipped policy (NumPy only), evaluated on unseen seeds")
-    p.add_argument("run_dir", help="a run directory written by train (SB3)")
-    p.add_argument("--out", help="policy folder (default pretrained/<task>-<robot>: shipped as pretrained:<task>-<robot>)")
+    p.add_argument("run_dir", help="a run directory written by train (SB3 or RLlib; static or co-optimised)")
+    p.add_argument("--out", help="policy folder (default pretrained/<task>-<robot>, co-optimised pretrained/<task>-<robot>-coop: "
+                   "shipped as pretrained:<that name>)")
     p.add_argument("--episodes", type=int, default=100, help="evaluation episodes (default 100, as the paper)")
     p.add_argument("--seed", type=int, default=EVAL_SEED, help=f"first evaluation seed (default {EVAL_SEED:,}: never used in training)")
     p.add_argument("--label", help="the table row's name (default: the algorithm and its config's description)")
