@@ -55,8 +55,19 @@ def test_shipped_policy_is_small_and_says_what_it_is(name):
     assert info["evaluation"]["episodes"] == 100 and info["evaluation"]["seed"] >= 1_000_000  # unseen seeds
     assert info["trained_steps"] <= 1_000_000 and info["export_max_action_difference"] < 1e-4
     env = _env(name)
-    policy = make_policy(f"pretrained:{name}", env)
-    assert (policy.obs_dim, policy.action_dim) == (env.observation_space.shape[0], env.action_space.shape[0])
+    if info["coop"]:  # a robot and a human policy, each fitting its agent's spaces
+        from assistive_compiler.coop.parallel import AssistiveParallelEnv
+        from assistive_compiler.policies.pretrained import load_trained
+
+        pair, _ = load_trained(f"pretrained:{name}")
+        coop = AssistiveParallelEnv(env.artifact_dir)
+        for agent in ("robot", "human"):
+            part = pair.agent(agent)
+            assert (part.obs_dim, part.action_dim) == (coop.observation_space(agent).shape[0], coop.action_space(agent).shape[0])
+        coop.close()
+    else:
+        policy = make_policy(f"pretrained:{name}", env)
+        assert (policy.obs_dim, policy.action_dim) == (env.observation_space.shape[0], env.action_space.shape[0])
     env.close()
 
 
@@ -68,8 +79,15 @@ def test_shipped_policy_still_succeeds_on_the_current_code(name):
     info = shipped_info(name)
     reg = info["regression"]
     env = _env(name)
-    policy = make_policy(f"pretrained:{name}", env)
-    runs = [rollout(env, policy, reg["seed"] + k) for k in range(reg["episodes"])]
+    if info["coop"]:  # the pair plays both agents, as export evaluated it
+        from assistive_compiler.policies.pretrained import load_trained
+        from assistive_compiler.training.evaluate import play_episodes
+
+        pair, _ = load_trained(f"pretrained:{name}")
+        runs = play_episodes(env.artifact_dir, pair, True, reg["episodes"], reg["seed"])
+    else:
+        policy = make_policy(f"pretrained:{name}", env)
+        runs = [rollout(env, policy, reg["seed"] + k) for k in range(reg["episodes"])]
     env.close()
     seeds = f"seeds {reg['seed']}..{reg['seed'] + reg['episodes'] - 1}"
     success = float(np.mean([r["success"] for r in runs]))
