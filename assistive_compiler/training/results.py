@@ -125,11 +125,9 @@ def write_pictures(records: list[dict], doc_dir: Path, progress=None) -> list[Pa
             png = out_dir / f"{r['name']}-curve.png"
             plot_curves({r["label"]: curve}, png, title=f"{r['gym_id'].split('/')[-1]}: {r['label']}, training episodes")
             written.append(png)
-        if r["coop"]:
-            continue
-        policy, _ = load_trained(PREFIX + r["name"])
+        policy, _ = load_trained(PREFIX + r["name"])  # a co-optimised pair plays both agents
         png = out_dir / f"{r['name']}.png"
-        write_rollout(compile_for_policy(r).out_dir, policy, False, r["evaluation"]["seed"], png)
+        write_rollout(compile_for_policy(r).out_dir, policy, r["coop"], r["evaluation"]["seed"], png)
         written.append(png)
         if progress:
             progress(r["name"])
