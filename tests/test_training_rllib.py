@@ -80,6 +80,23 @@ def test_multi_agent_ppo_iteration_checkpoint_resume_evaluate(local_ray, tmp_pat
     summary = json.loads((out / "summary.json").read_text())
     assert summary["engine"] == "rllib" and summary["steps"] == 400
 
+    # Deterministic actions are the Gaussian's means clipped to the action bounds (the env clips them
+    # for the motion, but the action penalty sees them raw), and the NumPy export gives the same.
+    from assistive_compiler.training.export import export_run
+    from assistive_compiler.training.rllib import RLlibPolicy
+
+    import torch
+
+    pair = RLlibPolicy(checkpoint.parent / f"step_{400:010d}", coop=True, algorithm="ppo")
+    with torch.no_grad():  # a head whose means leave the bounds
+        for weight in pair.modules["robot"].pi.parameters():
+            weight.mul_(1e3)
+    obs = np.random.default_rng(0).normal(0.0, 1.0, (8, pair.modules["robot"].observation_space.shape[0]))
+    actions = np.array([pair.agent("robot")(o) for o in obs])
+    assert np.abs(actions).max() == 1.0 and (np.abs(actions) == 1.0).mean() > 0.5
+    record = export_run(out, tmp_path / "ppo-pair", episodes=1, seed=0)
+    assert record["coop"] and record["export_max_action_difference"] < 1e-4
+
 
 def test_unreachable_ray_address_fails_fast_with_a_message(tmp_path, capsys):
     out = tmp_path / "run"

@@ -338,9 +338,10 @@ class RLlibPolicy:
             out = self.modules[name].forward_inference({"obs": torch.as_tensor(obs, dtype=torch.float32)[None]})
         dist = out["action_dist_inputs"][0].numpy()
         mean = dist[: dist.shape[0] // 2]  # a diagonal Gaussian's inputs: means, then log-stds
-        if self.algorithm != "sac":
-            return mean
-        space = self.modules[name].action_space  # SAC's Gaussian is squashed by tanh into the action bounds
+        space = self.modules[name].action_space
+        if self.algorithm != "sac":  # PPO's mean, clipped to the action bounds as SB3's PPO and the export clip it
+            return np.clip(mean, space.low, space.high).astype(np.float32)
+        # SAC's Gaussian is squashed by tanh into the action bounds.
         return (space.low + 0.5 * (np.tanh(mean) + 1.0) * (space.high - space.low)).astype(np.float32)
 
     def agent(self, name: str):
