@@ -17,20 +17,6 @@ REPO = Path(__file__).resolve().parents[1]
 FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
 
 
-def pytest_collection_modifyitems(config, items):
-    """Under pytest-xdist (``--dist loadgroup``), keep the tests that share a module-scoped fixture of
-    their own module on one worker: spread over two, each worker built the fixture again (twice the
-    training run of test_training_sb3, 130 s each). Tests already in a group keep it."""
-    for item in items:
-        if item.get_closest_marker("xdist_group"):
-            continue
-        module_id = item.nodeid.split("::")[0]
-        for defs in getattr(item, "_fixtureinfo").name2fixturedefs.values():
-            if defs and defs[-1].scope == "module" and defs[-1].baseid == module_id:
-                item.add_marker(pytest.mark.xdist_group(module_id))
-                break
-
-
 @pytest.fixture(scope="session")
 def artifact(tmp_path_factory) -> Path:
     """Feeding compiled for Jaco, once per test session."""
