@@ -250,6 +250,21 @@ class ParticleRest(_Model):
     max_turn: float = Field(description="Turn of the apparent up (container frame) since they came to rest above which they are simulated again, radians.")
     max_speed: float = Field(description="Mean speed relative to the container below which simulated particles are still, m/s.")
     still_steps: int = Field(description="Env steps in a row they must be still before they are carried.")
+    carry_at_reset: bool = Field(True, description="Carry the settled start positions from the reset on (False: simulated until they rest).")
+    near_body: str | None = Field(None, description="Body near which they are simulated even at rest (None: none).")
+    near_distance: float = Field(0.0, description="Gap between the container's link and near_body below which they are simulated, m.")
+
+    @model_serializer(mode="wrap")
+    def _without_unset_additions(self, handler):
+        """``carry_at_reset`` and ``near_body`` came after artifacts were first written: left out
+        while at their defaults, so an artifact compiled before them still matches its content hash."""
+        data = handler(self)
+        if data.get("carry_at_reset", True):
+            data.pop("carry_at_reset", None)
+        if data.get("near_body") is None:
+            data.pop("near_body", None)
+            data.pop("near_distance", None)
+        return data
 
 
 class MarkerSet(_Model):
@@ -351,7 +366,8 @@ class Manifest(_Model):
     gym_id: str = Field(description="Gymnasium id that makes this (task, robot): a shipped task's own "
                                     "(assistive_compiler/FeedingJaco-v1), else assistive_compiler/Task-v1 (with spec= and robot=).")
     input_hash: str = Field(description="sha256 of every input (spec files, parts, templates, compiler source).")
-    content_hash: str = Field("", description="sha256 of the output files (URDFs and manifest minus this field).")
+    content_hash: str = Field("", description="sha256 of the output files (URDFs and the manifest minus this field and input_hash): "
+                                              "what was compiled, whichever compiler source compiled it.")
     sources: list[str] = Field(description="Spec and part files this was compiled from.")
     sim: Sim
     bodies: list[Body]
@@ -386,11 +402,16 @@ class Manifest(_Model):
     def to_json(self) -> str:
         return json.dumps(self.model_dump(mode="json"), indent=1, sort_keys=True) + "\n"
 
-    def hash_of(self, artifact_dir: str | Path) -> str:
-        """sha256 of the body files under ``artifact_dir`` and this manifest (``content_hash`` empty):
-        what ``content_hash`` records when the artifact is as compiled."""
+    def hash_of(self, artifact_dir: str | Path, *, with_input_hash: bool = False) -> str:
+        """sha256 of the body files under ``artifact_dir`` and this manifest (``content_hash`` and
+        ``input_hash`` empty): what ``content_hash`` records when the artifact is as compiled. The
+        same content compiled by another version of the compiler source has the same hash, so a
+        run can be resumed across a change that compiles its task to the same files.
+        ``with_input_hash``: the hash as artifacts written before 2026-11-28 recorded it (the
+        manifest with its input hash, which covers the compiler source)."""
         files = b"".join(Path(artifact_dir, b.urdf).read_bytes() for b in sorted(self.bodies, key=lambda b: b.urdf))
-        return hashlib.sha256(files + self.model_copy(update={"content_hash": ""}).to_json().encode()).hexdigest()
+        blank = {"content_hash": ""} if with_input_hash else {"content_hash": "", "input_hash": ""}
+        return hashlib.sha256(files + self.model_copy(update=blank).to_json().encode()).hexdigest()
 
     def damage(self, artifact_dir: str | Path) -> str | None:
         """What is wrong with the files of the artifact at ``artifact_dir`` (a missing, truncated or
@@ -403,7 +424,7 @@ class Manifest(_Model):
                 ET.parse(path)
             except ET.ParseError as exc:
                 return f"{path}: not complete URDF XML ({exc}); truncated or edited?"
-        if self.content_hash and self.hash_of(artifact_dir) != self.content_hash:
+        if self.content_hash and self.content_hash not in (self.hash_of(artifact_dir), self.hash_of(artifact_dir, with_input_hash=True)):
             return f"{artifact_dir}: files differ from what was compiled (the manifest's content hash does not match)"
         return None
 

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import shutil
+from collections.abc import Callable
 from pathlib import Path
 
 import pybullet as pb
 import pytest
 import xacro
 import yourdfpy
+from filelock import FileLock
 
 from assistive_compiler.bullet import connect
 from assistive_compiler.compile.compiler import compile_task
@@ -21,6 +24,26 @@ FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
 def artifact(tmp_path_factory) -> Path:
     """Feeding compiled for Jaco, once per test session."""
     return compile_task(FEEDING, "jaco", tmp_path_factory.mktemp("feeding-artifact") / "feeding-jaco").out_dir
+
+
+def built_once(tmp_path_factory, worker_id: str, name: str, build: Callable[[Path], None]) -> Path:
+    """A directory ``build(path)`` makes, built once per test session, not once per xdist worker:
+    the first worker to ask builds it into the session's shared temporary folder under a file
+    lock (xdist's documented recipe); every worker gets its own copy, so tests that write into
+    it do not race."""
+    mine = tmp_path_factory.mktemp(name) / name
+    if worker_id == "master":  # not under xdist
+        build(mine)
+        return mine
+    shared = tmp_path_factory.getbasetemp().parent / f"built-once-{name}"
+    with FileLock(f"{shared}.lock"):
+        if not (shared / ".built").is_file():
+            if shared.exists():
+                shutil.rmtree(shared)  # a build that failed part way
+            build(shared)
+            (shared / ".built").touch()
+    shutil.copytree(shared, mine, ignore=shutil.ignore_patterns(".built"))
+    return mine
 
 
 @pytest.fixture

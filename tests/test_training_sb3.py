@@ -20,12 +20,15 @@ from PIL import Image
 
 pytest.importorskip("stable_baselines3", reason='needs the "train" extra (README: Training); CI installs it')
 
+from assistive_compiler.artifact import Manifest
 from assistive_compiler.cli import main
 from assistive_compiler.cli.run import rollout
+from assistive_compiler.errors import SpecError
 from assistive_compiler.policies import make_policy
 from assistive_compiler.runtime.env import AssistiveEnv
 from assistive_compiler.training.evaluate import evaluate
-from assistive_compiler.training.run_dir import RunDir
+from assistive_compiler.training.run_dir import RunDir, check_resumable
+from conftest import built_once
 
 pytestmark = pytest.mark.slow
 
@@ -35,11 +38,13 @@ EVAL_SEED, EVAL_EPISODES = 100, 20
 
 
 @pytest.fixture(scope="module")
-def reach_run(tmp_path_factory) -> Path:
-    """PPO (ppo_quick: 2 env processes, 30k steps) trained on reach for Jaco, once per module."""
-    out = tmp_path_factory.mktemp("runs") / "reach-jaco"
-    assert main(["train", str(REACH), "--robot", "jaco", "--config", "ppo_quick", "--out", str(out), "--quiet"]) == 0
-    return out
+def reach_run(tmp_path_factory, worker_id) -> Path:
+    """PPO (ppo_quick: 2 env processes, 30k steps) trained on reach for Jaco, once per test session
+    (the module's tests may run on both xdist workers; each gets a copy)."""
+    def train(out: Path) -> None:
+        assert main(["train", str(REACH), "--robot", "jaco", "--config", "ppo_quick", "--out", str(out), "--quiet"]) == 0
+
+    return built_once(tmp_path_factory, worker_id, "reach-jaco", train)
 
 
 def test_ppo_learns_to_reach(reach_run):
@@ -147,6 +152,26 @@ def test_resume_refuses_a_run_of_another_spec(reach_run, tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 2
     assert f"{copy / 'run.json'}:1:1: --resume: this run trained a different compiled task" in err
+
+
+def test_resume_accepts_the_same_task_compiled_by_another_compiler_version(reach_run, tmp_path):
+    """A run recorded before content hashes left the input hash out (which covers the compiler
+    source) resumes when today's compile of its spec gives the same files; an edited artifact does not."""
+    copy = tmp_path / "older"
+    shutil.copytree(reach_run, copy)
+    run = RunDir(copy)
+    today = Manifest.read(run.artifact).content_hash
+    older = Manifest.read(run.artifact).model_copy(update={"input_hash": "0" * 64})
+    older = older.model_copy(update={"content_hash": older.hash_of(run.artifact, with_input_hash=True)})
+    (run.artifact / "manifest.json").write_text(older.to_json())
+    info = json.loads((copy / "run.json").read_text())
+    (copy / "run.json").write_text(json.dumps({**info, "content_hash": older.content_hash}))
+    assert older.content_hash != today and Manifest.read(run.artifact, verify=True).content_hash == older.content_hash
+    assert check_resumable(run, today, "jaco", False, "sb3").content_hash == older.content_hash
+    urdf = next(run.artifact.rglob("*.urdf"))
+    urdf.write_text(urdf.read_text().replace("<robot ", "<robot  ", 1))
+    with pytest.raises(SpecError, match="--resume: this run trained a different compiled task"):
+        check_resumable(run, today, "jaco", False, "sb3")
 
 
 @pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])

@@ -27,6 +27,7 @@ from pathlib import Path
 
 import yaml
 
+from ..artifact import Manifest
 from ..errors import SpecError, UsageError
 from ..paths import display
 from .config import TrainingConfig
@@ -168,11 +169,22 @@ def new_run_info(spec: str, manifest, robot: str, coop: bool, engine: str, confi
     )
 
 
+def _same_content(run: RunDir, content_hash: str) -> bool:
+    """Whether the run's own, undamaged artifact has ``content_hash`` as today's compiler hashes
+    content (a run recorded before 2026-11-28 holds the older hash, which covered the compiler
+    source: the same task compiled to the same files after any compiler change would not match)."""
+    try:
+        own = Manifest.read(run.artifact)
+    except (OSError, ValueError, SpecError):  # no readable artifact: nothing to compare
+        return False
+    return own.damage(run.artifact) is None and own.hash_of(run.artifact) == content_hash
+
+
 def check_resumable(run: RunDir, content_hash: str, robot: str, coop: bool, engine: str) -> RunInfo:
     """The run's info, after checking it trains the same compiled task the same way."""
     info = run.info()
     where = display(run.path / RUN_FILE)
-    if info.content_hash != content_hash:
+    if info.content_hash != content_hash and not _same_content(run, content_hash):
         raise SpecError.at(
             where,
             f"--resume: this run trained a different compiled task (content hash {info.content_hash[:12]}, spec {info.spec}); "
