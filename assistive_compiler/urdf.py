@@ -9,6 +9,8 @@ import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 
+from .rotation import rpy_matrix
+
 
 @dataclass(frozen=True)
 class JointInfo:
@@ -114,13 +116,6 @@ def _spheres(root: ET.Element, capsules: dict[str, Capsule]) -> dict[str, tuple[
     return out
 
 
-def _rpy_matrix(r: float, p: float, y: float) -> list[list[float]]:
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    return [[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr]]
-
-
 def _capsules(root: ET.Element) -> dict[str, Capsule]:
     """Each link's first collision cylinder, as a capsule axis in the link frame."""
     out: dict[str, Capsule] = {}
@@ -133,7 +128,7 @@ def _capsules(root: ET.Element) -> dict[str, Capsule]:
             xyz = [float(v) for v in (origin.get("xyz", "0 0 0") if origin is not None else "0 0 0").split()]
             rpy = [float(v) for v in (origin.get("rpy", "0 0 0") if origin is not None else "0 0 0").split()]
             half = float(cyl.get("length", "0")) / 2
-            axis = [row[2] for row in _rpy_matrix(*rpy)]
+            axis = [float(v) for v in rpy_matrix(rpy)[:, 2]]
             a = tuple(c - half * d for c, d in zip(xyz, axis))
             b = tuple(c + half * d for c, d in zip(xyz, axis))
             start, end = (a, b) if math.hypot(*a) <= math.hypot(*b) else (b, a)

@@ -11,7 +11,7 @@ from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.errors import SpecError
 from assistive_compiler.library import Library
 from assistive_compiler.person.landmarks import LANDMARKS, landmark_offsets
-from assistive_compiler.quat import quat_rotate
+from assistive_compiler.rotation import quat_rotate
 from assistive_compiler.runtime.env import AssistiveEnv
 from conftest import FEEDING
 

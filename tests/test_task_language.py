@@ -15,7 +15,7 @@ import pytest
 from assistive_compiler.cli import main
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.paths import specs_dir
-from assistive_compiler.quat import quat_angle, quat_rotate, vec_angle
+from assistive_compiler.rotation import quat_angle, quat_rotate, vec_angle
 from assistive_compiler.runtime.env import AssistiveEnv
 from assistive_compiler.terms.registry import terms
 from helpers import compiled_env

@@ -45,6 +45,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..rotation import matrix_quat, matrix_rpy, rpy_matrix
+
 __all__ = ["MergedFrame", "Pose", "merge_fixed_links", "origin_pose", "parse_vector", "reindent", "write_origin"]
 
 _SIGNIFICANT_DIGITS = 12
@@ -63,68 +65,6 @@ class MergedFrame:
     xyz: tuple[float, float, float]
     #: Frame orientation in ``into``'s frame, quaternion (x, y, z, w) with w >= 0.
     quat: tuple[float, float, float, float]
-
-
-# --------------------------------------------------------------------------- transforms
-
-
-def _rpy_matrix(rpy: Sequence[float]) -> np.ndarray:
-    """URDF's fixed-axis roll-pitch-yaw: R = Rz(yaw) Ry(pitch) Rx(roll)."""
-    r, p, y = (float(v) for v in rpy)
-    cr, sr = math.cos(r), math.sin(r)
-    cp, sp = math.cos(p), math.sin(p)
-    cy, sy = math.cos(y), math.sin(y)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
-
-
-def _matrix_rpy(rot: np.ndarray) -> tuple[float, float, float]:
-    """Inverse of `_rpy_matrix`, numerically stable at pitch = +-pi/2.
-
-    Yaw comes from the first column (0 when that column is along z, i.e. at gimbal lock); roll
-    and pitch are then solved from ``Rz(yaw)^T R = Ry(pitch) Rx(roll)`` so that the three angles
-    reproduce ``rot`` to rounding error whatever the yaw.
-    """
-    if math.hypot(rot[0, 0], rot[1, 0]) < 1e-10:
-        yaw = 0.0
-    else:
-        yaw = math.atan2(rot[1, 0], rot[0, 0])
-    cy, sy = math.cos(yaw), math.sin(yaw)
-    pitch = math.atan2(-rot[2, 0], cy * rot[0, 0] + sy * rot[1, 0])
-    roll = math.atan2(sy * rot[0, 2] - cy * rot[1, 2], cy * rot[1, 1] - sy * rot[0, 1])
-    return roll, pitch, yaw
-
-
-def _matrix_quat(rot: np.ndarray) -> tuple[float, float, float, float]:
-    """Rotation matrix -> unit quaternion (x, y, z, w), w >= 0 (Shepperd's method)."""
-    m = rot
-    trace = m[0, 0] + m[1, 1] + m[2, 2]
-    if trace > 0.0:
-        s = 2.0 * math.sqrt(1.0 + trace)
-        w, x = 0.25 * s, (m[2, 1] - m[1, 2]) / s
-        y, z = (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s
-    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
-        s = 2.0 * math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
-        w, x = (m[2, 1] - m[1, 2]) / s, 0.25 * s
-        y, z = (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s
-    elif m[1, 1] > m[2, 2]:
-        s = 2.0 * math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
-        w, x = (m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s
-        y, z = 0.25 * s, (m[1, 2] + m[2, 1]) / s
-    else:
-        s = 2.0 * math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
-        w, x = (m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s
-        y, z = (m[1, 2] + m[2, 1]) / s, 0.25 * s
-    q = np.array([x, y, z, w])
-    q /= np.linalg.norm(q)
-    if q[3] < 0.0:
-        q = -q
-    return tuple(float(v) + 0.0 for v in q)  # type: ignore[return-value]
 
 
 class Pose:
@@ -180,7 +120,7 @@ def origin_pose(parent: ET.Element, what: str) -> Pose:
         return Pose.identity()
     xyz = parse_vector(origin.get("xyz"), f"{what} <origin xyz>")
     rpy = parse_vector(origin.get("rpy"), f"{what} <origin rpy>")
-    return Pose(_rpy_matrix(rpy), xyz)
+    return Pose(rpy_matrix(rpy), xyz)
 
 
 def _round(value: float) -> float:
@@ -207,7 +147,7 @@ def write_origin(parent: ET.Element, pose: Pose, *, index: int = 0) -> None:
         parent.insert(index, origin)
     origin.attrib.clear()
     origin.set("xyz", _fmt(_clean(pose.pos, pose.scale)))
-    angles = [_round(a) for a in _matrix_rpy(pose.rot)]
+    angles = [_round(a) for a in matrix_rpy(pose.rot)]
     origin.set("rpy", _fmt([0.0 if abs(a) <= _RELATIVE_ZERO else a for a in angles]))
 
 
@@ -330,7 +270,7 @@ def merge_fixed_links(
         if tree.merged(name):
             pose = in_survivor[name]
             xyz = tuple(float(v) + 0.0 for v in pose.pos)
-            frames[name] = MergedFrame(survivor[name], xyz, _matrix_quat(pose.rot))  # type: ignore[arg-type]
+            frames[name] = MergedFrame(survivor[name], xyz, matrix_quat(pose.rot))  # type: ignore[arg-type]
     reindent(tree.root)
     text = '<?xml version="1.0"?>\n' + ET.tostring(tree.root, encoding="unicode") + "\n"
     return text, frames

@@ -16,18 +16,12 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..resolve import ResolvedTask
+from ..rotation import axis_rotation
 from .merge import Pose, origin_pose, parse_vector, reindent, write_origin
 from ..urdf import urdf_info
 from .task import fail
 
 _MOTION_TAGS = ("axis", "limit", "dynamics", "calibration", "safety_controller", "mimic")
-
-
-def _axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
-    """Rotation by ``angle`` (rad) about the unit vector ``axis`` (Rodrigues)."""
-    x, y, z = axis
-    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-    return np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
 
 
 def weld_joints(urdf_xml: str, values: Mapping[str, float]) -> str:
@@ -62,7 +56,7 @@ def weld_joints(urdf_xml: str, values: Mapping[str, float]) -> str:
         if kind == "prismatic":
             motion = Pose(np.eye(3), axis * float(value))
         else:
-            motion = Pose(_axis_rotation(axis, float(value)), np.zeros(3))
+            motion = Pose(axis_rotation(axis, float(value)), np.zeros(3))
         origin = origin_pose(joint, f"joint {name!r}")
         write_origin(joint, origin * motion, index=0)
         joint.set("type", "fixed")

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..urdf import Capsule, Sphere, UrdfInfo
-from ..quat import capsule_axes
+from ..rotation import capsule_axes
 
 Vec3 = tuple[float, float, float]
 

@@ -26,7 +26,7 @@ import numpy as np
 import pybullet as pb
 
 from ..ik_options import ik_damping, ik_limits
-from ..quat import quat_about, quat_conj, quat_mul, quat_rotate, quat_towards, vec_angle
+from ..rotation import quat_about, quat_conj, quat_mul, quat_rotate, quat_towards, vec_angle
 
 
 STALL_STEPS = 10  # steps without getting STALL_GAIN_M closer before moving on to the next waypoint

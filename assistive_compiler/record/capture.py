@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pybullet as pb
 
-from ..quat import quat_rotate
+from ..rotation import quat_rotate
 from ..runtime.snapshot import PointHandle
 
 

@@ -40,7 +40,7 @@ import numpy as np
 import pybullet as pb
 
 from ..artifact import Manifest, TermUse
-from ..quat import capsule_axes
+from ..rotation import capsule_axes
 from ..terms.registry import ref_fields, terms
 from .markers import MarkerSystem
 from .drive import BaseDriveControl, FollowerControl

@@ -44,7 +44,7 @@ import numpy as np
 import pybullet as pb
 
 from ..artifact import Container, ParticleSet
-from ..quat import vec_angle
+from ..rotation import vec_angle
 from .snapshot import ParticleEvents, PointHandle, Snapshot
 from .world import PARK, World, rotation_matrix
 

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 import pybullet as pb
 
-from ..quat import quat_conj, quat_mul, quat_rotate  # noqa: F401  (re-exported)
+from ..rotation import quat_conj, quat_mul, quat_rotate  # noqa: F401  (re-exported)
 from .world import World, rotation_matrix
 
 

@@ -9,7 +9,7 @@ from typing import Literal
 
 from pydantic import Field, model_validator
 
-from ..quat import quat_rotate, vec_angle
+from ..rotation import quat_rotate, vec_angle
 from .registry import BodiesRef, BodyRef, MarkersRef, NodesRef, Params, ParticlesRef, PointRef, term
 
 

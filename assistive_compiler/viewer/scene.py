@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..record.format import Recording
+from ..rotation import wxyz
 from .meshes import garment_faces, link_visuals
 
 TARGET_RGBA = (0.1, 0.8, 0.1, 1.0)
@@ -20,10 +21,6 @@ TARGET_RGBA = (0.1, 0.8, 0.1, 1.0)
 
 def _rgb255(rgba) -> tuple[int, int, int]:
     return tuple(int(round(255 * float(c))) for c in rgba[:3])
-
-
-def _wxyz(xyzw: np.ndarray) -> np.ndarray:
-    return np.array([xyzw[3], xyzw[0], xyzw[1], xyzw[2]])
 
 
 class RecordingScene:
@@ -74,7 +71,7 @@ class RecordingScene:
             pos, quat = a["link_pos"][k], a["link_quat"][k]
             for column, frame in self.frames:
                 frame.position = pos[column]
-                frame.wxyz = _wxyz(quat[column])
+                frame.wxyz = wxyz(quat[column])
             for node, p in zip(self.targets, a["target_pos"][k]):
                 node.position = p
             for name, colors in self.particles.items():

@@ -13,7 +13,7 @@ from collections import Counter
 
 import numpy as np
 
-from ...quat import quat_from_rpy
+from ...rotation import quat_from_rpy
 from ...resolve import ResolvedTask
 from ..task import fail
 

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from ...ik_options import ik_damping, ik_limits
-from ...quat import quat_angle, quat_from_rpy_deg
+from ...rotation import quat_angle, quat_from_rpy_deg
 from ...resolve import ResolvedTask
 from ..task import start_for
 from .client import PlacementClient

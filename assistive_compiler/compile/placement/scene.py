@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from ...artifact import Body, ToolAttachment
-from ...quat import quat_from_rpy, quat_from_rpy_deg
+from ...rotation import quat_from_rpy, quat_from_rpy_deg
 from ...resolve import ResolvedTask
 from ..emit import EmittedScene
 from ..task import mounted_on, present_furniture, rounded, seat_links

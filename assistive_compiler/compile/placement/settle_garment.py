@@ -14,7 +14,7 @@ import numpy as np
 
 from ...artifact import Garment
 from ...bullet import connect
-from ...quat import quat_from_rpy_deg
+from ...rotation import quat_from_rpy_deg
 from ...resolve import ResolvedTask
 from ..task import fail, rounded
 

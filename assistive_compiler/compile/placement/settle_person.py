@@ -14,7 +14,7 @@ import numpy as np
 
 from ...library import PERSON_TEMPLATE_RELPATH
 from ...paths import templates_dir
-from ...quat import quat_from_rpy_deg
+from ...rotation import quat_from_rpy_deg
 from ...resolve import ResolvedTask
 from ..emit import EmittedScene, person_xacro_args
 from ..render import render_template

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from ...artifact import Body, StartState
-from ...quat import quat_yaw
+from ...rotation import quat_yaw
 from ...resolve import ResolvedTask
 from ..task import fail, mounted_on, rounded, seed
 from .base_search import reach_goals, search_base

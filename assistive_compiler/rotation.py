@@ -1,10 +1,14 @@
-"""Quaternion arithmetic on (x, y, z, w) tuples, as pybullet orders them, and the frame of a capsule
-axis. Plain numpy, no pybullet, so the term library and the compiler can use it without importing
-the simulator."""
+"""Rotations, in one place: quaternions (x, y, z, w) as pybullet orders them (and the (w, x, y, z)
+order viewers use), 3×3 rotation matrices (columns: the rotated frame's axes), URDF's fixed-axis
+roll-pitch-yaw, rotation about an axis, and the frame of a capsule axis. Angles in radians unless
+a name says degrees. Plain numpy, no pybullet, so the term library and the compiler can use it
+without importing the simulator (the runtime reads body orientations as matrices with
+:func:`assistive_compiler.runtime.world.rotation_matrix`, pybullet's own conversion)."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -107,3 +111,74 @@ def capsule_axes(start, end) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]
     u = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0])
     u /= np.linalg.norm(u)
     return length, axis, u, np.cross(axis, u)
+
+
+def rpy_matrix(rpy: Sequence[float]) -> np.ndarray:
+    """URDF's fixed-axis roll-pitch-yaw: R = Rz(yaw) Ry(pitch) Rx(roll)."""
+    r, p, y = (float(v) for v in rpy)
+    cr, sr = math.cos(r), math.sin(r)
+    cp, sp = math.cos(p), math.sin(p)
+    cy, sy = math.cos(y), math.sin(y)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+def matrix_rpy(rot: np.ndarray) -> tuple[float, float, float]:
+    """Inverse of :func:`rpy_matrix`, numerically stable at pitch = +-pi/2.
+
+    Yaw comes from the first column (0 when that column is along z, i.e. at gimbal lock); roll
+    and pitch are then solved from ``Rz(yaw)^T R = Ry(pitch) Rx(roll)`` so that the three angles
+    reproduce ``rot`` to rounding error whatever the yaw.
+    """
+    if math.hypot(rot[0, 0], rot[1, 0]) < 1e-10:
+        yaw = 0.0
+    else:
+        yaw = math.atan2(rot[1, 0], rot[0, 0])
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    pitch = math.atan2(-rot[2, 0], cy * rot[0, 0] + sy * rot[1, 0])
+    roll = math.atan2(sy * rot[0, 2] - cy * rot[1, 2], cy * rot[1, 1] - sy * rot[0, 1])
+    return roll, pitch, yaw
+
+
+def matrix_quat(rot: np.ndarray) -> tuple[float, float, float, float]:
+    """Rotation matrix -> unit quaternion (x, y, z, w), w >= 0 (Shepperd's method)."""
+    m = rot
+    trace = m[0, 0] + m[1, 1] + m[2, 2]
+    if trace > 0.0:
+        s = 2.0 * math.sqrt(1.0 + trace)
+        w, x = 0.25 * s, (m[2, 1] - m[1, 2]) / s
+        y, z = (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
+        w, x = (m[2, 1] - m[1, 2]) / s, 0.25 * s
+        y, z = (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s
+    elif m[1, 1] > m[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
+        w, x = (m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s
+        y, z = 0.25 * s, (m[1, 2] + m[2, 1]) / s
+    else:
+        s = 2.0 * math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
+        w, x = (m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s
+        y, z = (m[1, 2] + m[2, 1]) / s, 0.25 * s
+    q = np.array([x, y, z, w])
+    q /= np.linalg.norm(q)
+    if q[3] < 0.0:
+        q = -q
+    return tuple(float(v) + 0.0 for v in q)  # type: ignore[return-value]
+
+
+def axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+    """Rotation by ``angle`` (rad) about the unit vector ``axis`` (Rodrigues)."""
+    x, y, z = axis
+    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    return np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
+
+
+def wxyz(xyzw) -> np.ndarray:
+    """A quaternion (x, y, z, w) reordered as (w, x, y, z)."""
+    return np.array([xyzw[3], xyzw[0], xyzw[1], xyzw[2]])
