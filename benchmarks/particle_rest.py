@@ -37,26 +37,27 @@ from assistive_compiler.runtime.env import AssistiveEnv  # noqa: E402
 from assistive_compiler.spec.load import load_spec  # noqa: E402
 
 
-def container_frame(env, ps) -> np.ndarray:
-    """Every particle of set ``ps`` in its container's frame, (n, 3) m."""
+def container_frame(env, ps, box) -> np.ndarray:
+    """Every particle of set ``ps`` in the frame of container ``box``, (n, 3) m."""
     w, c = env.world, env.world.client
-    pos, orn = w.base_frame(w.bodies[ps.outside_of.body])
+    pos, orn = w.base_frame(w.bodies[box.body])
     inv = pb.invertTransform(pos, orn)
     return np.array([pb.multiplyTransforms(*inv, pb.getBasePositionAndOrientation(pid, physicsClientId=c)[0], (0, 0, 0, 1))[0]
                      for pid in w.particles[ps.name]])
 
 
-def creep(artifact: Path, angles: list[int]) -> None:
+def creep(artifact: Path, box, angles: list[int]) -> None:
+    """``artifact`` simulates the particles always; ``box``: the container they rest in when shipped."""
     env = AssistiveEnv(artifact)
     ps = env.manifest.particles[0]
-    grip = env.world.tool_constraints[ps.outside_of.body]
+    grip = env.world.tool_constraints[box.body]
     hold = np.zeros(env.action_space.shape)
     print("| turned by | mean / max movement (mm) | top above the floor (cm) | left in the container |\n|---|---|---|---|")
     for theta in angles:
         env.reset(seed=0)
         for _ in range(10):
             env.step(hold)
-        rested = container_frame(env, ps)
+        rested = container_frame(env, ps, box)
         n = max(2, theta // 5)
         for k in range(1, n + 1):
             turn = pb.getQuaternionFromEuler([-math.radians(theta * k / n), 0, 0])
@@ -65,8 +66,8 @@ def creep(artifact: Path, angles: list[int]) -> None:
         for _ in range(20):
             env.step(hold)
         left = env.particles.active[ps.name]
-        moved = np.linalg.norm(container_frame(env, ps) - rested, axis=1)[left]
-        top = container_frame(env, ps)[left, 2].max()
+        moved = np.linalg.norm(container_frame(env, ps, box) - rested, axis=1)[left]
+        top = container_frame(env, ps, box)[left, 2].max()
         print(f"| {theta}° | {moved.mean() * 1e3:.1f} / {moved.max() * 1e3:.1f} | {top * 1e2:.1f} | {left.sum()} |")
     env.close()
 
@@ -113,11 +114,11 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{spec.name}: no particle set rests in a container", file=sys.stderr)
             return 2
         always = compile_task(off, args.robot, root / "rest-off").out_dir
+        shipped = compile_task(args.spec, args.robot, root / "shipped")
         if args.what == "creep":
-            creep(always, [int(a) for a in args.angles.split(",")])
+            creep(always, next(ps.rest.container for ps in shipped.manifest.particles if ps.rest), [int(a) for a in args.angles.split(",")])
         else:
-            speed({"carried at rest (shipped)": compile_task(args.spec, args.robot, root / "shipped").out_dir,
-                   "always simulated": always}, args.steps, args.repeats)
+            speed({"carried at rest (shipped)": shipped.out_dir, "always simulated": always}, args.steps, args.repeats)
     return 0
 
 

@@ -5,11 +5,15 @@ the shipped 4 solver sub-steps, upright or tilted, and a tilted cup keeps it car
 turns further; tipping the cup past the limits puts it back into the physics, and past ~90° most
 of it pours out; a cup turned upright again carries what is left; seeded episodes that pour
 replay bit for bit; renders draw carried water where it is; a rest container must be a tool with one.
+Feeding with resting food (benchmarks/specs/feeding_food_rests.yaml, Jaco): the food is simulated
+from the reset, rides in the spoon once it rests and is simulated near the person, where it is
+eaten; `simulated_near` names a known body.
 """
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pybullet as pb
@@ -220,3 +224,71 @@ def test_rest_container_must_be_a_tool_with_a_container(tmp_path, capsys):
     column = text.index("wheelchair}") - text.rfind("\n", 0, text.index("wheelchair}"))
     assert rc == 2
     assert err.splitlines() == [f"{display(path)}:{line}:{column}: 'wheelchair' is not a tool with a container; tools with one: 'cup'"]
+
+
+# -- Feeding with food resting in the spoon (a benchmark variant; not shipped, docs/physics.md) ----
+
+FOOD_RESTS = Path(__file__).resolve().parents[1] / "benchmarks" / "specs" / "feeding_food_rests.yaml"
+
+
+@pytest.fixture(scope="module")
+def feeding_artifact(tmp_path_factory):
+    return compile_task(FOOD_RESTS, "jaco", tmp_path_factory.mktemp("rest") / "feeding-jaco").out_dir
+
+
+def spoon_gap_to_person(env) -> float:
+    """The gap between the spoon and the person, m (inf: farther than 1 m)."""
+    w, c = env.world, env.world.client
+    person = env.particles.snap.handle(env.particles.snap.body_key("person")).id
+    points = pb.getClosestPoints(w.bodies["spoon"].id, person, 1.0, -1, physicsClientId=c)
+    return min((p[8] for p in points), default=math.inf)
+
+
+def test_food_rides_in_the_spoon_on_the_way_and_is_simulated_near_the_person(feeding_artifact):
+    """Scripted Feeding, seed 0: the food is simulated from the reset (``carry_at_reset: false``)
+    and carried once it rests in the spoon on the way; an env step that
+    ends with the spoon within 10 cm of the person (``simulated_near``) puts every particle back
+    into the physics for the next one, and none is carried there again; the food is eaten at the
+    mouth, which only simulated particles can be."""
+    env = AssistiveEnv(feeding_artifact)
+    try:
+        rest = env.manifest.particles[0].rest
+        assert (rest.near_body, rest.near_distance) == ("person", 0.1)
+        policy = ScriptedPolicy(env)
+        obs, _ = env.reset(seed=0)
+        particles = env.particles
+        assert not particles.carried["food"].any()
+        carried_steps = near_steps = eaten = 0
+        was_near, done = False, False
+        while not done:
+            carried = particles.carried["food"].copy()
+            obs, _, terminated, truncated, info = env.step(policy(obs))
+            done = terminated or truncated
+            near = spoon_gap_to_person(env) < 0.1
+            assert particles._near["food"] == near
+            if was_near:  # released when this step started, simulated all through it, not carried again
+                assert not particles.carried["food"].any()
+            if particles.snap.events["food"].consumed:
+                assert not carried.all()
+            eaten += particles.snap.events["food"].consumed
+            carried_steps += bool(carried.any())
+            near_steps += near
+            was_near = near
+        assert carried_steps >= 10 and near_steps >= 10
+        assert eaten >= 7 and info["task_success"]
+    finally:
+        env.close()
+
+
+def test_simulated_near_names_a_known_body(tmp_path, capsys):
+    text = (f"extends: {FOOD_RESTS}\nparticles:\n  food:\n    rest:\n      container: spoon\n"
+            "      simulated_near: {body: persn, distance_m: 0.1}\n")
+    path = tmp_path / "spec.yaml"
+    path.write_text(text, encoding="utf-8")
+    rc = main(["validate", str(path)])
+    err = capsys.readouterr().err
+    line = text.count("\n", 0, text.index("persn")) + 1
+    column = text.index("persn") - text.rfind("\n", 0, text.index("persn"))
+    assert rc == 2
+    assert err.splitlines()[0].startswith(f"{display(path)}:{line}:{column}: unknown body 'persn'; ")
+    assert "did you mean 'person'" in err

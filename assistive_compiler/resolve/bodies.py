@@ -161,6 +161,8 @@ def check_particles(s: Scope) -> None:
                 _check_container(s, ps.consumed_at.outside_of, base + ("consumed_at", "outside_of"))
         if ps.rest is not None:
             _check_container(s, ps.rest.container, base + ("rest", "container"))
+            if ps.rest.simulated_near is not None:
+                s.body(ps.rest.simulated_near.body, base + ("rest", "simulated_near", "body"), allow_particles=False)
         if ps.lost_beyond:
             s.body(ps.lost_beyond.body, base + ("lost_beyond", "body"), allow_particles=False)
         if ps.hit_body:

@@ -25,11 +25,14 @@ remembered. A mean, not the fastest particle: under solver sub-steps a resting h
 particle or two rattling at several cm/s, while the heap itself creeps at millimetres per second
 (docs/physics.md). At the start of an env step carried particles are put back at their carried
 positions with the container's velocity (linear plus ω × r) and simulated when the last env
-step's up has turned more than ``rest.max_turn`` from the remembered one, or its effective tilt
-exceeds ``rest.max_tilt``: a heap that came to rest tilted stays carried while the cup is held
+step's up has turned more than ``rest.max_turn`` from the remembered one, its effective tilt
+exceeds ``rest.max_tilt``, or the container ended it within ``rest.near_distance`` of
+``rest.near_body`` (there nothing rests: what the particles do near that body, touch it or be
+consumed, happens in the physics, as without the shortcut): a heap that came to rest tilted stays carried while the cup is held
 at that tilt, and only a turn of the apparent gravity makes it flow. A reset carries them at
 their settled start positions (settled at compile time, so at rest) when the container starts
-within ``max_tilt``. While carried, their weight pushes on the container
+within ``max_tilt``, unless ``rest.carry_at_reset`` is off: then they are simulated until they
+rest (the spoon's food settles as a stack that the first tilt topples). While carried, their weight pushes on the container
 (:meth:`World.set_load`), as it would through their contacts. Carried particles are active and
 inside their container, so they produce no events; renders draw them where they are carried
 (:meth:`ParticleSystem.visual_spheres`). Every decision is a function of the world's state, so
@@ -72,6 +75,9 @@ class ParticleSystem:
         self._last_up: dict[str, np.ndarray] = {}
         self._rest_up: dict[str, np.ndarray] = {}
         self._still_steps: dict[str, int] = {}
+        #: Per set with ``rest.near_body``: whether its container was within ``near_distance`` of
+        #: that body at the end of the last env step (its particles are then simulated).
+        self._near: dict[str, bool] = {}
         self._dt = world.m.sim.time_step * world.m.sim.frame_skip
         self._gravity = np.array([0.0, 0.0, world.m.sim.gravity])
         #: Env steps a parked particle may fall before it is put back at its parking spot: the free
@@ -150,7 +156,8 @@ class ParticleSystem:
     # -- lifecycle -------------------------------------------------------------------------------
     def reset(self) -> None:
         """Place every particle at its settled position in its holder's frame; all active (and
-        carried, for a set that rests in a container that starts within its tilt limit)."""
+        carried, for a set that rests in a container that starts within its tilt limit and is
+        carried from the reset on)."""
         w, c = self.world, self.world.client
         for ps, ids, _ in self.sets:
             holder = w.bodies[ps.attach]
@@ -178,8 +185,19 @@ class ParticleSystem:
             if ps.rest is None or not self.carried[ps.name].any():
                 continue
             up = self._last_up[ps.name]
-            if vec_angle(up, self._rest_up[ps.name]) > ps.rest.max_turn or vec_angle(up, _AXIS) > ps.rest.max_tilt:
+            if (vec_angle(up, self._rest_up[ps.name]) > ps.rest.max_turn or vec_angle(up, _AXIS) > ps.rest.max_tilt
+                    or self._near.get(ps.name, False)):
                 self._release(ps, ids)
+
+    def _container_near(self, ps: ParticleSet) -> bool:
+        """Whether the set's container link is within ``rest.near_distance`` (m) of ``rest.near_body``."""
+        rest = ps.rest
+        if rest.near_body is None:
+            return False
+        w = self.world
+        holder, near = w.bodies[rest.container.body], self.snap.handle(self.snap.body_key(rest.near_body))
+        return bool(pb.getClosestPoints(holder.id, near.id, rest.near_distance, holder.links[rest.container.link],
+                                        physicsClientId=w.client))
 
     def _maybe_carry(self, ps: ParticleSet, ids: list[int], settled: bool = False) -> None:
         """After an env step: carry the set's free particles if they have rested in their container
@@ -188,10 +206,11 @@ class ParticleSystem:
         pos, rot, com, lin, ang = self._container_state(box)
         up = self._last_up[name] = self._apparent_up(name, rot, lin)
         self._container_velocity[name] = lin
+        near = self._near[name] = self._container_near(ps)
         free = self.active[name] & ~self.carried[name]
-        if not free.any():
+        if not free.any() or (settled and not ps.rest.carry_at_reset):
             return
-        if vec_angle(up, _AXIS) > ps.rest.max_tilt:
+        if near or vec_angle(up, _AXIS) > ps.rest.max_tilt:
             self._still_steps[name] = 0
             return
         idx = np.flatnonzero(free)

@@ -47,7 +47,10 @@ def settle_particles(rt: ResolvedTask, pc: PlacementClient, name: str, ps, scene
                        hit_body=ps.hit_body, outside_of=_container(rt, ps.consumed_at.outside_of if ps.consumed_at else None),
                        rest=None if ps.rest is None else ParticleRest(
                            container=_container(rt, ps.rest.container), max_tilt=math.radians(ps.rest.max_tilt_deg),
-                           max_turn=math.radians(ps.rest.max_turn_deg), max_speed=ps.rest.max_speed_mps, still_steps=ps.rest.still_steps))
+                           max_turn=math.radians(ps.rest.max_turn_deg), max_speed=ps.rest.max_speed_mps, still_steps=ps.rest.still_steps,
+                           carry_at_reset=ps.rest.carry_at_reset,
+                           near_body=ps.rest.simulated_near.body if ps.rest.simulated_near else None,
+                           near_distance=ps.rest.simulated_near.distance_m if ps.rest.simulated_near else 0.0))
 
 
 def _drop_grid(pc: PlacementClient, ps, frame_pos, frame_orn) -> list[tuple]:

@@ -28,7 +28,7 @@ from .sim import Solver, Ground, Sim
 from .scene import FurnitureUse, Scene
 from .person import Tremor, Weakness, LimitedRange, NoImpairment, Impairment, Impairments, CompliantHold, PersonControl, Settle, StageHold, SettleStage, Placement, Person
 from .robot import RobotControl, StartGoal, Goal, BaseSearch, PerRobot, RobotRole, ToolUse
-from .bodies import Target, ClearedBy, Markers, ConsumedAt, LostBeyond, RestInContainer, Particles, SleeveShape, SoftBodyPhysics, GarmentHold, GarmentSettle, Garment
+from .bodies import Target, ClearedBy, Markers, ConsumedAt, LostBeyond, SimulatedNear, RestInContainer, Particles, SleeveShape, SoftBodyPhysics, GarmentHold, GarmentSettle, Garment
 from .terms import TermUse, RewardTerm, Observations, PREFERENCE_NAMES, PAPER_PREFERENCE_WEIGHTS, Preference, Preferences, Success
 from .scripted import Waypoint, SegmentUse, WaypointItem, ScriptedArm, ScriptedRobot, Scripted
 from .task import CameraView, Camera, TaskSpec
@@ -74,6 +74,7 @@ __all__ = [
     "ConsumedAt",
     "LostBeyond",
     "RestInContainer",
+    "SimulatedNear",
     "Particles",
     "SleeveShape",
     "SoftBodyPhysics",

@@ -112,6 +112,14 @@ class LostBeyond(Strict):
     distance_m: float = Field(gt=0, le=10, description="Distance beyond which it is lost, metres.")
 
 
+class SimulatedNear(Strict):
+    """Where resting particles are simulated even though they rest: while their container is this
+    close to a body they could touch or be consumed at (e.g. food in the spoon at the person)."""
+
+    body: Ref = Field(description="The body, e.g. person.")
+    distance_m: float = Field(gt=0, le=1, description="Gap between the container's link and the body (metres) below which the particles are simulated.")
+
+
 class RestInContainer(Strict):
     """A simulation shortcut: particles resting in their container ride with it instead of being simulated.
 
@@ -125,7 +133,9 @@ class RestInContainer(Strict):
     the tilt exceeds ``max_tilt_deg``, they are put back where they were carried, with the
     container's velocity, and simulated again. What this trades: the heap's slow creep under a
     turn below ``max_turn_deg`` (a few millimetres for Drinking's water, docs/physics.md) and
-    sloshing under accelerations that turn the apparent up less than that.
+    sloshing under accelerations that turn the apparent up less than that. With ``simulated_near``
+    they are also simulated while the container is near that body, so whatever they do there
+    (touch it, be consumed at a target on it) happens in the physics as without the shortcut.
     """
 
     container: Ref = Field(description="A tool with a container (e.g. the cup) that carries the resting particles.")
@@ -142,6 +152,14 @@ class RestInContainer(Strict):
     )
     still_steps: int = Field(
         2, ge=1, le=100, description="Env steps in a row the particles must be still before they are carried."
+    )
+    carry_at_reset: bool = Field(
+        True, description="Carry the settled start positions from the reset on (false: simulate the particles from the "
+        "reset until they come to rest, for a heap settled in a balance the motion would soon upset, such as the "
+        "spoon's stacked food)."
+    )
+    simulated_near: SimulatedNear | None = Field(
+        None, description="Simulate them, resting or not, while the container is near this body (None: wherever they rest)."
     )
 
 
