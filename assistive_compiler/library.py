@@ -30,7 +30,7 @@ from typing import Generic, Iterable, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
-from .compile.render import render_template
+from .templates import expand_template
 from .errors import Problem, SpecError
 from .paths import display, specs_dir, templates_dir
 from .spec.parts import FurniturePart, PersonPart, RobotPart, ToolPart
@@ -132,7 +132,7 @@ class Library:
         """The person template rendered with variant ``name``'s measurements (URDF XML); raises like
         :meth:`get` for an unknown or broken variant."""
         if name not in self._person_urdfs:  # resolving for every supported robot asks again for the same variant
-            self._person_urdfs[name] = render_template(PERSON_TEMPLATE_RELPATH, self.get("people", name).part.measurements().xacro_args())
+            self._person_urdfs[name] = expand_template(PERSON_TEMPLATE_RELPATH, self.get("people", name).part.measurements().xacro_args())
         return self._person_urdfs[name]
 
     def default_urdf(self, kind: str, name: str) -> UrdfInfo:
@@ -146,7 +146,7 @@ class Library:
         if getattr(part, "urdf", None):
             return self._urdf_file_info(loaded)
         params = dict(part.template.params) | dict(getattr(part, "mount_params", {}) or {})
-        return urdf_info(render_template(self.template_path(loaded), params))
+        return urdf_info(expand_template(self.template_path(loaded), params))
 
     def urdf_path(self, loaded: LoadedPart) -> Path:
         """A bring-your-own robot's URDF: relative to its part file, or inside an installed package."""

@@ -112,21 +112,21 @@ def test_the_plan_is_exact_on_the_unmerged_body():
     """person_self_collision on a rendered body: every pair of geometry links lands on surviving
     links whose pair decision is the reference's (for the moving groups)."""
     from assistive_compiler.library import PERSON_TEMPLATE_RELPATH
-    from assistive_compiler.compile.render import render_template
+    from assistive_compiler.templates import expand_template
     from assistive_compiler.paths import templates_dir
     from assistive_compiler.person.body import REVOLUTE_JOINTS, body_measurements, format_fixed_joints
 
     movable = {"right_elbow", "head_x", "head_y", "head_z"}  # only the forearm of the right arm moves
     fixed = {j: 0.0 for j in REVOLUTE_JOINTS if j not in movable}
     args = body_measurements("male").xacro_args(fixed_joints=format_fixed_joints(fixed))
-    xml = render_template(templates_dir() / PERSON_TEMPLATE_RELPATH, args)
+    xml = expand_template(templates_dir() / PERSON_TEMPLATE_RELPATH, args)
     keep, pairs = person_self_collision(xml, set())
     # The static upper arm (forearm's neighbour, same group) and the girdle (excluded from the arm's
     # group) stay out of the chest, which the forearm must collide with.
     assert {"right_shoulder", "right_pecs"} <= keep
     assert ("chest", "right_elbow_link") in pairs and ("right_elbow_link", "right_shoulder") not in pairs
     nothing_moves = {j: 0.0 for j in REVOLUTE_JOINTS}
-    xml = render_template(templates_dir() / PERSON_TEMPLATE_RELPATH,
+    xml = expand_template(templates_dir() / PERSON_TEMPLATE_RELPATH,
                           body_measurements("male").xacro_args(fixed_joints=format_fixed_joints(nothing_moves)))
     assert person_self_collision(xml, set()) == (set(), [])
 

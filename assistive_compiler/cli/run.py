@@ -105,7 +105,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
     from ..compile.compiler import compile_task
     from ..policies import make_policy
     from ..runtime.env import AssistiveEnv
-    from .render import record, write_picture
+    from ..pictures import episode_frames, write_picture
 
     spec = str(Path(args.spec))
     result = compile_task(spec, args.robot)
@@ -117,7 +117,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
     for k in range(args.episodes):
         frames = None
         if k == 0:
-            frames, _ = record(env, policy, args.seed, every=10)
+            frames, _ = episode_frames(env, policy, args.seed, every=10)
             env.reset(seed=args.seed)
         e = rollout(env, policy, args.seed + k)
         outcomes.append(e)

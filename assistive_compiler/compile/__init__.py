@@ -3,7 +3,7 @@
 The driver is :func:`.compiler.compile_task` (cache check, atomic write, hashes); it runs these
 stages in order (:func:`.compiler.build`):
 
-1. :mod:`.emit` — render the robot, furniture and tools from their xacro templates, lint
+1. :mod:`.emit` — expand the robot, furniture and tools from their xacro templates, lint
    (:mod:`.lint`) and write them; the robot's undriven joints welded (:mod:`.weld`).
 2. :mod:`.placement.settle_person` — a supine person settles limp onto the furniture; its
    settled angles become its posture.
@@ -16,5 +16,5 @@ stages in order (:func:`.compiler.build`):
 6. :mod:`.person` — self-collision pairs apart at rest, a user's arm-limit model copied.
 
 Shared questions about the resolved task (present furniture, joint groups, seeds, rounding) live
-in :mod:`.task`; :mod:`.render` and :mod:`.external_checks` serve the stages.
+in :mod:`.task`; :mod:`.external_checks` serves the stages (xacro expansion: :mod:`assistive_compiler.templates`).
 """

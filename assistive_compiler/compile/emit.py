@@ -22,7 +22,7 @@ from ..person.body import format_fixed_joints
 from ..resolve import ResolvedTask
 from .lint import lint_urdf
 from .weld import robot_welds, weld_joints
-from .render import render_template
+from ..templates import expand_template
 from .task import impairment_joints, mounted_on, observed_person_joints, policy_joints, present_furniture
 
 
@@ -48,7 +48,7 @@ class EmittedScene:
 
 def emit_body(scene: EmittedScene, body_name: str, template: Path, params: dict[str, Any], where) -> Path:
     """Render, lint and write one body; a refusal is located at ``where`` (the part's template line)."""
-    xml = render_template(template, params)
+    xml = expand_template(template, params)
     problems = lint_urdf(xml, template=display(template))
     if problems:
         raise SpecError([Problem(where, f"generated URDF refused: {pr}") for pr in problems])

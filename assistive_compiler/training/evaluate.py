@@ -95,12 +95,12 @@ def play_episodes(artifact_dir: str | Path, policy, coop: bool, episodes: int, s
 
 def write_rollout(artifact_dir: str | Path, policy, coop: bool, seed: int, out: Path, every: int = 2) -> str:
     """Write one rollout of ``policy`` as a GIF (or a PNG strip); returns a line saying so."""
-    from ..cli.render import record, write_picture
+    from ..pictures import episode_frames, write_picture
     from ..runtime.env import AssistiveEnv
 
     env = AssistiveEnv(artifact_dir, render_mode="rgb_array")
     target, act = (env, policy) if not coop else both_agents(env, policy)
-    frames, summary = record(target, act, seed, every)
+    frames, summary = episode_frames(target, act, seed, every)
     env.close()
     write_picture(frames, out, fps=max(1, 10 // every))
     return f"wrote {display(out)} ({len(frames)} frames; return {summary['return']:.1f}, success {'yes' if summary['success'] else 'no'})"

@@ -17,7 +17,7 @@ from ...paths import templates_dir
 from ...rotation import quat_from_rpy_deg
 from ...resolve import ResolvedTask
 from ..emit import EmittedScene, person_xacro_args
-from ..render import render_template
+from ...templates import expand_template
 from ..task import fail, group_joints, present_furniture, rounded, seed
 from .client import PlacementClient
 
@@ -76,7 +76,7 @@ def _load_limp(rt: ResolvedTask, pc: PlacementClient, scene: EmittedScene, varia
     """Load the person with every joint free (nothing baked), its base frame at the placement pose."""
     args = person_xacro_args(scene.measurements[variant], rt.people[variant].part, "")
     limp = scene.urdf_dir / f".settle_{variant}.urdf"
-    limp.write_text(render_template(templates_dir() / PERSON_TEMPLATE_RELPATH, args))
+    limp.write_text(expand_template(templates_dir() / PERSON_TEMPLATE_RELPATH, args))
     placement = rt.spec.person.placement
     orn = quat_from_rpy_deg(placement.rpy_deg)
     body = pc.load(limp, (0, 0, 0), orn, False)

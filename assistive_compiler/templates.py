@@ -1,4 +1,5 @@
-"""Rendering xacro templates to URDF text, deterministically (what a URDF declares: :mod:`assistive_compiler.urdf`)."""
+"""Expanding xacro templates (robots, people, tools, furniture) into URDF text, deterministically.
+(What a URDF declares: :mod:`assistive_compiler.urdf`; pictures of episodes: :mod:`assistive_compiler.pictures`.)"""
 
 from __future__ import annotations
 
@@ -10,8 +11,8 @@ from typing import Mapping
 
 import xacro
 
-from ..errors import SpecError
-from ..paths import display, templates_dir
+from .errors import SpecError
+from .paths import display, templates_dir
 
 _BANNER = re.compile(r"<!--\s*=+\s*-->\s*<!--.*?-->\s*<!--.*?-->\s*<!--\s*=+\s*-->\s*", re.S)
 
@@ -30,23 +31,23 @@ def format_param(value: object) -> str:
     return str(value)
 
 
-def render_template(template: str | Path, params: Mapping[str, object]) -> str:
-    """Render a xacro template (a path, or one relative to the shipped ``templates/``) with
+def expand_template(template: str | Path, params: Mapping[str, object]) -> str:
+    """Expand a xacro template (a path, or one relative to the shipped ``templates/``) with
     ``params``; the same inputs give the same bytes."""
     path = Path(template)
     if not path.is_absolute():
         path = templates_dir() / path
-    return _render_cached(path, tuple(sorted((k, format_param(v)) for k, v in params.items())))
+    return _expand_cached(path, tuple(sorted((k, format_param(v)) for k, v in params.items())))
 
 
 @lru_cache(maxsize=256)
-def _render_cached(path: Path, params: tuple[tuple[str, str], ...]) -> str:
+def _expand_cached(path: Path, params: tuple[tuple[str, str], ...]) -> str:
     if not path.is_file():
         raise SpecError.at(display(path), "template not found")
     declared = set(_declared_args(path))
     unknown = [k for k, _ in params if k not in declared]
     if unknown:
-        from ..errors import did_you_mean
+        from .errors import did_you_mean
 
         raise SpecError.at(
             display(path),
@@ -56,7 +57,7 @@ def _render_cached(path: Path, params: tuple[tuple[str, str], ...]) -> str:
     try:
         doc = xacro.process_file(str(path), mappings=dict(params) | {SHIPPED_TEMPLATES_ARG: str(templates_dir())})
     except Exception as exc:  # xacro raises plain Exceptions (XacroException, NameError, ...)
-        raise SpecError.at(display(path), f"template failed to render: {exc}") from None
+        raise SpecError.at(display(path), f"template failed to expand: {exc}") from None
     text = doc.toprettyxml(indent="  ")
     return _BANNER.sub("", text, count=1)
 
