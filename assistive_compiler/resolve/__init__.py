@@ -69,9 +69,11 @@ def resolve(loaded: LoadedSpec, robot: str | None = None, library: Library | Non
     base_goals = robot_section.base_goals(s)
     s.fail_if_any()
     return ResolvedTask(
-        loaded, s.robot_name, s.robot, s.robot_urdf, s.tools, s.furniture, s.people, s.person_urdf,
-        s.robot_links, s.joint_groups, observations, reward, threshold, points, script, base_goals, markers,
-        s.sides, {n: u for n, u in spec.tools.items() if n not in s.tool_aliases}, s.tool_aliases,
+        loaded=loaded, robot_name=s.robot_name, robot=s.robot, robot_urdf=s.robot_urdf, tools=s.tools,
+        furniture=s.furniture, people=s.people, person_urdf=s.person_urdf, robot_links=s.robot_links,
+        joint_groups=s.joint_groups, observations=observations, reward=reward, success_threshold=threshold,
+        points=points, scripted=script, base_goals=base_goals, markers=markers, sides=s.sides,
+        tool_uses={n: u for n, u in spec.tools.items() if n not in s.tool_aliases}, tool_aliases=s.tool_aliases,
     )
 
 

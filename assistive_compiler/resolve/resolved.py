@@ -27,9 +27,9 @@ class ResolvedTerm:
     params: dict[str, Any]
 
 
-@dataclass
+@dataclass(kw_only=True)
 class ResolvedTask:
-    """Everything the compiler needs for one (task, robot) pair."""
+    """Everything the compiler needs for one (task, robot) pair (built by keyword only)."""
 
     loaded: LoadedSpec
     robot_name: str
