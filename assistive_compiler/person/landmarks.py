@@ -14,9 +14,10 @@ Offsets are in the landmark's link frame, metres, at the person's zero pose: +x 
 from __future__ import annotations
 
 import math
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import Callable
+
+from ..urdf import urdf_info
 
 Vec3 = tuple[float, float, float]
 
@@ -131,23 +132,19 @@ def vec3(text: str | None) -> Vec3:
 
 
 def link_shapes(urdf_xml: str) -> dict[str, LinkShapes]:
-    """Each link's collision spheres and capsules (a capsule: a cylinder, its end spheres dropped)."""
+    """Each link's collision spheres and capsule (its cylinder; the end spheres are part of it), as
+    :func:`assistive_compiler.urdf.urdf_info` reads them: centres in the link frame, m."""
+    info = urdf_info(urdf_xml)
     out: dict[str, LinkShapes] = {}
-    for link in ET.fromstring(urdf_xml).findall("link"):
-        spheres, capsules = [], []
-        for col in link.findall("collision"):
-            origin = col.find("origin")
-            xyz = vec3(origin.get("xyz") if origin is not None else None)
-            rpy = vec3(origin.get("rpy") if origin is not None else None)
-            for g in col.find("geometry") or ():
-                if g.tag == "sphere":
-                    spheres.append((xyz, float(g.get("radius"))))
-                elif g.tag == "cylinder":
-                    axis = 1 if abs(rpy[0]) > 1e-6 else (0 if abs(rpy[1]) > 1e-6 else 2)  # rolled: along y; pitched: along x
-                    capsules.append((xyz, float(g.get("radius")), float(g.get("length")), axis))
-        if capsules:  # the end spheres of a capsule are not shapes of their own here
-            spheres = [s for s in spheres if not any(abs(s[1] - c[1]) < 1e-9 for c in capsules)]
-        out[link.get("name")] = LinkShapes(tuple(spheres), tuple(capsules))
+    for link in info.links:
+        spheres = tuple((s.centre, s.radius) for s in info.spheres.get(link, ()))
+        cap = info.capsules.get(link)
+        capsules: tuple[tuple[Vec3, float, float, int], ...] = ()
+        if cap is not None:
+            centre = tuple((a + b) / 2 for a, b in zip(cap.start, cap.end))
+            axis = max(range(3), key=lambda k: abs(cap.end[k] - cap.start[k]))
+            capsules = ((centre, cap.radius, cap.length, axis),)  # type: ignore[assignment]
+        out[link] = LinkShapes(spheres, capsules)
     return out
 
 
