@@ -214,16 +214,21 @@ def test_renders_draw_carried_water_in_the_cup(artifact):
         e.close()
 
 
-def test_rest_container_must_be_a_tool_with_a_container(tmp_path, capsys):
-    text = f"extends: {DRINKING}\nparticles:\n  water:\n    rest: {{container: wheelchair}}\n"
+def validate_at(tmp_path, capsys, text: str, token: str) -> tuple[int, str, str]:
+    """``validate`` on a spec of ``text``: its exit code, its stderr, and ``path:line:column`` of
+    the first ``token`` in the text (where the error must point)."""
     path = tmp_path / "spec.yaml"
     path.write_text(text, encoding="utf-8")
     rc = main(["validate", str(path)])
-    err = capsys.readouterr().err
-    line = text.count("\n", 0, text.index("wheelchair}")) + 1
-    column = text.index("wheelchair}") - text.rfind("\n", 0, text.index("wheelchair}"))
+    at = text.index(token)
+    return rc, capsys.readouterr().err, f"{display(path)}:{text.count(chr(10), 0, at) + 1}:{at - text.rfind(chr(10), 0, at)}"
+
+
+def test_rest_container_must_be_a_tool_with_a_container(tmp_path, capsys):
+    rc, err, where = validate_at(tmp_path, capsys, f"extends: {DRINKING}\nparticles:\n  water:\n    rest: {{container: wheelchair}}\n",
+                                 "wheelchair}")
     assert rc == 2
-    assert err.splitlines() == [f"{display(path)}:{line}:{column}: 'wheelchair' is not a tool with a container; tools with one: 'cup'"]
+    assert err.splitlines() == [f"{where}: 'wheelchair' is not a tool with a container; tools with one: 'cup'"]
 
 
 # -- Feeding with food resting in the spoon (a benchmark variant; not shipped, docs/physics.md) ----
@@ -281,14 +286,8 @@ def test_food_rides_in_the_spoon_on_the_way_and_is_simulated_near_the_person(fee
 
 
 def test_simulated_near_names_a_known_body(tmp_path, capsys):
-    text = (f"extends: {FOOD_RESTS}\nparticles:\n  food:\n    rest:\n      container: spoon\n"
-            "      simulated_near: {body: persn, distance_m: 0.1}\n")
-    path = tmp_path / "spec.yaml"
-    path.write_text(text, encoding="utf-8")
-    rc = main(["validate", str(path)])
-    err = capsys.readouterr().err
-    line = text.count("\n", 0, text.index("persn")) + 1
-    column = text.index("persn") - text.rfind("\n", 0, text.index("persn"))
+    rc, err, where = validate_at(tmp_path, capsys, f"extends: {FOOD_RESTS}\nparticles:\n  food:\n    rest:\n      container: spoon\n"
+                                 "      simulated_near: {body: persn, distance_m: 0.1}\n", "persn")
     assert rc == 2
-    assert err.splitlines()[0].startswith(f"{display(path)}:{line}:{column}: unknown body 'persn'; ")
+    assert err.splitlines()[0].startswith(f"{where}: unknown body 'persn'; ")
     assert "did you mean 'person'" in err
