@@ -86,7 +86,9 @@ class SurfacePoint(_Model):
     link: str = Field(description="URDF link it is on.")
     offset: Vec3 = Field(description="Position in the link frame, m.")
     normal: Vec3 = Field(description="Outward surface normal, link frame (unit).")
-    axis: Vec3 = Field(description="A direction along the surface, link frame (unit): a limb's axis away from its joint, else toward +z.")
+    axis: Vec3 = Field(
+        description="A direction along the surface, link frame (unit): a limb's axis away from its joint, else toward +z."
+    )
 
 
 class PersonVariant(_Model):
@@ -102,13 +104,17 @@ class PersonVariant(_Model):
     randomize: dict[str, tuple[float, float]] = Field(description="Per-reset uniform angle ranges, rad.")
     target_offsets: dict[str, Vec3] = Field(description="Offset of each person-attached target in its link, m.")
     surfaces: dict[str, list[Capsule]] = Field(
-        default_factory=dict, description="Per surface-drawn target: the limbs (capsules, link frame) a reset draws its point on."
+        default_factory=dict,
+        description="Per surface-drawn target: the limbs (capsules, link frame) a reset draws its point on.",
     )
     surface_points: dict[str, list[SurfacePoint]] = Field(
-        default_factory=dict, description="Per surface-drawn target not drawn on plain capsules (a sphere link such as the "
-        "head, or a region): the points a reset draws from, a link uniformly, then a point of it uniformly."
+        default_factory=dict,
+        description="Per surface-drawn target not drawn on plain capsules (a sphere link such as the "
+        "head, or a region): the points a reset draws from, a link uniformly, then a point of it uniformly.",
     )
-    markers: dict[str, list[MarkerPoint]] = Field(default_factory=dict, description="Per marker set: every marker of this body.")
+    markers: dict[str, list[MarkerPoint]] = Field(
+        default_factory=dict, description="Per marker set: every marker of this body."
+    )
     starts: list[StartState] = Field(description="Robot starts for this variant; reset() draws one.")
 
     @model_serializer(mode="wrap")
@@ -134,7 +140,9 @@ class Person(_Model):
     compliant_gain: float = Field(0.0, description="Gain of the compliant hold.")
     compliant_force: float = Field(0.0, description="Force of the compliant hold, N·m.")
     impairments: list[dict[str, Any]] = Field(description="Impairment choices (spec form, angles in rad).")
-    action_scale: float = Field(0.05, description="Policy-joint target change per unit human action per physics step, rad.")
+    action_scale: float = Field(
+        0.05, description="Policy-joint target change per unit human action per physics step, rad."
+    )
     arm_limits: str = Field(
         "analytic",
         description="Pose-dependent arm-limit model of the policy-controlled arm: 'none', 'analytic' (built in) or the path "
@@ -176,12 +184,25 @@ class Robot(_Model):
     action_scale: float = Field(description="Target change per unit action per physics step, rad.")
     position_gain: float = Field(description="Arm position gain.")
     max_force: float = Field(description="Arm force limit, N·m.")
-    gripper_joints: list[str] = Field(description="The acting hands' finger joints (welded at gripper_position: see welded_joints).")
+    gripper_joints: list[str] = Field(
+        description="The acting hands' finger joints (welded at gripper_position: see welded_joints)."
+    )
     gripper_position: list[float] = Field(description="The task's grip: each finger joint's value (rad or m).")
-    welded_joints: dict[str, float] = Field(default_factory=dict, description="Moving joints of the robot's URDF that the task never drives, made fixed in the artifact's robot.urdf at these values (rad or m): fingers at the grip, the rest at 0 (both within the joint's limits).")
-    placement: dict[str, Any] = Field(default_factory=dict, description="How the base was placed: mount, or the search's kept poses with goals reached and JLWKI.")
-    action_multipliers: list[float] | None = Field(None, description="Per arm joint, a factor on action_scale (None: 1 each).")
-    followers: dict[str, str] | None = Field(None, description="Joints moved with an arm joint (follower -> leader): the same target change every step, the leader's value at start.")
+    welded_joints: dict[str, float] = Field(
+        default_factory=dict,
+        description="Moving joints of the robot's URDF that the task never drives, made fixed in the artifact's robot.urdf at these values (rad or m): fingers at the grip, the rest at 0 (both within the joint's limits).",
+    )
+    placement: dict[str, Any] = Field(
+        default_factory=dict,
+        description="How the base was placed: mount, or the search's kept poses with goals reached and JLWKI.",
+    )
+    action_multipliers: list[float] | None = Field(
+        None, description="Per arm joint, a factor on action_scale (None: 1 each)."
+    )
+    followers: dict[str, str] | None = Field(
+        None,
+        description="Joints moved with an arm joint (follower -> leader): the same target change every step, the leader's value at start.",
+    )
     drive: Drive | None = Field(None, description="The mobile base's drive (None: a fixed base).")
 
     @model_serializer(mode="wrap")
@@ -215,7 +236,9 @@ class Target(_Model):
     link: str = Field(description="URDF link name.")
     offset: Vec3 = Field(description="Offset in the link frame, m (for the person: the first variant's).")
     show_rgba: tuple[float, float, float, float] | None = Field(None, description="Marker colour for renders.")
-    surface: bool = Field(False, description="Drawn on a limb surface at every reset (offsets per variant in PersonVariant.surfaces).")
+    surface: bool = Field(
+        False, description="Drawn on a limb surface at every reset (offsets per variant in PersonVariant.surfaces)."
+    )
 
 
 class ParticleSet(_Model):
@@ -234,10 +257,17 @@ class ParticleSet(_Model):
     lost_body: str | None = Field(description="Body a particle must stay near.")
     lost_link: str | None = Field(None, description="URDF link of that body (closest-points query).")
     lost_distance: float = Field(0.0, description="Distance beyond which it is lost, m.")
-    lost_anchor: Vec3 = Field((0.0, 0.0, 0.0), description="A point inside the lost body's collision geometry (lost link frame), m: a particle nearer than lost_distance to it is certainly not lost.")
+    lost_anchor: Vec3 = Field(
+        (0.0, 0.0, 0.0),
+        description="A point inside the lost body's collision geometry (lost link frame), m: a particle nearer than lost_distance to it is certainly not lost.",
+    )
     hit_body: str | None = Field(description="Body whose first contact with an active particle is a hit.")
-    outside_of: Container | None = Field(None, description="Particles inside this container are neither consumed nor lost.")
-    rest: ParticleRest | None = Field(None, description="Carry particles at rest in a container instead of simulating them (None: always simulated).")
+    outside_of: Container | None = Field(
+        None, description="Particles inside this container are neither consumed nor lost."
+    )
+    rest: ParticleRest | None = Field(
+        None, description="Carry particles at rest in a container instead of simulating them (None: always simulated)."
+    )
 
 
 class ParticleRest(_Model):
@@ -247,12 +277,20 @@ class ParticleRest(_Model):
 
     container: Container = Field(description="The container that carries them.")
     max_tilt: float = Field(description="Effective tilt above which particles are never carried, radians.")
-    max_turn: float = Field(description="Turn of the apparent up (container frame) since they came to rest above which they are simulated again, radians.")
-    max_speed: float = Field(description="Mean speed relative to the container below which simulated particles are still, m/s.")
+    max_turn: float = Field(
+        description="Turn of the apparent up (container frame) since they came to rest above which they are simulated again, radians."
+    )
+    max_speed: float = Field(
+        description="Mean speed relative to the container below which simulated particles are still, m/s."
+    )
     still_steps: int = Field(description="Env steps in a row they must be still before they are carried.")
-    carry_at_reset: bool = Field(True, description="Carry the settled start positions from the reset on (False: simulated until they rest).")
+    carry_at_reset: bool = Field(
+        True, description="Carry the settled start positions from the reset on (False: simulated until they rest)."
+    )
     near_body: str | None = Field(None, description="Body near which they are simulated even at rest (None: none).")
-    near_distance: float = Field(0.0, description="Gap between the container's link and near_body below which they are simulated, m.")
+    near_distance: float = Field(
+        0.0, description="Gap between the container's link and near_body below which they are simulated, m."
+    )
 
     @model_serializer(mode="wrap")
     def _without_unset_additions(self, handler):
@@ -310,7 +348,9 @@ class Garment(_Model):
     damping_stiffness: float = Field(description="springDampingStiffness (all directions), N·s/m.")
     bending_stiffness: float = Field(description="springBendingStiffness, N/m.")
     friction: float = Field(description="Friction coefficient.")
-    collides_with: list[str] | None = Field(None, description="Bodies ('person' = every variant) the cloth collides with; None: all and the floor.")
+    collides_with: list[str] | None = Field(
+        None, description="Bodies ('person' = every variant) the cloth collides with; None: all and the floor."
+    )
     rgba: tuple[float, float, float, float] = Field(description="Colour.")
 
 
@@ -331,7 +371,9 @@ class Success(_Model):
     term: str = Field(description="Reward term name.")
     aggregate: Literal["sum", "max", "min", "last"] = Field(description="Aggregation over the episode.")
     threshold: float = Field(description="Absolute threshold (a fraction when fraction_of is set).")
-    fraction_of: str | None = Field(None, description="A marker set: the threshold is this fraction of the active variant's markers.")
+    fraction_of: str | None = Field(
+        None, description="A marker set: the threshold is this fraction of the active variant's markers."
+    )
 
 
 class Camera(_Model):
@@ -343,8 +385,7 @@ class Camera(_Model):
 
 
 class Sim(_Model):
-    """World physics and timing.
-"""
+    """World physics and timing."""
 
     time_step: float = Field(description="Physics step, s.")
     frame_skip: int = Field(description="Physics steps per env step.")
@@ -363,11 +404,16 @@ class Manifest(_Model):
     task: str = Field(description="Task name.")
     title: str = Field(description="Task title.")
     robot_name: str = Field(description="Robot compiled for.")
-    gym_id: str = Field(description="Gymnasium id that makes this (task, robot): a shipped task's own "
-                                    "(assistive_compiler/FeedingJaco-v1), else assistive_compiler/Task-v1 (with spec= and robot=).")
+    gym_id: str = Field(
+        description="Gymnasium id that makes this (task, robot): a shipped task's own "
+        "(assistive_compiler/FeedingJaco-v1), else assistive_compiler/Task-v1 (with spec= and robot=)."
+    )
     input_hash: str = Field(description="sha256 of every input (spec files, parts, templates, compiler source).")
-    content_hash: str = Field("", description="sha256 of the output files (URDFs and the manifest minus this field and input_hash): "
-                                              "what was compiled, whichever compiler source compiled it.")
+    content_hash: str = Field(
+        "",
+        description="sha256 of the output files (URDFs and the manifest minus this field and input_hash): "
+        "what was compiled, whichever compiler source compiled it.",
+    )
     sources: list[str] = Field(description="Spec and part files this was compiled from.")
     sim: Sim
     bodies: list[Body]
@@ -381,8 +427,12 @@ class Manifest(_Model):
     observations: dict[str, list[TermUse]] = Field(description="Observation features per agent, in order.")
     reward: list[TermUse] = Field(description="Reward terms including preference costs.")
     success: Success
-    garments: list[Garment] = Field(default_factory=list, description="Soft-body garments (their presence makes the world a deformable one).")
-    scripted: dict[str, Any] | None = Field(None, description="Scripted baseline: point moved and waypoints (normalised).")
+    garments: list[Garment] = Field(
+        default_factory=list, description="Soft-body garments (their presence makes the world a deformable one)."
+    )
+    scripted: dict[str, Any] | None = Field(
+        None, description="Scripted baseline: point moved and waypoints (normalised)."
+    )
     camera: Camera = Field(default_factory=Camera, description="The task's camera for this robot (renders).")
 
     @property
@@ -424,24 +474,34 @@ class Manifest(_Model):
                 ET.parse(path)
             except ET.ParseError as exc:
                 return f"{path}: not complete URDF XML ({exc}); truncated or edited?"
-        if self.content_hash and self.content_hash not in (self.hash_of(artifact_dir), self.hash_of(artifact_dir, with_input_hash=True)):
+        if self.content_hash and self.content_hash not in (
+            self.hash_of(artifact_dir),
+            self.hash_of(artifact_dir, with_input_hash=True),
+        ):
             return f"{artifact_dir}: files differ from what was compiled (the manifest's content hash does not match)"
         return None
 
     @classmethod
-    def read(cls, artifact_dir: str | Path, verify: bool = False) -> "Manifest":
+    def read(cls, artifact_dir: str | Path, verify: bool = False) -> Manifest:
         """The manifest of the artifact at ``artifact_dir``; with ``verify``, a :class:`SpecError`
         naming what is damaged when its files are not as compiled (see :meth:`damage`)."""
         from .errors import SpecError
 
         path = Path(artifact_dir, "manifest.json")
         if not path.is_file():
-            raise SpecError.at(str(artifact_dir), "not a compiled artifact (no manifest.json); compile a spec into it first")
+            raise SpecError.at(
+                str(artifact_dir), "not a compiled artifact (no manifest.json); compile a spec into it first"
+            )
         try:
             manifest = cls.model_validate_json(path.read_text())
         except (ValueError, UnicodeDecodeError) as exc:
-            raise SpecError.at(str(path), f"not a readable manifest ({str(exc).splitlines()[0]}); recompile with 'compile --force'") from None
+            raise SpecError.at(
+                str(path), f"not a readable manifest ({str(exc).splitlines()[0]}); recompile with 'compile --force'"
+            ) from None
         problem = manifest.damage(artifact_dir) if verify else None
         if problem:
-            raise SpecError.at(str(artifact_dir), f"damaged artifact: {problem}; recompile it (assistive-compiler compile SPEC --out {artifact_dir} --force)")
+            raise SpecError.at(
+                str(artifact_dir),
+                f"damaged artifact: {problem}; recompile it (assistive-compiler compile SPEC --out {artifact_dir} --force)",
+            )
         return manifest

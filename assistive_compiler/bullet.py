@@ -24,7 +24,9 @@ import pybullet as pb
 BULLET_DEFAULT_CONTACT_BREAKING_THRESHOLD_M = 0.02
 
 
-def connect(contact_breaking_threshold: float = BULLET_DEFAULT_CONTACT_BREAKING_THRESHOLD_M, deformable: bool = False) -> int:
+def connect(
+    contact_breaking_threshold: float = BULLET_DEFAULT_CONTACT_BREAKING_THRESHOLD_M, deformable: bool = False
+) -> int:
     """A new DIRECT client using ``contact_breaking_threshold`` (m); ``deformable``: Bullet's
     deformable world (soft bodies), which must be chosen before anything is loaded. Returns a
     negative id when pybullet cannot connect."""

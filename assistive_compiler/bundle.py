@@ -15,7 +15,7 @@ import hashlib
 import os
 import shutil
 import tempfile
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 from . import __version__
@@ -25,7 +25,7 @@ PACKAGE_DIR = Path(__file__).resolve().parent
 FORMAT = 1
 
 
-@lru_cache(maxsize=None)
+@cache
 def source_hash() -> str:
     """sha256 of the installed package's Python source (paths relative to the package, so two
     machines with the same code agree wherever it is installed)."""
@@ -43,8 +43,15 @@ def pack(artifact_dir: str | Path) -> dict:
     root = Path(artifact_dir)
     manifest = Manifest.read(root, verify=True)
     files = {p.relative_to(root).as_posix(): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
-    return {"format": FORMAT, "content_hash": manifest.content_hash, "task": manifest.task, "robot": manifest.robot_name,
-            "version": __version__, "source_hash": source_hash(), "files": files}
+    return {
+        "format": FORMAT,
+        "content_hash": manifest.content_hash,
+        "task": manifest.task,
+        "robot": manifest.robot_name,
+        "version": __version__,
+        "source_hash": source_hash(),
+        "files": files,
+    }
 
 
 def check_same_package(bundle: dict) -> None:
@@ -54,7 +61,8 @@ def check_same_package(bundle: dict) -> None:
         raise UsageError(
             f"this worker's assistive-compiler {ours[0]} (source {ours[1][:12]}) differs from the driver's {theirs[0]} "
             f"(source {theirs[1][:12]}): the compiled task {bundle['content_hash'][:12]} ({bundle['task']}, {bundle['robot']}) "
-            "could run differently here; install the same assistive-compiler on every machine of the cluster")
+            "could run differently here; install the same assistive-compiler on every machine of the cluster"
+        )
 
 
 def unpack(bundle: dict, cache: str | Path | None = None) -> Path:
@@ -64,7 +72,9 @@ def unpack(bundle: dict, cache: str | Path | None = None) -> Path:
     from .registration import cache_dir
 
     if bundle.get("format") != FORMAT:
-        raise UsageError(f"a compiled-task bundle of format {bundle.get('format')} (this assistive-compiler reads format {FORMAT})")
+        raise UsageError(
+            f"a compiled-task bundle of format {bundle.get('format')} (this assistive-compiler reads format {FORMAT})"
+        )
     check_same_package(bundle)
     root = Path(cache) if cache is not None else cache_dir()
     target = root / "jobs" / bundle["content_hash"]
@@ -81,8 +91,10 @@ def unpack(bundle: dict, cache: str | Path | None = None) -> Path:
             path.write_bytes(data)
         manifest = Manifest.read(tmp, verify=True)
         if manifest.content_hash != bundle["content_hash"]:
-            raise UsageError(f"a compiled-task bundle says content hash {bundle['content_hash'][:12]} but holds "
-                             f"{manifest.content_hash[:12]}")
+            raise UsageError(
+                f"a compiled-task bundle says content hash {bundle['content_hash'][:12]} but holds "
+                f"{manifest.content_hash[:12]}"
+            )
         if target.is_dir():  # a damaged earlier copy: replace it
             shutil.rmtree(target, ignore_errors=True)
         try:

@@ -48,25 +48,59 @@ def describe_scene(env) -> dict:
             for link in body["links"]:
                 k = reader.links.index([body["name"], link])
                 rot = rotation_matrix(quat[k])
-                entry["links"].append({"name": link, "position_m": _rounded(pos[k]),
-                                       "axes": {AXES[a]: axis_direction(rot[:, a]) for a in range(3)}})
+                entry["links"].append(
+                    {
+                        "name": link,
+                        "position_m": _rounded(pos[k]),
+                        "axes": {AXES[a]: axis_direction(rot[:, a]) for a in range(3)},
+                    }
+                )
         bodies.append(entry)
     person_base = next(b for b in reader.bodies if b["name"] == active.body)["links"][0]  # base link first
     person_rot = rotation_matrix(quat[reader.links.index([active.body, person_base])])  # the person faces its base's -y
     targets = reader.target_positions(pos, quat)
     out = {
-        "task": m.task, "robot": m.robot_name, "gym_id": m.gym_id,
-        "person": {"variant": active.name, "body": active.body, "faces": axis_direction(-person_rot[:, 1]), "base_link": person_base},
+        "task": m.task,
+        "robot": m.robot_name,
+        "gym_id": m.gym_id,
+        "person": {
+            "variant": active.name,
+            "body": active.body,
+            "faces": axis_direction(-person_rot[:, 1]),
+            "base_link": person_base,
+        },
         "robot_links": {role: link for role, link in sorted(m.robot.links.items())},
-        "tools": [{"body": t.body, "held_by": f"robot.{t.parent_link}", "links": dict(sorted(t.links.items()))} for t in m.tools],
-        "targets": [{"name": name, "position_m": _rounded(targets[k]),
-                     "on": f"{m.targets[name].body}.{m.targets[name].link}", "drawn_on_surface": m.targets[name].surface}
-                    for k, name in enumerate(reader.targets)],
-        "markers": [{"name": s.name, "count": env.markers.count(s.name),
-                     "centroid_m": _rounded(np.mean(env.markers.positions(s.name), axis=0)) if env.markers.count(s.name) else None}
-                    for s in m.markers],
-        "particles": [{"name": p.name, "count": p.count, "centroid_m": _rounded(np.mean(env.particles.shown_positions(p.name), axis=0))}
-                      for p in m.particles],
+        "tools": [
+            {"body": t.body, "held_by": f"robot.{t.parent_link}", "links": dict(sorted(t.links.items()))}
+            for t in m.tools
+        ],
+        "targets": [
+            {
+                "name": name,
+                "position_m": _rounded(targets[k]),
+                "on": f"{m.targets[name].body}.{m.targets[name].link}",
+                "drawn_on_surface": m.targets[name].surface,
+            }
+            for k, name in enumerate(reader.targets)
+        ],
+        "markers": [
+            {
+                "name": s.name,
+                "count": env.markers.count(s.name),
+                "centroid_m": _rounded(np.mean(env.markers.positions(s.name), axis=0))
+                if env.markers.count(s.name)
+                else None,
+            }
+            for s in m.markers
+        ],
+        "particles": [
+            {
+                "name": p.name,
+                "count": p.count,
+                "centroid_m": _rounded(np.mean(env.particles.shown_positions(p.name), axis=0)),
+            }
+            for p in m.particles
+        ],
         "bodies": bodies,
     }
     return out
@@ -75,16 +109,24 @@ def describe_scene(env) -> dict:
 def describe_text(d: dict) -> str:
     """:func:`describe_scene`'s dict as the lines ``describe`` prints."""
     p = d["person"]
-    lines = [f"{d['task']} for {d['robot']}: person {p['variant']} (body {p['body']}), facing {p['faces']}. "
-             "World frame, metres, z up; each link's frame axes given as the world direction they point in."]
-    lines.append("robot links by role: " + ", ".join(f"{role} = robot.{link}" for role, link in d["robot_links"].items()))
+    lines = [
+        f"{d['task']} for {d['robot']}: person {p['variant']} (body {p['body']}), facing {p['faces']}. "
+        "World frame, metres, z up; each link's frame axes given as the world direction they point in."
+    ]
+    lines.append(
+        "robot links by role: " + ", ".join(f"{role} = robot.{link}" for role, link in d["robot_links"].items())
+    )
     for t in d["tools"]:
-        lines.append(f"tool {t['body']}: held by {t['held_by']}; links " + ", ".join(f"{k} = {v}" for k, v in t["links"].items()))
+        lines.append(
+            f"tool {t['body']}: held by {t['held_by']}; links " + ", ".join(f"{k} = {v}" for k, v in t["links"].items())
+        )
     for t in d["targets"]:
         where = "drawn on the surface of " if t["drawn_on_surface"] else "on "
         lines.append(f"target {t['name']}: {_xyz(t['position_m'])} ({where}{t['on']})")
     for s in d["markers"]:
-        lines.append(f"markers {s['name']}: {s['count']}" + (f", centroid {_xyz(s['centroid_m'])}" if s["centroid_m"] else ""))
+        lines.append(
+            f"markers {s['name']}: {s['count']}" + (f", centroid {_xyz(s['centroid_m'])}" if s["centroid_m"] else "")
+        )
     for s in d["particles"]:
         lines.append(f"particles {s['name']}: {s['count']}, centroid {_xyz(s['centroid_m'])}")
     for b in d["bodies"]:
@@ -94,15 +136,23 @@ def describe_text(d: dict) -> str:
         if not b["shown"]:
             lines.append(f"\n{b['name']} ({b['kind']}): parked, not this episode's person")
             continue
-        merged = ("; the person's other links are static in this task and merged into these "
-                  "(all 43 and their frames: docs/person.md)") if b["kind"] == "person" and len(b["links"]) < 43 else ""
+        merged = (
+            (
+                "; the person's other links are static in this task and merged into these "
+                "(all 43 and their frames: docs/person.md)"
+            )
+            if b["kind"] == "person" and len(b["links"]) < 43
+            else ""
+        )
         lines.append(f"\n{b['name']} ({b['kind']}, {len(b['links'])} links{merged})")
         width = max(len(link["name"]) for link in b["links"])
         wide = max(len(v) for link in b["links"] for v in link["axes"].values()) + 1
         lines.append(f"  {'link':<{width}}  {'position (m)':<26}  {'+x':<{wide}} {'+y':<{wide}} +z")
         for link in b["links"]:
             a = link["axes"]
-            lines.append(f"  {link['name']:<{width}}  {_xyz(link['position_m']):<26}  {a['x']:<{wide}} {a['y']:<{wide}} {a['z']}")
+            lines.append(
+                f"  {link['name']:<{width}}  {_xyz(link['position_m']):<26}  {a['x']:<{wide}} {a['y']:<{wide}} {a['z']}"
+            )
     return "\n".join(lines)
 
 

@@ -8,9 +8,9 @@ prints its problems one per line and exits 2. Anything else escaping those stage
 from __future__ import annotations
 
 import difflib
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterable, Sequence
 
 
 @dataclass(frozen=True, order=True)
@@ -44,7 +44,7 @@ class SpecError(Exception):
         super().__init__("\n".join(str(p) for p in self.problems))
 
     @classmethod
-    def at(cls, path: str | Path, message: str, line: int = 1, column: int = 1) -> "SpecError":
+    def at(cls, path: str | Path, message: str, line: int = 1, column: int = 1) -> SpecError:
         return cls([Problem(Location(str(path), line, column), message)])
 
     def __reduce__(self):

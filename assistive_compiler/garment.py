@@ -107,8 +107,11 @@ def write_obj(path: str | Path, vertices: np.ndarray, faces: np.ndarray, *, name
 def read_obj_faces(path: str | Path) -> np.ndarray:
     """(M, 3) 0-based vertex indices of an OBJ's triangles (``f`` lines as :func:`write_obj` writes
     them; ``v/vt/vn`` forms keep their vertex index)."""
-    faces = [[int(tok.split("/")[0]) - 1 for tok in line.split()[1:4]]
-             for line in Path(path).read_text().splitlines() if line.startswith("f ")]
+    faces = [
+        [int(tok.split("/")[0]) - 1 for tok in line.split()[1:4]]
+        for line in Path(path).read_text().splitlines()
+        if line.startswith("f ")
+    ]
     return np.asarray(faces, dtype=np.int64).reshape(-1, 3)
 
 
@@ -122,7 +125,9 @@ def opening_ring_indices(segments: int) -> np.ndarray:
     return ring_indices(0, segments)
 
 
-def gripped_ring_indices(segments: int, ring: int = 0, arc_deg: float | None = None, centre_deg: float = 90.0) -> np.ndarray:
+def gripped_ring_indices(
+    segments: int, ring: int = 0, arc_deg: float | None = None, centre_deg: float = 90.0
+) -> np.ndarray:
     """Indices of the nodes a gripper holds.
 
     ``arc_deg=None`` → the whole ring ``ring`` (the gripper holds the opening like a hoop, which
@@ -239,21 +244,40 @@ def sleeve_progress(
     return -to_hand
 
 
-def load_garment(pb, c: int, obj: str | Path, held_pos, held_orn, mass, margin, ks, kd, kb, friction, anchored, rgba=None) -> tuple[int, int]:
+def load_garment(
+    pb, c: int, obj: str | Path, held_pos, held_orn, mass, margin, ks, kd, kb, friction, anchored, rgba=None
+) -> tuple[int, int]:
     """Load a garment OBJ (vertices in the held frame) as a mass-spring soft body with its held
     frame at (held_pos, held_orn), world frame, and pin the ``anchored`` nodes to a massless,
     collision-free body placed at that frame (teleport that body to move them). The world must
     be a deformable one (``resetSimulation(RESET_USE_DEFORMABLE_WORLD)`` before anything was
     loaded). Returns (soft body id, anchor body id). Shared by the compiler (settling) and the runtime."""
-    sb = pb.loadSoftBody(str(obj), basePosition=list(held_pos), baseOrientation=list(held_orn), scale=1.0, mass=mass,
-                         collisionMargin=margin, useMassSpring=1, useBendingSprings=1, useNeoHookean=0,
-                         springElasticStiffness=ks, springDampingStiffness=kd, springDampingAllDirections=1,
-                         springBendingStiffness=kb, useSelfCollision=0, frictionCoeff=friction, useFaceContact=1, physicsClientId=c)
+    sb = pb.loadSoftBody(
+        str(obj),
+        basePosition=list(held_pos),
+        baseOrientation=list(held_orn),
+        scale=1.0,
+        mass=mass,
+        collisionMargin=margin,
+        useMassSpring=1,
+        useBendingSprings=1,
+        useNeoHookean=0,
+        springElasticStiffness=ks,
+        springDampingStiffness=kd,
+        springDampingAllDirections=1,
+        springBendingStiffness=kb,
+        useSelfCollision=0,
+        frictionCoeff=friction,
+        useFaceContact=1,
+        physicsClientId=c,
+    )
     if rgba is not None:
         pb.changeVisualShape(sb, -1, rgbaColor=list(rgba), flags=pb.VISUAL_SHAPE_DOUBLE_SIDED, physicsClientId=c)
     # Asleep, a soft body reports no contacts: keep it awake.
     pb.changeDynamics(sb, -1, activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING, physicsClientId=c)
-    anchor = pb.createMultiBody(baseMass=0, basePosition=list(held_pos), baseOrientation=list(held_orn), physicsClientId=c)
+    anchor = pb.createMultiBody(
+        baseMass=0, basePosition=list(held_pos), baseOrientation=list(held_orn), physicsClientId=c
+    )
     # The anchor's local point is taken from the node's position at this moment (the node lies at
     # held pose × its OBJ vertex), so the pinned nodes keep their place in the held frame.
     nodes = pb.getMeshData(sb, -1, flags=pb.MESH_DATA_SIMULATION_MESH, physicsClientId=c)[1]

@@ -9,7 +9,9 @@ FROZEN_DAMPING = 1e6  # IK damping of joints IK must not move
 DRIVE_DAMPING = PYBULLET_DAMPING  # IK damping of a drive's planar joints that the scripted policy drives
 
 
-def ik_damping(movable: list[int], frozen: list[int], driven: list[int] = (), own: dict[int, float] | None = None) -> list[float] | None:
+def ik_damping(
+    movable: list[int], frozen: list[int], driven: list[int] = (), own: dict[int, float] | None = None
+) -> list[float] | None:
     """Per movable joint, pybullet's IK damping: huge for ``frozen`` joints (a mobile base's drive,
     which reaching must not move), ``own``'s value for the joints a script damps itself (joint
     index → damping, e.g. a slow shoulder), DRIVE_DAMPING for ``driven`` ones (a drive IK may
@@ -17,8 +19,10 @@ def ik_damping(movable: list[int], frozen: list[int], driven: list[int] = (), ow
     own = own or {}
     if not frozen and not driven and not own:
         return None
-    return [FROZEN_DAMPING if j in frozen else own[j] if j in own else DRIVE_DAMPING if j in driven else PYBULLET_DAMPING
-            for j in movable]
+    return [
+        FROZEN_DAMPING if j in frozen else own[j] if j in own else DRIVE_DAMPING if j in driven else PYBULLET_DAMPING
+        for j in movable
+    ]
 
 
 def ik_limits(chain, rest) -> dict:

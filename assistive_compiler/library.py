@@ -23,18 +23,19 @@ from __future__ import annotations
 
 import os
 import xml.etree.ElementTree as ET
+from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Generic, Iterable, TypeVar
+from typing import Generic, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
-from .templates import expand_template
 from .errors import Problem, SpecError
 from .paths import display, specs_dir, templates_dir
 from .spec.parts import FurniturePart, PersonPart, RobotPart, ToolPart
 from .spec.validation import problems_from_validation
+from .templates import expand_template
 from .urdf import UrdfInfo, urdf_info
 from .yamlsrc import load_located
 
@@ -95,8 +96,11 @@ class Library:
             folder = root / kind
             shown.append(f"{display(folder)}/" + ("" if folder.is_dir() else " (no such folder)"))
             if not folder.is_dir():
-                hints += [f"{display(below.parent)}/ holds {kind}/: use it as the library" for below in sorted(root.glob(f"*/{kind}"))
-                          if any(below.glob("*.yaml"))]
+                hints += [
+                    f"{display(below.parent)}/ holds {kind}/: use it as the library"
+                    for below in sorted(root.glob(f"*/{kind}"))
+                    if any(below.glob("*.yaml"))
+                ]
         return f" (looked in {', '.join(shown)}{''.join('; ' + h for h in hints)})"
 
     def path_of(self, kind: str, name: str) -> Path | None:
@@ -104,8 +108,11 @@ class Library:
         found = [root / kind / f"{name}.yaml" for root in self.roots if (root / kind / f"{name}.yaml").is_file()]
         if len(found) > 1:
             others = " and ".join(display(p) for p in found[1:])
-            raise SpecError.at(display(found[0]), f"{kind[:-1] if kind != 'people' else 'person'} '{name}' is defined in more than "
-                               f"one library: {display(found[0])} and {others}; part names must be unique, rename one")
+            raise SpecError.at(
+                display(found[0]),
+                f"{kind[:-1] if kind != 'people' else 'person'} '{name}' is defined in more than "
+                f"one library: {display(found[0])} and {others}; part names must be unique, rename one",
+            )
         return found[0] if found else None
 
     def get(self, kind: str, name: str) -> LoadedPart:
@@ -122,7 +129,9 @@ class Library:
             except ValidationError as exc:
                 raise SpecError(problems_from_validation(exc, data, smap, model)) from None
             if getattr(part, "name", name) != name:
-                raise SpecError([Problem(smap.value(("name",)), f"part name '{part.name}' must match its file name '{name}'")])
+                raise SpecError(
+                    [Problem(smap.value(("name",)), f"part name '{part.name}' must match its file name '{name}'")]
+                )
             loaded = LoadedPart(part, path, smap)
             self._check_semantics(kind, loaded)
             self._cache[key] = loaded
@@ -132,7 +141,9 @@ class Library:
         """The person template rendered with variant ``name``'s measurements (URDF XML); raises like
         :meth:`get` for an unknown or broken variant."""
         if name not in self._person_urdfs:  # resolving for every supported robot asks again for the same variant
-            self._person_urdfs[name] = expand_template(PERSON_TEMPLATE_RELPATH, self.get("people", name).part.measurements().xacro_args())
+            self._person_urdfs[name] = expand_template(
+                PERSON_TEMPLATE_RELPATH, self.get("people", name).part.measurements().xacro_args()
+            )
         return self._person_urdfs[name]
 
     def default_urdf(self, kind: str, name: str) -> UrdfInfo:
@@ -153,7 +164,7 @@ class Library:
         ref = loaded.part.urdf
         prefix = "python-package:"
         if ref.startswith(prefix):
-            package, _, rel = ref[len(prefix):].partition("/")
+            package, _, rel = ref[len(prefix) :].partition("/")
             import importlib.util
 
             spec = importlib.util.find_spec(package)
@@ -169,30 +180,59 @@ class Library:
         try:
             info = urdf_info(path.read_bytes().decode("utf-8"))
         except UnicodeDecodeError as exc:
-            raise SpecError([Problem(where, f"{display(path)} is not a URDF: not UTF-8 text ({exc.reason} at byte {exc.start})")]) from None
+            raise SpecError(
+                [Problem(where, f"{display(path)} is not a URDF: not UTF-8 text ({exc.reason} at byte {exc.start})")]
+            ) from None
         except ET.ParseError as exc:
             line, col = exc.position
-            raise SpecError([Problem(where, f"{display(path)} is not a URDF: XML error at line {line}, column {col + 1}: "
-                                            f"{str(exc).split(':')[0]}")]) from None
+            raise SpecError(
+                [
+                    Problem(
+                        where,
+                        f"{display(path)} is not a URDF: XML error at line {line}, column {col + 1}: "
+                        f"{str(exc).split(':')[0]}",
+                    )
+                ]
+            ) from None
         except (AttributeError, ValueError) as exc:
             raise SpecError([Problem(where, f"{display(path)} is not a valid URDF: {exc}")]) from None
         if info.root_tag != "robot":
-            raise SpecError([Problem(where, f"{display(path)} is not a URDF: its root element is <{info.root_tag}>, expected <robot>")])
+            raise SpecError(
+                [
+                    Problem(
+                        where, f"{display(path)} is not a URDF: its root element is <{info.root_tag}>, expected <robot>"
+                    )
+                ]
+            )
         return info
 
     def template_path(self, loaded: LoadedPart) -> Path:
         """The part's template: absolute as written, else under the ``templates/`` beside the part's
         library (``<root>/../templates``), else under the shipped templates."""
         rel = Path(loaded.part.template.path)
-        searched = [rel] if rel.is_absolute() else [
-            *(root.parent / "templates" / rel for root in self.roots if loaded.path.is_relative_to(root) and root != specs_dir()),
-            templates_dir() / rel,
-        ]
+        searched = (
+            [rel]
+            if rel.is_absolute()
+            else [
+                *(
+                    root.parent / "templates" / rel
+                    for root in self.roots
+                    if loaded.path.is_relative_to(root) and root != specs_dir()
+                ),
+                templates_dir() / rel,
+            ]
+        )
         for candidate in searched:
             if candidate.is_file():
                 return candidate
-        raise SpecError([Problem(loaded.smap.value(("template", "path")),
-                                 f"template '{rel}' not found (looked in {', '.join(display(c.parent) + '/' for c in searched)})")])
+        raise SpecError(
+            [
+                Problem(
+                    loaded.smap.value(("template", "path")),
+                    f"template '{rel}' not found (looked in {', '.join(display(c.parent) + '/' for c in searched)})",
+                )
+            ]
+        )
 
     def _check_semantics(self, kind: str, loaded: LoadedPart) -> None:
         """Every URDF name a part declares must exist in the URDF it renders."""
@@ -212,11 +252,18 @@ class Library:
             from .errors import did_you_mean
 
             if value is not None and value not in pool:
-                problems.append(Problem(smap.value(at), f"{what} '{value}' is not in the URDF{did_you_mean(value, pool)}"))
+                problems.append(
+                    Problem(smap.value(at), f"{what} '{value}' is not in the URDF{did_you_mean(value, pool)}")
+                )
 
         need(part.base_link, links, "link", ("base_link",))
         if info.root_link and part.base_link in links and part.base_link != info.root_link:
-            problems.append(Problem(smap.value(("base_link",)), f"base_link '{part.base_link}' is not the URDF root link '{info.root_link}'"))
+            problems.append(
+                Problem(
+                    smap.value(("base_link",)),
+                    f"base_link '{part.base_link}' is not the URDF root link '{info.root_link}'",
+                )
+            )
         for sem, link in getattr(part, "links", {}).items():
             need(link, links, "link", ("links", sem))
         for attr in ("seat_link", "mount_link"):
@@ -237,17 +284,25 @@ class Library:
                 for i, j in enumerate(grip.joints):
                     need(j, joints, "joint", ("gripper", side, "joints", i))
         if isinstance(part, ToolPart) and part.reference_link not in part.links:
-            problems.append(Problem(smap.value(("reference_link",)), f"reference_link '{part.reference_link}' is not one of links {sorted(part.links)}"))
+            problems.append(
+                Problem(
+                    smap.value(("reference_link",)),
+                    f"reference_link '{part.reference_link}' is not one of links {sorted(part.links)}",
+                )
+            )
         if problems:
             raise SpecError(problems)
 
     @classmethod
-    def for_spec(cls, spec_path: str | Path | None = None, dirs: Iterable[str | Path] = ()) -> "Library":
+    def for_spec(cls, spec_path: str | Path | None = None, dirs: Iterable[str | Path] = ()) -> Library:
         """The library a spec sees: ``dirs``, ``$ASSISTIVE_COMPILER_LIBRARY``, the spec's own
         library root, the shipped parts (see the module docstring)."""
         missing = [d for d in dirs if not Path(d).is_dir()]
         if missing:
-            raise SpecError.at(str(missing[0]), "library directory not found (expected a folder holding robots/, tools/, furniture/ or people/)")
+            raise SpecError.at(
+                str(missing[0]),
+                "library directory not found (expected a folder holding robots/, tools/, furniture/ or people/)",
+            )
         roots = [Path(d) for d in dirs] + env_library_dirs()
         own = spec_library_root(spec_path) if spec_path is not None else None
         return cls([*roots, *([own] if own else []), specs_dir()])

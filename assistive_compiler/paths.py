@@ -3,13 +3,13 @@ installed package (the wheel carries ``specs/`` and ``templates/`` as package da
 
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 _PACKAGE = Path(__file__).resolve().parent
 
 
-@lru_cache(maxsize=None)
+@cache
 def data_root() -> Path:
     """The directory holding ``specs/`` and ``templates/``."""
     for candidate in (_PACKAGE.parent, _PACKAGE / "_data"):

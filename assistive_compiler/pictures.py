@@ -44,7 +44,10 @@ PICTURE_SUFFIXES = (".gif", ".mp4", ".png")
 def check_picture_path(out: Path) -> None:
     """Refuse an output ``render`` cannot write before anything is simulated."""
     if out.suffix.lower() not in PICTURE_SUFFIXES:
-        raise SpecError.at(str(out), f"--out must end in {', '.join(PICTURE_SUFFIXES)} (a GIF or MP4 of the episode, a PNG strip), got '{out.suffix or out.name}'")
+        raise SpecError.at(
+            str(out),
+            f"--out must end in {', '.join(PICTURE_SUFFIXES)} (a GIF or MP4 of the episode, a PNG strip), got '{out.suffix or out.name}'",
+        )
     if out.is_dir():
         raise SpecError.at(str(out), "--out is a directory; expected a file name ending in .gif, .mp4 or .png")
     parent = out.parent if str(out.parent) else Path(".")
@@ -52,8 +55,11 @@ def check_picture_path(out: Path) -> None:
     if not existing.is_dir() or not os.access(existing, os.W_OK):
         raise SpecError.at(str(out), f"cannot write here: {existing} is not a writable folder")
     if out.suffix.lower() == ".mp4" and importlib.util.find_spec("av") is None:
-        raise SpecError.at(str(out), "MP4 output needs the optional 'av' package (PyAV, which carries its own FFmpeg): "
-                                     "pip install 'assistive-compiler[video]'; or write a .gif")
+        raise SpecError.at(
+            str(out),
+            "MP4 output needs the optional 'av' package (PyAV, which carries its own FFmpeg): "
+            "pip install 'assistive-compiler[video]'; or write a .gif",
+        )
 
 
 def write_picture(frames: list[np.ndarray], out: Path, fps: float) -> None:
@@ -66,7 +72,9 @@ def write_picture(frames: list[np.ndarray], out: Path, fps: float) -> None:
     if suffix == ".gif":
         images = [Image.fromarray(f) for f in frames]
         # GIF frame delays are whole hundredths of a second.
-        images[0].save(out, save_all=True, append_images=images[1:], duration=10 * max(1, round(100 / fps)), loop=0, optimize=False)
+        images[0].save(
+            out, save_all=True, append_images=images[1:], duration=10 * max(1, round(100 / fps)), loop=0, optimize=False
+        )
     elif suffix == ".mp4":
         write_mp4(frames, out, fps)
     else:
@@ -84,7 +92,9 @@ def write_mp4(frames: list[np.ndarray], out: Path, fps: float) -> None:
         stream = container.add_stream("libx264", rate=Fraction(fps).limit_denominator(1000))
         stream.width, stream.height, stream.pix_fmt = width, height, "yuv420p"
         for frame in frames:
-            for packet in stream.encode(av.VideoFrame.from_ndarray(np.ascontiguousarray(frame[:height, :width]), format="rgb24")):
+            for packet in stream.encode(
+                av.VideoFrame.from_ndarray(np.ascontiguousarray(frame[:height, :width]), format="rgb24")
+            ):
                 container.mux(packet)
         for packet in stream.encode():
             container.mux(packet)

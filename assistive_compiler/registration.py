@@ -23,7 +23,10 @@ TASK_ID = f"{NAMESPACE}/Task-v1"
 
 
 def cache_dir() -> Path:
-    root = os.environ.get("ASSISTIVE_COMPILER_CACHE") or Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "assistive-compiler"
+    root = (
+        os.environ.get("ASSISTIVE_COMPILER_CACHE")
+        or Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "assistive-compiler"
+    )
     return Path(root)
 
 
@@ -49,7 +52,9 @@ def shipped_tasks() -> list[ShippedTask]:
         ids = []
         for robot in robots:
             robot_file = robots_dir / f"{robot}.yaml"
-            robot_title = (yaml.safe_load(robot_file.read_text()) or {}).get("title", robot) if robot_file.is_file() else robot
+            robot_title = (
+                (yaml.safe_load(robot_file.read_text()) or {}).get("title", robot) if robot_file.is_file() else robot
+            )
             ids.append(f"{NAMESPACE}/{title.replace(' ', '')}{robot_title}-v1")
         out.append(ShippedTask(str(data.get("name", spec.stem)), title, spec, robots, ids))
     return out
@@ -98,8 +103,12 @@ def register_all() -> list[str]:
     ids = []
     for env_id, (spec, robot) in shipped_ids().items():
         if env_id not in gymnasium.registry:
-            gymnasium.register(id=env_id, entry_point="assistive_compiler.registration:make_env",
-                               kwargs={"spec": str(spec), "robot": robot}, disable_env_checker=True)
+            gymnasium.register(
+                id=env_id,
+                entry_point="assistive_compiler.registration:make_env",
+                kwargs={"spec": str(spec), "robot": robot},
+                disable_env_checker=True,
+            )
         ids.append(env_id)
     if TASK_ID not in gymnasium.registry:  # any other spec: gym.make(TASK_ID, spec=..., robot=...)
         gymnasium.register(id=TASK_ID, entry_point="assistive_compiler.registration:make_env", disable_env_checker=True)

@@ -62,7 +62,7 @@ class UrdfInfo:
     @property
     def surface_links(self) -> tuple[str, ...]:
         """Links with a collision capsule or sphere (what markers and surface targets may cover)."""
-        return tuple(l for l in self.links if l in self.capsules or l in self.spheres)
+        return tuple(link for link in self.links if link in self.capsules or link in self.spheres)
 
     @property
     def movable_joints(self) -> dict[str, JointInfo]:
@@ -88,9 +88,15 @@ def urdf_info(urdf_xml: str) -> UrdfInfo:
         child = el.find("child").get("link", "")  # type: ignore[union-attr]
         children.add(child)
         joints[el.get("name", "")] = JointInfo(
-            el.get("name", ""), jtype, el.find("parent").get("link", ""), child, lower, upper, axis  # type: ignore[union-attr]
+            el.get("name", ""),
+            jtype,
+            el.find("parent").get("link", ""),
+            child,
+            lower,
+            upper,
+            axis,  # type: ignore[union-attr]
         )
-    roots = [l for l in links if l not in children]
+    roots = [link for link in links if link not in children]
     capsules = _capsules(root)
     return UrdfInfo(roots[0] if roots else "", links, joints, capsules, root.tag, _spheres(root, capsules))
 
@@ -108,7 +114,11 @@ def _spheres(root: ET.Element, capsules: dict[str, Capsule]) -> dict[str, tuple[
             origin = col.find("origin")
             centre = tuple(float(v) for v in (origin.get("xyz", "0 0 0") if origin is not None else "0 0 0").split())
             radius = float(sphere.get("radius", "0"))
-            if cap is not None and abs(radius - cap.radius) < 1e-9 and min(math.dist(centre, cap.start), math.dist(centre, cap.end)) < 1e-6:
+            if (
+                cap is not None
+                and abs(radius - cap.radius) < 1e-9
+                and min(math.dist(centre, cap.start), math.dist(centre, cap.end)) < 1e-6
+            ):
                 continue
             found.append(Sphere(centre, radius))  # type: ignore[arg-type]
         if found:

@@ -38,8 +38,9 @@ MAX_DEPTH = 48
 MAX_VALUES = 200_000
 """At most this many values are built from one file, aliases expanded."""
 
-BOOLEAN_WORDS = frozenset(w for word in ("y", "yes", "n", "no", "on", "off", "true", "false")
-                          for w in (word, word.capitalize(), word.upper()))
+BOOLEAN_WORDS = frozenset(
+    w for word in ("y", "yes", "n", "no", "on", "off", "true", "false") for w in (word, word.capitalize(), word.upper())
+)
 """Words YAML 1.1 (PyYAML) reads as booleans; never a spec key."""
 BOOLEAN_KEY_HINTS = {"on": "onto"}
 
@@ -91,10 +92,24 @@ class _Builder:
         self.smap.values[at] = _loc(self.path, node)
         self.count += 1
         if self.count > MAX_VALUES:
-            raise SpecError([Problem(_loc(self.path, node), f"more than {MAX_VALUES} values once anchors and aliases are expanded; "
-                                                           "a spec is far smaller (aliases that expand exponentially?)")])
-        if node.tag.startswith("!") or (node.tag.startswith("tag:yaml.org,2002:") and node.tag.rsplit(":", 1)[1] not in SAFE_TAGS):
-            self.problems.append(Problem(_loc(self.path, node), f"YAML tag '{node.tag}' is not allowed; a spec holds plain mappings, lists and scalars"))
+            raise SpecError(
+                [
+                    Problem(
+                        _loc(self.path, node),
+                        f"more than {MAX_VALUES} values once anchors and aliases are expanded; "
+                        "a spec is far smaller (aliases that expand exponentially?)",
+                    )
+                ]
+            )
+        if node.tag.startswith("!") or (
+            node.tag.startswith("tag:yaml.org,2002:") and node.tag.rsplit(":", 1)[1] not in SAFE_TAGS
+        ):
+            self.problems.append(
+                Problem(
+                    _loc(self.path, node),
+                    f"YAML tag '{node.tag}' is not allowed; a spec holds plain mappings, lists and scalars",
+                )
+            )
             return None
         if id(node) in self._active:
             self.problems.append(Problem(_loc(self.path, node), "recursive YAML alias; a spec must be a tree"))
@@ -115,7 +130,9 @@ class _Builder:
         try:
             return _construct_scalar(node)
         except (yaml.YAMLError, ValueError) as exc:  # e.g. int() of 5000 digits
-            self.problems.append(Problem(_loc(self.path, node), f"cannot read this value: {str(exc).splitlines()[0][:200]}"))
+            self.problems.append(
+                Problem(_loc(self.path, node), f"cannot read this value: {str(exc).splitlines()[0][:200]}")
+            )
             return None
 
     def _mapping(self, node: MappingNode, at: DataPath) -> dict:
@@ -123,7 +140,12 @@ class _Builder:
         first_seen: dict[str, Location] = {}
         for key_node, value_node in node.value:
             if key_node.tag == "tag:yaml.org,2002:merge":
-                self.problems.append(Problem(_loc(self.path, key_node), "YAML merge keys ('<<') are not supported; use 'extends:' to build on another spec"))
+                self.problems.append(
+                    Problem(
+                        _loc(self.path, key_node),
+                        "YAML merge keys ('<<') are not supported; use 'extends:' to build on another spec",
+                    )
+                )
                 continue
             # Keys are names: take a scalar key's text as written, so YAML 1.1 does not turn
             # `on:` / `no:` / `y:` into booleans behind the user's back.
@@ -134,12 +156,21 @@ class _Builder:
             key_loc = _loc(self.path, key_node)
             if key in BOOLEAN_WORDS:
                 hint = BOOLEAN_KEY_HINTS.get(key.lower())
-                self.problems.append(Problem(key_loc, f"'{key}' is a YAML 1.1 boolean word (PyYAML reads it as {key.lower() in ('y', 'yes', 'on', 'true')}), "
-                                                      "so no spec key may be one" + (f" (did you mean '{hint}'?)" if hint else "")))
+                self.problems.append(
+                    Problem(
+                        key_loc,
+                        f"'{key}' is a YAML 1.1 boolean word (PyYAML reads it as {key.lower() in ('y', 'yes', 'on', 'true')}), "
+                        "so no spec key may be one" + (f" (did you mean '{hint}'?)" if hint else ""),
+                    )
+                )
                 continue
             if key in first_seen:
                 first = first_seen[key]
-                self.problems.append(Problem(key_loc, f"duplicate key '{key}' (first defined at line {first.line}, column {first.column})"))
+                self.problems.append(
+                    Problem(
+                        key_loc, f"duplicate key '{key}' (first defined at line {first.line}, column {first.column})"
+                    )
+                )
                 continue
             first_seen[key] = key_loc
             self.smap.keys[at + (key,)] = key_loc
@@ -174,7 +205,6 @@ def _construct_scalar(node: ScalarNode) -> Any:
         loader.dispose()
 
 
-
 def load_located(path: str | Path, *, display_path: str | None = None) -> tuple[dict, SourceMap]:
     """Load one YAML file whose top level must be a mapping.
 
@@ -201,7 +231,9 @@ def load_located(path: str | Path, *, display_path: str | None = None) -> tuple[
     except UnicodeDecodeError as exc:
         line = raw.count(b"\n", 0, exc.start) + 1
         column = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
-        raise SpecError.at(shown, f"not UTF-8 text ({exc.reason} at byte {exc.start}); a spec is UTF-8 YAML", line, column) from None
+        raise SpecError.at(
+            shown, f"not UTF-8 text ({exc.reason} at byte {exc.start}); a spec is UTF-8 YAML", line, column
+        ) from None
     return loads_located(text, shown)
 
 
@@ -221,18 +253,33 @@ def loads_located(text: str, shown: str) -> tuple[dict, SourceMap]:
     except yaml.reader.ReaderError as exc:  # a control character, e.g. NUL in binary data
         line = text.count("\n", 0, exc.position) + 1
         column = exc.position - (text.rfind("\n", 0, exc.position) + 1) + 1
-        raise SpecError.at(shown, f"not YAML text: {exc.reason} (character U+{exc.character:04X}); a spec is plain UTF-8 YAML", line, column) from None
+        raise SpecError.at(
+            shown,
+            f"not YAML text: {exc.reason} (character U+{exc.character:04X}); a spec is plain UTF-8 YAML",
+            line,
+            column,
+        ) from None
     except yaml.YAMLError as exc:
         raise SpecError.at(shown, f"YAML error: {exc}") from None
     documents = [d for d in documents if d is not None]
     if not documents:
         raise SpecError.at(shown, "file is empty; expected a mapping of spec fields (e.g. 'name: my_task')")
     if len(documents) > 1:
-        raise SpecError.at(shown, "more than one YAML document ('---'); a spec file holds exactly one", documents[1].start_mark.line + 1, 1)
+        raise SpecError.at(
+            shown,
+            "more than one YAML document ('---'); a spec file holds exactly one",
+            documents[1].start_mark.line + 1,
+            1,
+        )
     root = documents[0]
     if not isinstance(root, MappingNode):
         kind = "a list" if isinstance(root, SequenceNode) else f"a single value ({root.value!r})"
-        raise SpecError.at(shown, f"top level is {kind}; expected a mapping of spec fields (e.g. 'name: my_task')", root.start_mark.line + 1, root.start_mark.column + 1)
+        raise SpecError.at(
+            shown,
+            f"top level is {kind}; expected a mapping of spec fields (e.g. 'name: my_task')",
+            root.start_mark.line + 1,
+            root.start_mark.column + 1,
+        )
     builder = _Builder(shown)
     data = builder.build(root, ())
     if builder.problems:
@@ -249,6 +296,11 @@ def _check_depth(text: str, shown: str) -> None:
             depth += 1
             if depth > MAX_DEPTH:
                 mark = event.start_mark
-                raise SpecError.at(shown, f"nested more than {MAX_DEPTH} levels deep; a spec is a shallow tree", mark.line + 1, mark.column + 1)
+                raise SpecError.at(
+                    shown,
+                    f"nested more than {MAX_DEPTH} levels deep; a spec is a shallow tree",
+                    mark.line + 1,
+                    mark.column + 1,
+                )
         elif isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
             depth -= 1

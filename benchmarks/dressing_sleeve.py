@@ -77,8 +77,14 @@ def arm_points(pose: str) -> dict[str, np.ndarray]:
     e = s + L_UPPER * u1
     w = e + L_FORE * u2
     return {
-        "shoulder": s, "elbow": e, "wrist": w, "hand": w + R_HAND * u2,
-        "hand_end": w + 2 * R_HAND * u2, "shoulder_end": s - R_UPPER * u1, "u1": u1, "u2": u2,
+        "shoulder": s,
+        "elbow": e,
+        "wrist": w,
+        "hand": w + R_HAND * u2,
+        "hand_end": w + 2 * R_HAND * u2,
+        "shoulder_end": s - R_UPPER * u1,
+        "u1": u1,
+        "u2": u2,
     }
 
 
@@ -224,9 +230,15 @@ def dist_to_arm(xyz: np.ndarray, pts) -> np.ndarray:
 
 def build_arm(pts, cid) -> int:
     """Fixed multibody: base = upper-arm capsule, plus forearm capsule and joint spheres (all static)."""
+
     def capsule(a, b, r):
-        return dict(shapeType=p.GEOM_CAPSULE, radius=r, length=float(np.linalg.norm(b - a)),
-                    pos=list((a + b) / 2), orn=_quat_z_to(b - a))
+        return dict(
+            shapeType=p.GEOM_CAPSULE,
+            radius=r,
+            length=float(np.linalg.norm(b - a)),
+            pos=list((a + b) / 2),
+            orn=_quat_z_to(b - a),
+        )
 
     parts = [
         capsule(pts["shoulder"], pts["elbow"], R_UPPER),
@@ -237,14 +249,28 @@ def build_arm(pts, cid) -> int:
         dict(shapeType=p.GEOM_SPHERE, radius=R_HAND, length=0, pos=list(pts["hand"]), orn=[0, 0, 0, 1]),
     ]
     col = p.createCollisionShapeArray(
-        shapeTypes=[q["shapeType"] for q in parts], radii=[q["radius"] for q in parts],
-        lengths=[q["length"] for q in parts], collisionFramePositions=[q["pos"] for q in parts],
-        collisionFrameOrientations=[q["orn"] for q in parts], physicsClientId=cid)
+        shapeTypes=[q["shapeType"] for q in parts],
+        radii=[q["radius"] for q in parts],
+        lengths=[q["length"] for q in parts],
+        collisionFramePositions=[q["pos"] for q in parts],
+        collisionFrameOrientations=[q["orn"] for q in parts],
+        physicsClientId=cid,
+    )
     return p.createMultiBody(baseMass=0, baseCollisionShapeIndex=col, basePosition=[0, 0, 0], physicsClientId=cid)
 
 
-SOFT_DEFAULTS = dict(mass=0.1, margin=0.01, ks=10.0, kd=0.002, kb=0.1, friction=0.5, substeps=4, damp_all=1, face_contact=1,
-                     sdf_voxel=0.25)
+SOFT_DEFAULTS = dict(
+    mass=0.1,
+    margin=0.01,
+    ks=10.0,
+    kd=0.002,
+    kb=0.1,
+    friction=0.5,
+    substeps=4,
+    damp_all=1,
+    face_contact=1,
+    sdf_voxel=0.25,
+)
 
 
 class SoftSleeve:
@@ -254,14 +280,29 @@ class SoftSleeve:
         cfg = {**SOFT_DEFAULTS, **kw}
         self.cid, self.segments = cid, segments
         self.sb = p.loadSoftBody(
-            str(obj_path), basePosition=list(pos), baseOrientation=list(orn), scale=1.0,
-            mass=cfg["mass"], collisionMargin=cfg["margin"], useMassSpring=1, useBendingSprings=1,
-            useNeoHookean=0, springElasticStiffness=cfg["ks"], springDampingStiffness=cfg["kd"],
-            springDampingAllDirections=cfg["damp_all"], springBendingStiffness=cfg["kb"],
-            useSelfCollision=0, frictionCoeff=cfg["friction"], useFaceContact=cfg["face_contact"], physicsClientId=cid)
+            str(obj_path),
+            basePosition=list(pos),
+            baseOrientation=list(orn),
+            scale=1.0,
+            mass=cfg["mass"],
+            collisionMargin=cfg["margin"],
+            useMassSpring=1,
+            useBendingSprings=1,
+            useNeoHookean=0,
+            springElasticStiffness=cfg["ks"],
+            springDampingStiffness=cfg["kd"],
+            springDampingAllDirections=cfg["damp_all"],
+            springBendingStiffness=cfg["kb"],
+            useSelfCollision=0,
+            frictionCoeff=cfg["friction"],
+            useFaceContact=cfg["face_contact"],
+            physicsClientId=cid,
+        )
         # Soft bodies fall asleep like rigid ones; asleep, they report no contacts — keep them awake.
         p.changeDynamics(self.sb, -1, activationState=p.ACTIVATION_STATE_DISABLE_SLEEPING, physicsClientId=cid)
-        self.anchor = p.createMultiBody(baseMass=0, basePosition=list(pos), baseOrientation=list(orn), physicsClientId=cid)
+        self.anchor = p.createMultiBody(
+            baseMass=0, basePosition=list(pos), baseOrientation=list(orn), physicsClientId=cid
+        )
         x = self.nodes()
         arc = None if grip == "ring" else 90.0
         self.gripped = garment.gripped_ring_indices(segments, 0, arc_deg=arc)
@@ -329,27 +370,65 @@ class RingSleeve:
             pos_ = [[r * math.cos(a), r * math.sin(a), 0.0] for a in th]
             orn_ = [p.getQuaternionFromEuler([0, 0, a + math.pi / 2]) for a in th]
             return p.createCollisionShapeArray(
-                shapeTypes=[p.GEOM_BOX] * nb, halfExtents=[ext] * nb,
-                collisionFramePositions=pos_, collisionFrameOrientations=orn_, physicsClientId=cid)
+                shapeTypes=[p.GEOM_BOX] * nb,
+                halfExtents=[ext] * nb,
+                collisionFramePositions=pos_,
+                collisionFrameOrientations=orn_,
+                physicsClientId=cid,
+            )
 
         cols = [hoop(r) for r in rs]
         self.body = p.createMultiBody(
-            baseMass=m_ring, baseCollisionShapeIndex=cols[0], basePosition=list(pos), baseOrientation=list(orn),
-            linkMasses=[m_ring] * (n - 1), linkCollisionShapeIndices=cols[1:], linkVisualShapeIndices=[-1] * (n - 1),
-            linkPositions=[[0, 0, self.spacing]] * (n - 1), linkOrientations=[[0, 0, 0, 1]] * (n - 1),
-            linkInertialFramePositions=[[0, 0, 0]] * (n - 1), linkInertialFrameOrientations=[[0, 0, 0, 1]] * (n - 1),
-            linkParentIndices=list(range(n - 1)), linkJointTypes=[p.JOINT_SPHERICAL] * (n - 1),
-            linkJointAxis=[[0, 0, 1]] * (n - 1), physicsClientId=cid)
+            baseMass=m_ring,
+            baseCollisionShapeIndex=cols[0],
+            basePosition=list(pos),
+            baseOrientation=list(orn),
+            linkMasses=[m_ring] * (n - 1),
+            linkCollisionShapeIndices=cols[1:],
+            linkVisualShapeIndices=[-1] * (n - 1),
+            linkPositions=[[0, 0, self.spacing]] * (n - 1),
+            linkOrientations=[[0, 0, 0, 1]] * (n - 1),
+            linkInertialFramePositions=[[0, 0, 0]] * (n - 1),
+            linkInertialFrameOrientations=[[0, 0, 0, 1]] * (n - 1),
+            linkParentIndices=list(range(n - 1)),
+            linkJointTypes=[p.JOINT_SPHERICAL] * (n - 1),
+            linkJointAxis=[[0, 0, 1]] * (n - 1),
+            physicsClientId=cid,
+        )
         for j in range(-1, n - 1):
-            p.changeDynamics(self.body, j, lateralFriction=cfg["friction"], linearDamping=0.5, angularDamping=0.5,
-                             physicsClientId=cid)
+            p.changeDynamics(
+                self.body,
+                j,
+                lateralFriction=cfg["friction"],
+                linearDamping=0.5,
+                angularDamping=0.5,
+                physicsClientId=cid,
+            )
         f = cfg["joint_force"]
         for j in range(n - 1):
-            p.setJointMotorControlMultiDof(self.body, j, p.POSITION_CONTROL, targetPosition=[0, 0, 0, 1],
-                                           targetVelocity=[0, 0, 0], positionGain=cfg["joint_gain"], velocityGain=1.0,
-                                           force=[f, f, f], physicsClientId=cid)
-        self.cons = p.createConstraint(self.body, -1, -1, -1, p.JOINT_FIXED, [0, 0, 0], [0, 0, 0], list(pos),
-                                       childFrameOrientation=list(orn), physicsClientId=cid)
+            p.setJointMotorControlMultiDof(
+                self.body,
+                j,
+                p.POSITION_CONTROL,
+                targetPosition=[0, 0, 0, 1],
+                targetVelocity=[0, 0, 0],
+                positionGain=cfg["joint_gain"],
+                velocityGain=1.0,
+                force=[f, f, f],
+                physicsClientId=cid,
+            )
+        self.cons = p.createConstraint(
+            self.body,
+            -1,
+            -1,
+            -1,
+            p.JOINT_FIXED,
+            [0, 0, 0],
+            [0, 0, 0],
+            list(pos),
+            childFrameOrientation=list(orn),
+            physicsClientId=cid,
+        )
         p.changeConstraint(self.cons, list(pos), list(orn), maxForce=200, physicsClientId=cid)
         self.nb = nb
 
@@ -358,8 +437,9 @@ class RingSleeve:
 
     def hoop_frames(self):
         out = [p.getBasePositionAndOrientation(self.body, physicsClientId=self.cid)]
-        for s in p.getLinkStates(self.body, list(range(p.getNumJoints(self.body, physicsClientId=self.cid))),
-                                 physicsClientId=self.cid):
+        for s in p.getLinkStates(
+            self.body, list(range(p.getNumJoints(self.body, physicsClientId=self.cid))), physicsClientId=self.cid
+        ):
             out.append((s[4], s[5]))
         return out
 
@@ -367,7 +447,7 @@ class RingSleeve:
         """Hoop-rim sample points (``boxes`` per hoop) — the ring method's 'nodes'."""
         out = []
         th = 2 * np.pi * np.arange(self.nb) / self.nb
-        for k, (pos, orn) in enumerate(self.hoop_frames()):
+        for pos, orn in self.hoop_frames():
             R = np.array(p.getMatrixFromQuaternion(orn)).reshape(3, 3)
             r = self.r_open  # rim radius (approximate for narrowed hoops)
             loc = np.stack([r * np.cos(th), r * np.sin(th), np.zeros_like(th)], axis=1)
@@ -378,7 +458,7 @@ class RingSleeve:
         return self.nodes()[: self.nb]
 
     def all_rings(self, x) -> list[np.ndarray]:
-        return [x[k * self.nb:(k + 1) * self.nb] for k in range(len(x) // self.nb)]
+        return [x[k * self.nb : (k + 1) * self.nb] for k in range(len(x) // self.nb)]
 
     def bodies(self):
         return [self.body]
@@ -416,13 +496,38 @@ def run(args) -> dict:
         verts, faces = garment.sleeve_mesh(args.length, args.radius, args.radius_end, args.rings, args.segments)
         obj = Path(tempfile.mkdtemp()) / "sleeve.obj"
         garment.write_obj(obj, verts, faces)
-        sleeve = SoftSleeve(cid, obj, args.rings, args.segments, pos0, orn0, grip=args.grip, mass=args.mass,
-                            margin=args.margin, ks=args.ks, kd=args.kd, kb=args.kb, friction=args.friction,
-                            damp_all=args.damp_all, face_contact=args.face_contact)
+        sleeve = SoftSleeve(
+            cid,
+            obj,
+            args.rings,
+            args.segments,
+            pos0,
+            orn0,
+            grip=args.grip,
+            mass=args.mass,
+            margin=args.margin,
+            ks=args.ks,
+            kd=args.kd,
+            kb=args.kb,
+            friction=args.friction,
+            damp_all=args.damp_all,
+            face_contact=args.face_contact,
+        )
     else:
-        sleeve = RingSleeve(cid, args.length, args.radius, args.radius_end, pos0, orn0, n_rings=args.n_hoops,
-                            mass=args.mass, friction=args.friction, joint_force=args.joint_force,
-                            overlap=args.overlap, boxes=args.boxes)
+        sleeve = RingSleeve(
+            cid,
+            args.length,
+            args.radius,
+            args.radius_end,
+            pos0,
+            orn0,
+            n_rings=args.n_hoops,
+            mass=args.mass,
+            friction=args.friction,
+            joint_force=args.joint_force,
+            overlap=args.overlap,
+            boxes=args.boxes,
+        )
 
     hist = dict(nan=False, max_dist=0.0, pen=-1.0, rings_in=0, best_progress=0.0, inside_final=False, forces=[], ncp=[])
     settle = args.settle
@@ -458,21 +563,31 @@ def run(args) -> dict:
             hist["ncp"].append(n)
             if args.print and (k // FRAME_SKIP) % 25 == 24:
                 c = ring.mean(axis=0)
-                print(f"  t={t:5.2f}s inside={int(inside)} progress={progress_along_arm(pts, c):.3f} "
-                      f"lag={np.linalg.norm(c - path.pose_at(t)[0]):.3f} maxdist={dist_to_arm(x, pts).max():.2f} "
-                      f"F={f:.3f}N ncp={n}")
+                print(
+                    f"  t={t:5.2f}s inside={int(inside)} progress={progress_along_arm(pts, c):.3f} "
+                    f"lag={np.linalg.norm(c - path.pose_at(t)[0]):.3f} maxdist={dist_to_arm(x, pts).max():.2f} "
+                    f"F={f:.3f}N ncp={n}"
+                )
     wall = time.perf_counter() - wall0
     n_rings_total = len(sleeve.all_rings(sleeve.nodes()))
     p.disconnect(cid)
     L = arm_length(pts)
     return dict(
-        nan=hist["nan"], max_dist=hist["max_dist"], pen=hist["pen"], rings_in=hist["rings_in"],
-        n_rings=n_rings_total, inside_final=hist["inside_final"],
-        progress=hist["best_progress"], arm_len=L, frac=hist["best_progress"] / L,
+        nan=hist["nan"],
+        max_dist=hist["max_dist"],
+        pen=hist["pen"],
+        rings_in=hist["rings_in"],
+        n_rings=n_rings_total,
+        inside_final=hist["inside_final"],
+        progress=hist["best_progress"],
+        arm_len=L,
+        frac=hist["best_progress"] / L,
         force_median=float(np.median(hist["forces"])) if hist["forces"] else float("nan"),
         force_max=float(np.max(hist["forces"])) if hist["forces"] else float("nan"),
         ncp_max=int(max(hist["ncp"])) if hist["ncp"] else 0,
-        phys_per_s=n_steps / t_step, phys_per_s_wall=n_steps / wall, env_per_s=n_steps / wall / FRAME_SKIP,
+        phys_per_s=n_steps / t_step,
+        phys_per_s_wall=n_steps / wall,
+        env_per_s=n_steps / wall / FRAME_SKIP,
     )
 
 
@@ -501,7 +616,9 @@ def main(argv=None):
     ap.add_argument("--damp-all", type=int, default=SOFT_DEFAULTS["damp_all"])
     ap.add_argument("--friction", type=float, default=0.5)
     ap.add_argument("--face-contact", type=int, default=SOFT_DEFAULTS["face_contact"])
-    ap.add_argument("--sdf-voxel", type=float, default=SOFT_DEFAULTS["sdf_voxel"], help="sparseSdfVoxelSize (0: engine default)")
+    ap.add_argument(
+        "--sdf-voxel", type=float, default=SOFT_DEFAULTS["sdf_voxel"], help="sparseSdfVoxelSize (0: engine default)"
+    )
     # rings
     ap.add_argument("--n-hoops", type=int, default=RING_DEFAULTS["n_rings"])
     ap.add_argument("--joint-force", type=float, default=RING_DEFAULTS["joint_force"])
@@ -515,15 +632,19 @@ def main(argv=None):
     for i in range(args.repeat):
         r = run(args)
         results.append(r)
-        print(f"run {i}: nan={r['nan']} max_node_dist_to_arm={r['max_dist']:.3f} m  arm_inside_opening_at_end={r['inside_final']}  "
-              f"opening_progress={r['progress']:.3f}/{r['arm_len']:.3f} m ({100 * r['frac']:.0f}%)  "
-              f"rings_around_arm_at_end={r['rings_in']}/{r['n_rings']}  max_penetration={1000 * r['pen']:.0f} mm  "
-              f"contact_F median={r['force_median']:.3f} max={r['force_max']:.3f} N (max {r['ncp_max']} contacts)  "
-              f"physics_steps/s={r['phys_per_s']:.0f} (incl. measurement {r['phys_per_s_wall']:.0f})  env_steps/s={r['env_per_s']:.0f}")
+        print(
+            f"run {i}: nan={r['nan']} max_node_dist_to_arm={r['max_dist']:.3f} m  arm_inside_opening_at_end={r['inside_final']}  "
+            f"opening_progress={r['progress']:.3f}/{r['arm_len']:.3f} m ({100 * r['frac']:.0f}%)  "
+            f"rings_around_arm_at_end={r['rings_in']}/{r['n_rings']}  max_penetration={1000 * r['pen']:.0f} mm  "
+            f"contact_F median={r['force_median']:.3f} max={r['force_max']:.3f} N (max {r['ncp_max']} contacts)  "
+            f"physics_steps/s={r['phys_per_s']:.0f} (incl. measurement {r['phys_per_s_wall']:.0f})  env_steps/s={r['env_per_s']:.0f}"
+        )
     if args.repeat > 1:
         med = lambda k: statistics.median(r[k] for r in results)  # noqa: E731
-        print(f"median of {args.repeat}: physics_steps/s={med('phys_per_s'):.0f} (with measurement {med('phys_per_s_wall'):.0f}), "
-              f"env_steps/s={med('env_per_s'):.0f}, progress={med('progress'):.3f} m")
+        print(
+            f"median of {args.repeat}: physics_steps/s={med('phys_per_s'):.0f} (with measurement {med('phys_per_s_wall'):.0f}), "
+            f"env_steps/s={med('env_per_s'):.0f}, progress={med('progress'):.3f} m"
+        )
     return results
 
 

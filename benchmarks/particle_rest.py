@@ -42,8 +42,12 @@ def container_frame(env, ps, box) -> np.ndarray:
     w, c = env.world, env.world.client
     pos, orn = w.base_frame(w.bodies[box.body])
     inv = pb.invertTransform(pos, orn)
-    return np.array([pb.multiplyTransforms(*inv, pb.getBasePositionAndOrientation(pid, physicsClientId=c)[0], (0, 0, 0, 1))[0]
-                     for pid in w.particles[ps.name]])
+    return np.array(
+        [
+            pb.multiplyTransforms(*inv, pb.getBasePositionAndOrientation(pid, physicsClientId=c)[0], (0, 0, 0, 1))[0]
+            for pid in w.particles[ps.name]
+        ]
+    )
 
 
 def creep(artifact: Path, box, angles: list[int]) -> None:
@@ -52,7 +56,9 @@ def creep(artifact: Path, box, angles: list[int]) -> None:
     ps = env.manifest.particles[0]
     grip = env.world.tool_constraints[box.body]
     hold = np.zeros(env.action_space.shape)
-    print("| turned by | mean / max movement (mm) | top above the floor (cm) | left in the container |\n|---|---|---|---|")
+    print(
+        "| turned by | mean / max movement (mm) | top above the floor (cm) | left in the container |\n|---|---|---|---|"
+    )
     for theta in angles:
         env.reset(seed=0)
         for _ in range(10):
@@ -91,9 +97,11 @@ def speed(artifacts: dict[str, Path], steps: int, repeats: int) -> None:
             cpu[label].append(steps / (time.process_time() - c0))
             carried[label].append(all_carried / steps)
     for label in envs:
-        print(f"{label}: {statistics.median(wall[label]):.1f} env steps/s (wall), {statistics.median(cpu[label]):.1f} per CPU second; "
-              f"per repeat wall {[round(x, 1) for x in wall[label]]}, CPU {[round(x, 1) for x in cpu[label]]}, "
-              f"steps with every particle carried {[round(x, 2) for x in carried[label]]}")
+        print(
+            f"{label}: {statistics.median(wall[label]):.1f} env steps/s (wall), {statistics.median(cpu[label]):.1f} per CPU second; "
+            f"per repeat wall {[round(x, 1) for x in wall[label]]}, CPU {[round(x, 1) for x in cpu[label]]}, "
+            f"steps with every particle carried {[round(x, 2) for x in carried[label]]}"
+        )
         envs[label].close()
 
 
@@ -116,7 +124,11 @@ def main(argv: list[str] | None = None) -> int:
         always = compile_task(off, args.robot, root / "rest-off").out_dir
         shipped = compile_task(args.spec, args.robot, root / "shipped")
         if args.what == "creep":
-            creep(always, next(ps.rest.container for ps in shipped.manifest.particles if ps.rest), [int(a) for a in args.angles.split(",")])
+            creep(
+                always,
+                next(ps.rest.container for ps in shipped.manifest.particles if ps.rest),
+                [int(a) for a in args.angles.split(",")],
+            )
         else:
             speed({"carried at rest (shipped)": shipped.out_dir, "always simulated": always}, args.steps, args.repeats)
     return 0

@@ -43,9 +43,20 @@ STAGES = {
     "solver setup (contact and joint rows)": ["solveGroupCacheFriendlySetup"],
     "collision: pair processing (narrowphase)": ["processAllOverlappingPairs"],
     "collision: bounding boxes (broadphase)": ["updateAabbs", "calculateOverlappingPairs"],
-    "soft bodies": ["solveSoftConstraints", "predictUnconstraintMotionSoftBody", "softBodySelfCollision", "btSoftBody",
-                    "integrateTransformsSoftBody", "solveDeformableConstraints", "btDeformable"],
-    "multibody dynamics (forward, integrate)": ["btMultiBody stepVelocities", "btMultiBody stepPositions", "computeAccelerationsArticulatedBodyAlgorithmMultiDof"],
+    "soft bodies": [
+        "solveSoftConstraints",
+        "predictUnconstraintMotionSoftBody",
+        "softBodySelfCollision",
+        "btSoftBody",
+        "integrateTransformsSoftBody",
+        "solveDeformableConstraints",
+        "btDeformable",
+    ],
+    "multibody dynamics (forward, integrate)": [
+        "btMultiBody stepVelocities",
+        "btMultiBody stepPositions",
+        "computeAccelerationsArticulatedBodyAlgorithmMultiDof",
+    ],
 }
 """Bullet profiler zones summed into each stage (a zone counts once: its nearest named ancestor wins)."""
 
@@ -150,7 +161,9 @@ def profile(spec: Path, robot: str, steps: int, seed: int, out_dir: Path) -> dic
         written = sorted(out_dir.glob(f"{trace_file.name}_*.json"))  # Bullet appends _<thread>.json
         shares = stage_shares(json.loads(written[0].read_text())) if written else {}
         return {
-            "task": env.manifest.task, "robot": robot, "steps": steps,
+            "task": env.manifest.task,
+            "robot": robot,
+            "steps": steps,
             "solver": {"sub_steps": env.manifest.sim.sub_steps, "iterations": env.manifest.sim.solver_iterations},
             "env_steps_per_s": steps / total,
             "physics_share_of_step": physics[0] / total,
@@ -168,8 +181,10 @@ def markdown(rows: list[dict]) -> str:
     lines = [head, "|" + "---|" * (4 + len(stages))]
     for r in rows:
         s = r["bullet_stage_shares"]
-        lines.append(f"| {r['task']} | {r['env_steps_per_s']:.0f} | {100 * r['physics_share_of_step']:.0f}% | "
-                     f"{r['python_us_per_step']:.0f} | " + " | ".join(f"{100 * s.get(k, 0):.0f}%" for k in stages) + " |")
+        lines.append(
+            f"| {r['task']} | {r['env_steps_per_s']:.0f} | {100 * r['physics_share_of_step']:.0f}% | "
+            f"{r['python_us_per_step']:.0f} | " + " | ".join(f"{100 * s.get(k, 0):.0f}%" for k in stages) + " |"
+        )
     lines += ["", "Contact points at the end of each env step (the last physics step's), by body pair:", ""]
     for r in rows:
         top = list(r["contact_points_per_env_step"].items())[:6]

@@ -77,7 +77,11 @@ class EpisodeProbe:
         self.intruders = [w.robot.id] + [w.bodies[b.name].id for b in m.bodies if b.kind == "tool"]
         self.intruders += [pid for ids in w.particles.values() for pid in ids]
         self.furniture = {w.bodies[b.name].id for b in m.bodies if b.kind == "furniture"}
-        movable = [j for j in range(pb.getNumJoints(w.robot.id, physicsClientId=c)) if pb.getJointInfo(w.robot.id, j, physicsClientId=c)[2] != pb.JOINT_FIXED]
+        movable = [
+            j
+            for j in range(pb.getNumJoints(w.robot.id, physicsClientId=c))
+            if pb.getJointInfo(w.robot.id, j, physicsClientId=c)[2] != pb.JOINT_FIXED
+        ]
         self.robot_idle = [j for j in movable if j not in set(env.arm_idx)]
 
     def begin(self) -> None:
@@ -92,7 +96,11 @@ class EpisodeProbe:
             keep = [k for k, j in enumerate(variant.movable_joints) if (j in compliant) == soft and k not in tremor]
             if keep:
                 self.held[kind] = ([h.idx[k] for k in keep], np.array([h.hold[k] for k in keep]))
-        self.idle_q = np.array([s[0] for s in pb.getJointStates(env.world.robot.id, self.robot_idle, physicsClientId=c)]) if self.robot_idle else None
+        self.idle_q = (
+            np.array([s[0] for s in pb.getJointStates(env.world.robot.id, self.robot_idle, physicsClientId=c)])
+            if self.robot_idle
+            else None
+        )
         self.targets = self.furniture | {self.person_id}
         self.forces, self.depth, self.idle_drift = [], 0.0, 0.0
         self.hold_drift = {kind: 0.0 for kind in self.held}
@@ -136,15 +144,23 @@ def run_episodes(artifact: Path, seeds: list[int]) -> list[dict]:
             total += reward
             probe.after_step(info)
             done = terminated or truncated
-        out.append({
-            "seed": seed, "success": float(info["task_success"]), "return": total, "success_metric": float(info["success_metric"]),
-            "force_mean_n": float(np.mean(probe.forces)), "force_p95_n": float(np.percentile(probe.forces, 95)),
-            "penetration_mm": probe.depth * 1e3, "particles_lost": float(probe.lost), "particles_consumed": float(probe.consumed),
-            "person_stiff_drift_rad": probe.hold_drift.get("stiff"),
-            "person_compliant_drift_rad": probe.hold_drift.get("compliant"),
-            "robot_idle_drift_rad": probe.idle_drift if probe.robot_idle else None,
-            "steps_per_s": env.steps / stepping,
-        })
+        out.append(
+            {
+                "seed": seed,
+                "success": float(info["task_success"]),
+                "return": total,
+                "success_metric": float(info["success_metric"]),
+                "force_mean_n": float(np.mean(probe.forces)),
+                "force_p95_n": float(np.percentile(probe.forces, 95)),
+                "penetration_mm": probe.depth * 1e3,
+                "particles_lost": float(probe.lost),
+                "particles_consumed": float(probe.consumed),
+                "person_stiff_drift_rad": probe.hold_drift.get("stiff"),
+                "person_compliant_drift_rad": probe.hold_drift.get("compliant"),
+                "robot_idle_drift_rad": probe.idle_drift if probe.robot_idle else None,
+                "steps_per_s": env.steps / stepping,
+            }
+        )
     env.close()
     return out
 
@@ -169,11 +185,21 @@ def compare(shipped: list[dict], reference: list[dict]) -> list[dict]:
         a, b = (list(v) for v in zip(*pairs))
         diff, lo, hi = paired_ci(a, b)
         noise = lo <= 0.0 <= hi
-        rows.append({"metric": key, "label": label, "unit": unit, "n": len(pairs),
-                     "shipped_mean": float(np.mean(a)), "shipped_sd": float(np.std(a, ddof=1)) if len(a) > 1 else 0.0,
-                     "reference_mean": float(np.mean(b)), "reference_sd": float(np.std(b, ddof=1)) if len(b) > 1 else 0.0,
-                     "diff": diff, "diff_ci95": [lo, hi],
-                     "verdict": "speed" if key == "steps_per_s" else ("within noise" if noise else "differs")})
+        rows.append(
+            {
+                "metric": key,
+                "label": label,
+                "unit": unit,
+                "n": len(pairs),
+                "shipped_mean": float(np.mean(a)),
+                "shipped_sd": float(np.std(a, ddof=1)) if len(a) > 1 else 0.0,
+                "reference_mean": float(np.mean(b)),
+                "reference_sd": float(np.std(b, ddof=1)) if len(b) > 1 else 0.0,
+                "diff": diff,
+                "diff_ci95": [lo, hi],
+                "verdict": "speed" if key == "steps_per_s" else ("within noise" if noise else "differs"),
+            }
+        )
     return rows
 
 
@@ -181,16 +207,20 @@ def markdown(result: dict) -> str:
     """The comparison as a markdown table."""
     s, r = result["shipped_solver"], result["reference_solver"]
     a, b = result.get("shipped_label", "shipped"), result.get("variant_label", "reference")
-    lines = [f"**{result['task']} × {result['robot']}**, {result['seeds']} seeds (scripted policy); "
-             f"{a} `{s}` vs {b} `{r}`", "",
-             f"| metric | {a} (mean ± sd) | {b} (mean ± sd) | difference [95% CI] | verdict |",
-             "|---|---|---|---|---|"]
+    lines = [
+        f"**{result['task']} × {result['robot']}**, {result['seeds']} seeds (scripted policy); {a} `{s}` vs {b} `{r}`",
+        "",
+        f"| metric | {a} (mean ± sd) | {b} (mean ± sd) | difference [95% CI] | verdict |",
+        "|---|---|---|---|---|",
+    ]
     for row in result["rows"]:
         unit = f" ({row['unit']})" if row["unit"] else ""
         lo, hi = row["diff_ci95"]
         seeds = f", {row['n']} seeds" if row["n"] != result["seeds"] else ""
-        lines.append(f"| {row['label']}{unit}{seeds} | {row['shipped_mean']:.3g} ± {row['shipped_sd']:.2g} | "
-                     f"{row['reference_mean']:.3g} ± {row['reference_sd']:.2g} | {row['diff']:+.3g} [{lo:+.3g}, {hi:+.3g}] | {row['verdict']} |")
+        lines.append(
+            f"| {row['label']}{unit}{seeds} | {row['shipped_mean']:.3g} ± {row['shipped_sd']:.2g} | "
+            f"{row['reference_mean']:.3g} ± {row['reference_sd']:.2g} | {row['diff']:+.3g} [{lo:+.3g}, {hi:+.3g}] | {row['verdict']} |"
+        )
     return "\n".join(lines) + "\n"
 
 
@@ -209,30 +239,47 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--robot", default="jaco")
     ap.add_argument("--seeds", type=int, default=20, help="episodes per setting (seeds 0..N-1)")
     ap.add_argument("--first-seed", type=int, default=0)
-    ap.add_argument("--solver", nargs="+", default=[], metavar="KEY=VALUE",
-                    help="compare against the reference's settings with these sim.solver keys changed "
-                         "(e.g. contact_breaking_threshold_m=0.002: which of the differences matters)")
-    ap.add_argument("--without-rest", action="store_true",
-                    help="compare against the shipped spec with particle sets' rest switched off (always simulated), "
-                         "at the shipped solver settings")
+    ap.add_argument(
+        "--solver",
+        nargs="+",
+        default=[],
+        metavar="KEY=VALUE",
+        help="compare against the reference's settings with these sim.solver keys changed "
+        "(e.g. contact_breaking_threshold_m=0.002: which of the differences matters)",
+    )
+    ap.add_argument(
+        "--without-rest",
+        action="store_true",
+        help="compare against the shipped spec with particle sets' rest switched off (always simulated), "
+        "at the shipped solver settings",
+    )
     ap.add_argument("--artifacts", help="where to compile (default: a temporary directory)")
     ap.add_argument("--json", help="write the full result (per-episode figures too) here")
     ap.add_argument("--markdown", help="write the table here")
-    ap.add_argument("--from-json", nargs="+", metavar="RESULT",
-                    help="re-tabulate a result written by --json (no episodes run); with two results of the same "
-                         "seeds, compare their compared settings (the first's as 'shipped', the second's as 'reference')")
+    ap.add_argument(
+        "--from-json",
+        nargs="+",
+        metavar="RESULT",
+        help="re-tabulate a result written by --json (no episodes run); with two results of the same "
+        "seeds, compare their compared settings (the first's as 'shipped', the second's as 'reference')",
+    )
     args = ap.parse_args(argv)
 
     if args.from_json:
         result = json.loads(Path(args.from_json[0]).read_text())
         if len(args.from_json) == 2:
             other = json.loads(Path(args.from_json[1]).read_text())
-            if [e["seed"] for e in other["episodes"]["reference"]] != [e["seed"] for e in result["episodes"]["reference"]]:
+            if [e["seed"] for e in other["episodes"]["reference"]] != [
+                e["seed"] for e in result["episodes"]["reference"]
+            ]:
                 raise SystemExit("--from-json: the two results ran different seeds")
             result["shipped_solver"], result["reference_solver"] = result["reference_solver"], other["reference_solver"]
             result["shipped_label"] = result.get("variant_label", "reference")
             result["variant_label"] = other.get("variant_label", "reference")
-            result["episodes"] = {"shipped": result["episodes"]["reference"], "reference": other["episodes"]["reference"]}
+            result["episodes"] = {
+                "shipped": result["episodes"]["reference"],
+                "reference": other["episodes"]["reference"],
+            }
         result["rows"] = compare(result["episodes"]["shipped"], result["episodes"]["reference"])
     else:
         result = run(args)
@@ -257,8 +304,10 @@ def write_rest_off_variant(spec_path: str | Path, spec, out: Path) -> Path | Non
         return None
     out.parent.mkdir(parents=True, exist_ok=True)
     sets = "".join(f"  {name}:\n    rest: null\n" for name in names)
-    out.write_text(f"# {Path(spec_path).name} with its particles always simulated (benchmarks/physics_settings.py)\n"
-                   f"extends: {Path(spec_path).resolve()}\nparticles:\n{sets}")
+    out.write_text(
+        f"# {Path(spec_path).name} with its particles always simulated (benchmarks/physics_settings.py)\n"
+        f"extends: {Path(spec_path).resolve()}\nparticles:\n{sets}"
+    )
     return out
 
 
@@ -282,7 +331,10 @@ def run(args: argparse.Namespace) -> dict | None:
                 return None
             variant_solver = {**ref, **parse_solver(args.solver)}
             if variant_solver == solver_settings(spec):
-                print(f"{spec.name}: the shipped solver settings are the compared ones; nothing to compare", file=sys.stderr)
+                print(
+                    f"{spec.name}: the shipped solver settings are the compared ones; nothing to compare",
+                    file=sys.stderr,
+                )
                 return None
             label = "reference" if not args.solver else "reference with " + ", ".join(args.solver)
             tag = "reference" if not args.solver else "variant-" + "-".join(args.solver).replace("=", "")
@@ -293,11 +345,19 @@ def run(args: argparse.Namespace) -> dict | None:
         compile_s = time.perf_counter() - t0
         shipped = run_episodes(shipped_dir, seeds)
         other = run_episodes(variant_dir, seeds)
-    return {"task": spec.name, "robot": args.robot, "seeds": len(seeds), "first_seed": args.first_seed,
-            "shipped_solver": solver_settings(spec), "reference_solver": variant_solver, "variant_label": label,
-            "command": " ".join(["benchmarks/physics_settings.py", *sys.argv[1:]]),
-            "compile_s": round(compile_s, 1), "rows": compare(shipped, other),
-            "episodes": {"shipped": shipped, "reference": other}}
+    return {
+        "task": spec.name,
+        "robot": args.robot,
+        "seeds": len(seeds),
+        "first_seed": args.first_seed,
+        "shipped_solver": solver_settings(spec),
+        "reference_solver": variant_solver,
+        "variant_label": label,
+        "command": " ".join(["benchmarks/physics_settings.py", *sys.argv[1:]]),
+        "compile_s": round(compile_s, 1),
+        "rows": compare(shipped, other),
+        "episodes": {"shipped": shipped, "reference": other},
+    }
 
 
 if __name__ == "__main__":

@@ -25,10 +25,10 @@ def rot_z(a: float) -> np.ndarray:
     return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
 
 
-def homogeneous(rot=np.eye(3), xyz=(0, 0, 0)) -> np.ndarray:
-    """A 4×4 transform from a rotation matrix and a translation."""
+def homogeneous(rot=None, xyz=(0, 0, 0)) -> np.ndarray:
+    """A 4×4 transform from a rotation matrix (None: none) and a translation."""
     t = np.eye(4)
-    t[:3, :3] = rot
+    t[:3, :3] = np.eye(3) if rot is None else rot
     t[:3, 3] = xyz
     return t
 

@@ -35,6 +35,12 @@ def cli(*args: str, cwd: Path | None = None, env: dict | None = None, timeout: f
     import subprocess
     import sys
 
-    proc = subprocess.run([sys.executable, "-m", "assistive_compiler.cli", *args], cwd=cwd, capture_output=True, text=True,
-                          timeout=timeout, env=os.environ | (env or {}))
+    proc = subprocess.run(
+        [sys.executable, "-m", "assistive_compiler.cli", *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env=os.environ | (env or {}),
+    )
     return proc.returncode, proc.stdout, proc.stderr

@@ -16,8 +16,11 @@ IDS = sorted(shipped_ids())
 def test_shipped_task_robot_pairs_are_registered():
     tasks = {i.split("/")[1].removesuffix("-v1") for i in IDS}
     robots = ("PR2", "Jaco", "Baxter", "Sawyer", "Panda", "Stretch")
-    expected = {f"{task}{robot}" for task in ("Feeding", "ScratchItch", "BedBathing", "Drinking", "Dressing", "ArmManipulation")
-                for robot in robots}
+    expected = {
+        f"{task}{robot}"
+        for task in ("Feeding", "ScratchItch", "BedBathing", "Drinking", "Dressing", "ArmManipulation")
+        for robot in robots
+    }
     assert tasks == expected and len(IDS) == 36
 
 
@@ -53,11 +56,22 @@ def assert_the_camera_shows_person_arm_and_tools(env, width: int = 160, height: 
 
     w, m = env.world, env.manifest
     view, proj = camera_matrices(m.camera.model_dump(), width, height, w.client)
-    seg = np.asarray(pb.getCameraImage(width, height, view, proj, renderer=pb.ER_TINY_RENDERER,
-                                       flags=pb.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX, physicsClientId=w.client)[4]).reshape(-1)
+    seg = np.asarray(
+        pb.getCameraImage(
+            width,
+            height,
+            view,
+            proj,
+            renderer=pb.ER_TINY_RENDERER,
+            flags=pb.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX,
+            physicsClientId=w.client,
+        )[4]
+    ).reshape(-1)
     body, link = seg & ((1 << 24) - 1), (seg >> 24) - 1
-    shown = {"person": int((body == w.variant_bodies[w.active_variant.name].id).sum()),
-             "arm": int(((body == w.robot.id) & np.isin(link, env.arm_idx)).sum())}
+    shown = {
+        "person": int((body == w.variant_bodies[w.active_variant.name].id).sum()),
+        "arm": int(((body == w.robot.id) & np.isin(link, env.arm_idx)).sum()),
+    }
     shown |= {att.body: int((body == w.bodies[att.body].id).sum()) for att in m.tools}
     hidden = [name for name, pixels in shown.items() if pixels < MIN_PIXELS.get(name, MIN_PIXELS["tool"])]
     assert not hidden, f"{m.gym_id}: {hidden} hardly visible from the task camera ({shown} pixels of {width}x{height})"

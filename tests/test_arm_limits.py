@@ -118,8 +118,10 @@ def test_valid_fraction(model):
     lo, hi = arm_box("right")  # the reference's pose-independent box (5...198 for shoulder_x)
     q = rng.uniform(lo, hi, size=(20000, 4))
     frac = float(model.valid(q, "right").mean())
-    print(f"\nanalytic model: valid fraction of 20,000 uniform samples in the right-arm box = {frac:.3f} "
-          f"(reference MLP: ~0.41)")
+    print(
+        f"\nanalytic model: valid fraction of 20,000 uniform samples in the right-arm box = {frac:.3f} "
+        f"(reference MLP: ~0.41)"
+    )
     assert 0.25 <= frac <= 0.60
 
 
@@ -137,8 +139,15 @@ def test_scalar_and_vector_paths_agree(model):
 @pytest.mark.parametrize("side", SIDES)
 def test_reference_task_poses_valid(model, side):
     # Initial arm postures of the reference tasks (paper §III-B-2.6), right-arm numbers.
-    for qx, qy, qz, qe in [(30, 0, 0, -90), (0, 0, 0, -90), (45, 0, 0, -90), (60, -60, 0, 0),
-                           (5, 0, 0, 0), (0, -90, 0, 0), (10, -40, 20, -125)]:
+    for qx, qy, qz, qe in [
+        (30, 0, 0, -90),
+        (0, 0, 0, -90),
+        (45, 0, 0, -90),
+        (60, -60, 0, 0),
+        (5, 0, 0, 0),
+        (0, -90, 0, 0),
+        (10, -40, 20, -125),
+    ]:
         assert model.valid(pose(qx, qy, qz, qe, side), side), (qx, qy, qz, qe)
 
 
@@ -217,18 +226,31 @@ def _forward(weights, biases, activations, q, side):
     """Direct forward pass in the reference's convention (paper §III-C), one pose."""
     tz, tx, ty, qe = (float(a) for a in q)
     s = -1.0 if side == "right" else 1.0
-    x = np.array([(s * tz + 2 * np.pi) % (2 * np.pi), (tx + 2 * np.pi) % (2 * np.pi), s * ty,
-                  (-qe + 2 * np.pi) % (2 * np.pi)])
-    fns = {"tanh": np.tanh, "sigmoid": lambda z: 1 / (1 + np.exp(-z)), "relu": lambda z: np.maximum(z, 0),
-           "linear": lambda z: z}
+    x = np.array(
+        [(s * tz + 2 * np.pi) % (2 * np.pi), (tx + 2 * np.pi) % (2 * np.pi), s * ty, (-qe + 2 * np.pi) % (2 * np.pi)]
+    )
+    fns = {
+        "tanh": np.tanh,
+        "sigmoid": lambda z: 1 / (1 + np.exp(-z)),
+        "relu": lambda z: np.maximum(z, 0),
+        "linear": lambda z: z,
+    }
     for w, b, a in zip(weights, biases, activations):
         x = fns[a](x @ w + b)
     return float(x[0])
 
 
 HAND_PICKED = [
-    (0, 0, 0, 0), (30, 0, 0, -90), (190, -170, 80, -120), (-45, 20, -30, -10), (120, -60, 45, -128),
-    (5, 61, -90, 0), (198, -188, 90, -64), (-198, 10, 0, -30), (90, -90, 0, -45), (60, -120, -75, -100),
+    (0, 0, 0, 0),
+    (30, 0, 0, -90),
+    (190, -170, 80, -120),
+    (-45, 20, -30, -10),
+    (120, -60, 45, -128),
+    (5, 61, -90, 0),
+    (198, -188, 90, -64),
+    (-198, 10, 0, -30),
+    (90, -90, 0, -45),
+    (60, -120, -75, -100),
 ]
 
 
@@ -338,8 +360,8 @@ def test_guard_reverts_to_last_valid(model, side):
     guard = ArmLimitGuard(model, side)
     q0 = pose(30, 0, 0, -90, side)
     q1 = pose(40, -20, 10, -80, side)
-    bad1 = pose(0, 0, 80, -90, side)      # forearm through the abdomen
-    bad2 = pose(170, 0, 0, 0, side)       # overhead without external rotation
+    bad1 = pose(0, 0, 80, -90, side)  # forearm through the abdomen
+    bad2 = pose(170, 0, 0, 0, side)  # overhead without external rotation
     q2 = pose(0, -90, 0, 0, side)
     assert model.valid(q1, side) and model.valid(q2, side)
     assert not model.valid(bad1, side) and not model.valid(bad2, side)
@@ -413,8 +435,7 @@ def test_cost_per_call(model, tmp_path):
     q = pose(30, -20, 10, -90)
     analytic_us = _median_call_us(model, q, "right")
     mlp_us = _median_call_us(mlp, q, "right")
-    print(f"\nvalid() median per call on one pose: analytic {analytic_us:.1f} us, "
-          f"MLP 4-64-64-64-1 {mlp_us:.1f} us")
+    print(f"\nvalid() median per call on one pose: analytic {analytic_us:.1f} us, MLP 4-64-64-64-1 {mlp_us:.1f} us")
     assert analytic_us < 1000.0
     assert mlp_us < 1000.0
 

@@ -11,11 +11,11 @@ from types import SimpleNamespace
 import numpy as np
 import pybullet as pb
 import pytest
+from helpers import at, compiled_env
 
 from assistive_compiler.cli import main
 from assistive_compiler.paths import display, specs_dir
 from assistive_compiler.terms.registry import terms
-from helpers import at, compiled_env
 
 SPEC = specs_dir() / "tasks" / "arm_manipulation.yaml"
 FEEDING = specs_dir() / "tasks" / "feeding.yaml"
@@ -71,7 +71,10 @@ def test_two_arm_robot_acts_with_both_arms_and_holds_two_scoopers(pr2):
     assert env.action_space.shape == (14,) and env.observation_space.shape == (45,)
     assert m.robot.arm_joints[:7] == m.joint_groups["robot.right_arm"]["joints"]
     assert m.robot.arm_joints[7:] == m.joint_groups["robot.left_arm"]["joints"]
-    assert {t.body: t.parent_link for t in m.tools} == {"scooper_right": "r_gripper_tool_frame", "scooper_left": "l_gripper_tool_frame"}
+    assert {t.body: t.parent_link for t in m.tools} == {
+        "scooper_right": "r_gripper_tool_frame",
+        "scooper_left": "l_gripper_tool_frame",
+    }
     assert len(m.robot.gripper_joints) == 8 and set(m.robot.gripper_position) == {0.15}
     env.reset(seed=0)
     w, c = env.world, env.world.client
@@ -126,7 +129,9 @@ def test_immovable_links_of_different_bodies_never_collide_and_moving_ones_do(ja
     pairs = set()
     for _ in range(20):
         jaco.step(rng.uniform(-1, 1, jaco.action_space.shape))
-        pairs |= {cp[4] for cp in pb.getContactPoints(bodyA=w.bodies["bed"].id, bodyB=person.id, physicsClientId=w.client)}
+        pairs |= {
+            cp[4] for cp in pb.getContactPoints(bodyA=w.bodies["bed"].id, bodyB=person.id, physicsClientId=w.client)
+        }
     assert pairs and not pairs & still, pairs
     assert pairs <= {person.links[n] for n in ("right_pecs", "right_shoulder", "right_elbow", "right_wrist")}, pairs
 
@@ -175,12 +180,17 @@ def test_scripted_right_replaces_the_main_script_on_two_arm_robots_only(tmp_path
     from assistive_compiler.spec.load import load_spec
 
     path = tmp_path / "spec.yaml"
-    path.write_text(f"extends: {SPEC}\nscripted:\n  right:\n    move: scooper_right\n    waypoints:\n"
-                    "      - {to: person.waist, offset_m: [-0.3, 0, 0.1]}\n")
+    path.write_text(
+        f"extends: {SPEC}\nscripted:\n  right:\n    move: scooper_right\n    waypoints:\n"
+        "      - {to: person.waist, offset_m: [-0.3, 0, 0.1]}\n"
+    )
     loaded = load_spec(path)
     two, one = resolve(loaded, "pr2").scripted, resolve(loaded, "jaco").scripted
     assert [w["to"]["link"] for w in two["waypoints"]] == ["waist"]
-    assert len(one["waypoints"]) == len(loaded.spec.scripted.waypoints) and one["waypoints"][-1]["to"]["link"] == "right_shoulder"
+    assert (
+        len(one["waypoints"]) == len(loaded.spec.scripted.waypoints)
+        and one["waypoints"][-1]["to"]["link"] == "right_shoulder"
+    )
     assert "left" in two and "left" not in one
 
 
@@ -245,33 +255,53 @@ def test_start_left_in_a_one_arm_task_is_refused(tmp_path, capsys):
         f"{at(text, '{tool_')}: robot.start_left: start_left is the left arm's start in a task acting with both arms, "
         "but this task's arm is 'right'; remove it or set arm: both (arm: right is inherited from "
         f"{display(FEEDING)}:{line}:{int(column) + len('arm: ')}; remove it in {display(tmp_path / 'spec.yaml')} with "
-        "robot: {$delete: [arm]}, or rewrite robot whole with robot: {$replace: {...}})"]
+        "robot: {$delete: [arm]}, or rewrite robot whole with robot: {$replace: {...}})"
+    ]
 
 
 def test_a_tool_in_a_hand_the_task_does_not_act_with_is_refused(tmp_path, capsys):
     text = f"extends: {FEEDING}\ntools:\n  spoon: {{part: spoon, hand: left}}\n"
     errors = _errors(tmp_path, capsys, text)
-    assert f"{at(text, 'left')}: tool 'spoon' is held in the left hand, but the task acts with the right arm only; use hand: right or robot.arm: both" in errors
+    assert (
+        f"{at(text, 'left')}: tool 'spoon' is held in the left hand, but the task acts with the right arm only; use hand: right or robot.arm: both"
+        in errors
+    )
 
 
 def test_two_tools_on_one_arm_need_one_arm_same_as(tmp_path, capsys):
-    text = (f"extends: {SPEC}\ntools:\n  scooper_right: {{part: scooper, hand: right}}\n"
-            "  scooper_left: {part: scooper, hand: left, one_arm_same_as: null}\n")
+    text = (
+        f"extends: {SPEC}\ntools:\n  scooper_right: {{part: scooper, hand: right}}\n"
+        "  scooper_left: {part: scooper, hand: left, one_arm_same_as: null}\n"
+    )
     errors = _errors(tmp_path, capsys, text)
-    assert f"{at(text, 'left, one')}: robot 'jaco' acts with one arm, which would hold both 'scooper_right' (right hand) and " \
-        "'scooper_left' (left hand); give 'scooper_left' one_arm_same_as: scooper_right (one tool serving both hands) or a hand the arm already uses" in errors
+    assert (
+        f"{at(text, 'left, one')}: robot 'jaco' acts with one arm, which would hold both 'scooper_right' (right hand) and "
+        "'scooper_left' (left hand); give 'scooper_left' one_arm_same_as: scooper_right (one tool serving both hands) or a hand the arm already uses"
+        in errors
+    )
 
 
 def test_one_arm_same_as_names_a_tool_of_the_same_part_in_the_other_hand(tmp_path, capsys):
-    text = (f"extends: {SPEC}\ntools:\n  scooper_right: {{part: scooper, hand: right}}\n"
-            "  scooper_left: {part: scooper, hand: left, one_arm_same_as: scoper_right}\n")
+    text = (
+        f"extends: {SPEC}\ntools:\n  scooper_right: {{part: scooper, hand: right}}\n"
+        "  scooper_left: {part: scooper, hand: left, one_arm_same_as: scoper_right}\n"
+    )
     errors = _errors(tmp_path, capsys, text)
-    assert f"{at(text, 'scoper_right')}: unknown tool 'scoper_right'; expected one of 'scooper_right' (did you mean 'scooper_right'?)" in errors
+    assert (
+        f"{at(text, 'scoper_right')}: unknown tool 'scoper_right'; expected one of 'scooper_right' (did you mean 'scooper_right'?)"
+        in errors
+    )
 
 
 def test_a_goal_arm_in_a_one_arm_task_and_an_unknown_stage_group_are_refused(tmp_path, capsys):
-    text = (f"extends: {SPEC}\nrobot:\n  arm: right\n  start_left: null\n  base_search:\n    goals:\n      - {{point: person.waist, arm: left}}\n"
-            "person:\n  placement:\n    settle:\n      then: {dynamic: [person.rigt_arm]}\n")
+    text = (
+        f"extends: {SPEC}\nrobot:\n  arm: right\n  start_left: null\n  base_search:\n    goals:\n      - {{point: person.waist, arm: left}}\n"
+        "person:\n  placement:\n    settle:\n      then: {dynamic: [person.rigt_arm]}\n"
+    )
     errors = _errors(tmp_path, capsys, text)
-    assert any(e.startswith(f"{at(text, 'left}')}: a goal names an arm only in a task acting with both arms") for e in errors), errors
-    assert any(e.startswith(f"{at(text, 'person.rigt_arm')}: unknown joint group 'person.rigt_arm'") for e in errors), errors
+    assert any(
+        e.startswith(f"{at(text, 'left}')}: a goal names an arm only in a task acting with both arms") for e in errors
+    ), errors
+    assert any(e.startswith(f"{at(text, 'person.rigt_arm')}: unknown joint group 'person.rigt_arm'") for e in errors), (
+        errors
+    )

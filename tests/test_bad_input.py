@@ -12,10 +12,9 @@ from pathlib import Path
 
 import pytest
 import yaml
+from helpers import cli
 
 from assistive_compiler.paths import specs_dir
-
-from helpers import cli
 
 FEEDING = specs_dir() / "tasks" / "feeding.yaml"
 LOCATED = re.compile(r"^\S+:\d+:\d+: \S.*$")
@@ -32,11 +31,20 @@ def _laughs(levels: int = 12) -> str:
 PATHOLOGICAL = {
     "deep_flow_sequence": ("a: " + "[" * 50_000 + "]" * 50_000 + "\n", "nested more than 48 levels deep"),
     "deep_flow_mapping": ("a: " + "{b: " * 50_000 + "1" + "}" * 50_000 + "\n", "nested more than 48 levels deep"),
-    "deep_block_mapping": ("".join("  " * i + f"k{i}:\n" for i in range(1200)) + "  " * 1200 + "v: 1\n", "nested more than 48 levels deep"),
-    "deep_block_sequence": ("a:\n" + "".join("  " * i + "-\n" for i in range(1, 1000)), "nested more than 48 levels deep"),
+    "deep_block_mapping": (
+        "".join("  " * i + f"k{i}:\n" for i in range(1200)) + "  " * 1200 + "v: 1\n",
+        "nested more than 48 levels deep",
+    ),
+    "deep_block_sequence": (
+        "a:\n" + "".join("  " * i + "-\n" for i in range(1, 1000)),
+        "nested more than 48 levels deep",
+    ),
     "billion_laughs": (_laughs(), "more than 200000 values once anchors and aliases are expanded"),
     "merge_key": ("a: &a {x: 1}\nb:\n  <<: *a\n", "YAML merge keys ('<<') are not supported"),
-    "python_object_tag": ("a: !!python/object/apply:os.system ['echo pwned']\n", "YAML tag 'tag:yaml.org,2002:python/object/apply:os.system' is not allowed"),
+    "python_object_tag": (
+        "a: !!python/object/apply:os.system ['echo pwned']\n",
+        "YAML tag 'tag:yaml.org,2002:python/object/apply:os.system' is not allowed",
+    ),
     "custom_tag": ("name: !include other.yaml\n", "YAML tag '!include' is not allowed"),
     "huge_integer": ("name: " + "9" * 5000 + "\n", "cannot read this value"),
     "nul_bytes": ("name: a\x00b\n", "not YAML text"),
@@ -65,8 +73,13 @@ def test_pathological_yaml_is_one_located_error(case, tmp_path):
 @pytest.mark.parametrize("case", ["binary", "latin1", "directory", "device", "missing"])
 def test_what_is_not_a_spec_file_is_one_located_error(case, tmp_path):
     path = tmp_path / "spec.yaml"
-    expected = {"binary": "not UTF-8 text", "latin1": "not UTF-8 text", "directory": "is a directory",
-                "device": "is not a regular file", "missing": "file not found"}[case]
+    expected = {
+        "binary": "not UTF-8 text",
+        "latin1": "not UTF-8 text",
+        "directory": "is a directory",
+        "device": "is not a regular file",
+        "missing": "file not found",
+    }[case]
     if case == "binary":
         path.write_bytes(bytes(range(256)) * 64)
     elif case == "latin1":
@@ -86,18 +99,23 @@ def test_latin1_is_located_at_the_byte(tmp_path):
     assert "spec.yaml:2:11: not UTF-8 text (invalid continuation byte at byte 18); a spec is UTF-8 YAML" in err
 
 
-@pytest.mark.parametrize("content,message", [
-    ("\x89PNG\r\n\x1a\n binary", "is not a URDF: not UTF-8 text"),
-    ("this is not xml", "is not a URDF: XML error at line 1, column 1: syntax error"),
-    ("<robot name='r'><link name='a'>", "is not a URDF: XML error at line 1, column"),
-    ("<html><body/></html>", "is not a URDF: its root element is <html>, expected <robot>"),
-])
+@pytest.mark.parametrize(
+    "content,message",
+    [
+        ("\x89PNG\r\n\x1a\n binary", "is not a URDF: not UTF-8 text"),
+        ("this is not xml", "is not a URDF: XML error at line 1, column 1: syntax error"),
+        ("<robot name='r'><link name='a'>", "is not a URDF: XML error at line 1, column"),
+        ("<html><body/></html>", "is not a URDF: its root element is <html>, expected <robot>"),
+    ],
+)
 def test_a_urdf_that_is_not_urdf_is_located_at_the_urdf_key(tmp_path, content, message):
     robots = tmp_path / "lib" / "robots"
     robots.mkdir(parents=True)
     (robots / "broken.urdf").write_bytes(content.encode("latin-1"))
-    (robots / "mybot.yaml").write_text("name: mybot\ntitle: MyBot\nurdf: broken.urdf\nbase_link: a\n"
-                                       "arms:\n  right: {joints: [j], end_effector: a, tool_mount: a}\n")
+    (robots / "mybot.yaml").write_text(
+        "name: mybot\ntitle: MyBot\nurdf: broken.urdf\nbase_link: a\n"
+        "arms:\n  right: {joints: [j], end_effector: a, tool_mount: a}\n"
+    )
     spec = tmp_path / "task.yaml"
     spec.write_text(f"extends: {FEEDING}\nrobot: {{default: mybot, supported: [mybot]}}\n")
     status, _, err = cli("validate", str(spec), "--library", str(tmp_path / "lib"), cwd=tmp_path)
@@ -110,15 +128,23 @@ def test_run_scripted_without_a_scripted_section_says_so(tmp_path):
     spec.write_text("extends: shipped:tasks/feeding.yaml\nscripted: {$replace: null}\n")
     status, _, err = cli("run", str(spec), "--episodes", "1", "--out", str(tmp_path / "out"), cwd=tmp_path)
     assert status == 2 and "Traceback" not in err
-    assert "task.yaml:1:1: task 'feeding' has no scripted: section, so there is no scripted policy for it; " \
-           "use --policy random or zero, or add scripted: waypoints" in err
+    assert (
+        "task.yaml:1:1: task 'feeding' has no scripted: section, so there is no scripted policy for it; "
+        "use --policy random or zero, or add scripted: waypoints" in err
+    )
 
 
-@pytest.mark.parametrize("out,message", [
-    ("x.jpg", "x.jpg:1:1: --out must end in .gif, .mp4, .png (a GIF or MP4 of the episode, a PNG strip), got '.jpg'"),
-    (".", ".:1:1: --out must end in .gif, .mp4, .png"),
-    ("afile/x.gif", "afile/x.gif:1:1: cannot write here: afile is not a writable folder"),
-])
+@pytest.mark.parametrize(
+    "out,message",
+    [
+        (
+            "x.jpg",
+            "x.jpg:1:1: --out must end in .gif, .mp4, .png (a GIF or MP4 of the episode, a PNG strip), got '.jpg'",
+        ),
+        (".", ".:1:1: --out must end in .gif, .mp4, .png"),
+        ("afile/x.gif", "afile/x.gif:1:1: cannot write here: afile is not a writable folder"),
+    ],
+)
 def test_render_refuses_an_output_it_cannot_write_before_simulating(tmp_path, out, message):
     (tmp_path / "afile").write_text("a file, not a folder")
     t0 = time.perf_counter()
@@ -163,20 +189,26 @@ def test_extends_markers_misused_are_located(tmp_path):
 
     with pytest.raises(SpecError) as info:
         _merged(tmp_path, "targets:\n  mouth:\n    offset_by_variant: {$delete: [female_5th]}\n")
-    assert str(info.value).endswith("derived.yaml:4:34: '$delete': no inherited key 'female_5th' to remove "
-                                    "(inherited keys here: female_50th, male_50th) (did you mean 'female_50th'?)")
+    assert str(info.value).endswith(
+        "derived.yaml:4:34: '$delete': no inherited key 'female_5th' to remove "
+        "(inherited keys here: female_50th, male_50th) (did you mean 'female_50th'?)"
+    )
     with pytest.raises(SpecError) as info:
         _merged(tmp_path, "targets:\n  mouth:\n    $replace: {link: person.neck}\n    offset_m: [0, 0, 0]\n")
-    assert str(info.value).endswith("derived.yaml:4:5: '$replace' stands alone in its mapping (it replaces the whole "
-                                    "inherited value); move offset_m inside it")
+    assert str(info.value).endswith(
+        "derived.yaml:4:5: '$replace' stands alone in its mapping (it replaces the whole "
+        "inherited value); move offset_m inside it"
+    )
 
 
 def test_a_mistake_inside_replace_is_located_where_it_was_written(tmp_path):
     """The merged value came from the child's ``$replace``: the error points there, not at the
     parent's line that the replacement removed."""
     spec = tmp_path / "task.yaml"
-    spec.write_text("extends: shipped:tasks/feeding.yaml\nsuccess:\n  $replace:\n    term: food_eaten\n"
-                    "    aggregate: final\n    threshold: -0.05\n")
+    spec.write_text(
+        "extends: shipped:tasks/feeding.yaml\nsuccess:\n  $replace:\n    term: food_eaten\n"
+        "    aggregate: final\n    threshold: -0.05\n"
+    )
     status, _, err = cli("validate", str(spec), cwd=tmp_path)
     assert status == 2 and "Traceback" not in err
     assert "task.yaml:5:16: success.aggregate: expected one of 'last', 'max', 'min', 'sum', got 'final'" in err, err
@@ -185,13 +217,16 @@ def test_a_mistake_inside_replace_is_located_where_it_was_written(tmp_path):
 
 def test_a_derived_spec_drops_a_variant_and_its_offsets(tmp_path):
     spec = tmp_path / "task.yaml"
-    spec.write_text("extends: shipped:tasks/feeding.yaml\nperson: {variants: [male_50th]}\n"
-                    "targets:\n  mouth:\n    offset_by_variant: {$delete: [female_50th]}\n")
+    spec.write_text(
+        "extends: shipped:tasks/feeding.yaml\nperson: {variants: [male_50th]}\n"
+        "targets:\n  mouth:\n    offset_by_variant: {$delete: [female_50th]}\n"
+    )
     status, out, err = cli("validate", str(spec), cwd=tmp_path)
     assert status == 0, err
 
 
 # -- every shipped spec survives a PyYAML round trip -------------------------------------------
+
 
 @pytest.mark.parametrize("kind_name", sorted(f"{p.parent.name}/{p.stem}" for p in specs_dir().glob("*/*.yaml")))
 def test_shipped_specs_survive_a_pyyaml_load_dump_round_trip(kind_name, tmp_path):
@@ -236,18 +271,32 @@ def test_errors_cross_process_boundaries_with_their_locations():
     again = pickle.loads(pickle.dumps(error))
     assert type(again) is SpecError and again.problems == error.problems
     assert str(again) == "a.yaml:2:5: first\nb.yaml:7:3: second"
-    assert str(pickle.loads(pickle.dumps(SpecError.at("run/artifact", "not a compiled artifact (no manifest.json)")))) == \
-        "run/artifact:1:1: not a compiled artifact (no manifest.json)"
+    assert (
+        str(pickle.loads(pickle.dumps(SpecError.at("run/artifact", "not a compiled artifact (no manifest.json)"))))
+        == "run/artifact:1:1: not a compiled artifact (no manifest.json)"
+    )
     assert str(pickle.loads(pickle.dumps(UsageError("--address: no Ray cluster")))) == "--address: no Ray cluster"
     lint = LintError([LintProblem("robot.urdf", "link 'base'", "mass must be positive")])
     assert pickle.loads(pickle.dumps(lint)).problems == lint.problems
 
 
-@pytest.mark.parametrize("text,message", [
-    (None, "nope.json:1:1: --reference-json: file not found (lines printed by the reference harness's measure.py ag ENV)"),
-    ('{"env": "FeedingJaco", "steps_per_s": 3', "nope.json:1:40: --reference-json: not JSON (Expecting ',' delimiter)"),
-    ('{"env": "FeedingJaco"}\n', "nope.json:1:1: --reference-json: each entry needs 'env' and 'steps_per_s' (measure.py's output)"),
-])
+@pytest.mark.parametrize(
+    "text,message",
+    [
+        (
+            None,
+            "nope.json:1:1: --reference-json: file not found (lines printed by the reference harness's measure.py ag ENV)",
+        ),
+        (
+            '{"env": "FeedingJaco", "steps_per_s": 3',
+            "nope.json:1:40: --reference-json: not JSON (Expecting ',' delimiter)",
+        ),
+        (
+            '{"env": "FeedingJaco"}\n',
+            "nope.json:1:1: --reference-json: each entry needs 'env' and 'steps_per_s' (measure.py's output)",
+        ),
+    ],
+)
 def test_bench_reference_json_mistakes_are_located_before_measuring(tmp_path, text, message):
     if text is not None:
         (tmp_path / "nope.json").write_text(text)

@@ -32,15 +32,13 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 import pytest
-
 import xacro
 import yourdfpy
+from frames import body_indices, origin_matrix, rot_z
 
+from assistive_compiler.compile.external_checks import captured_c_output
 from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.library import Library
-from assistive_compiler.compile.external_checks import captured_c_output
-
-from frames import body_indices, origin_matrix, rot_z
 
 ROOT = Path(__file__).resolve().parents[1]
 TEMPLATE = ROOT / "templates" / "robots" / "baxter.urdf.xacro"
@@ -72,8 +70,8 @@ def arm_chain(side: str) -> list[tuple[str, tuple, tuple]]:
         (f"{side}_w0", (0.10359, 0, 0), (HALF, 0, HALF)),
         (f"{side}_w1", (0.01, 0, 0.2707), (-HALF, -HALF, 0)),
         (f"{side}_w2", (0.115975, 0, 0), (HALF, 0, HALF)),
-        (f"{side}_hand", (0, 0, 0.11355), (0, 0, 0)),            # ERD right_hand_joint
-        (f"{side}_gripper_base", (0, 0, 0.025), (0, 0, 0)),      # ERD right_gripper_base_joint
+        (f"{side}_hand", (0, 0, 0.11355), (0, 0, 0)),  # ERD right_hand_joint
+        (f"{side}_gripper_base", (0, 0, 0.025), (0, 0, 0)),  # ERD right_gripper_base_joint
         (f"{side}_endpoint", (0, 0, 0.1327), (0, 0, 0)),
     ]
 
@@ -153,10 +151,9 @@ def dh_fk(side: str, q) -> np.ndarray:
     for th0, qi, d, a, alpha in zip(DH_THETA0, q, DH_D, DH_A, DH_ALPHA):
         th = th0 + qi
         ct, st, ca, sa = math.cos(th), math.sin(th), math.cos(alpha), math.sin(alpha)
-        t = t @ np.array([[ct, -st * ca, st * sa, a * ct],
-                          [st, ct * ca, -ct * sa, a * st],
-                          [0.0, sa, ca, d],
-                          [0.0, 0.0, 0.0, 1.0]])
+        t = t @ np.array(
+            [[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0.0, sa, ca, d], [0.0, 0.0, 0.0, 1.0]]
+        )
     return t
 
 
@@ -170,8 +167,7 @@ def bullet(urdf_path):
     Loaded at the origin, identity orientation: world frame == `base`."""
     cid = pb.connect(pb.DIRECT)
     with captured_c_output() as out:
-        body = pb.loadURDF(str(urdf_path), [0, 0, 0], [0, 0, 0, 1], useFixedBase=True,
-                           physicsClientId=cid)
+        body = pb.loadURDF(str(urdf_path), [0, 0, 0], [0, 0, 0, 1], useFixedBase=True, physicsClientId=cid)
     joints, links = body_indices(cid, body)
     yield cid, body, joints, links, out[0]
     pb.disconnect(cid)
@@ -202,6 +198,7 @@ def random_configs(n=30, seed=0):
 # --------------------------------------------------------------------------------------------
 # structure, origins, limits, masses
 
+
 def test_names_and_tree(model):
     assert model.base_link == "base"
     for side in SIDES:
@@ -229,8 +226,7 @@ def test_joint_origins_exact(model):
     for side in SIDES:
         expected |= {name: (xyz, rpy) for name, xyz, rpy in arm_chain(side)}
     for name, (xyz, rpy) in expected.items():
-        np.testing.assert_allclose(model.joint_map[name].origin, origin_matrix(xyz, rpy),
-                                   atol=1e-9, err_msg=name)
+        np.testing.assert_allclose(model.joint_map[name].origin, origin_matrix(xyz, rpy), atol=1e-9, err_msg=name)
 
 
 def test_joint_limits(model):
@@ -283,6 +279,7 @@ def test_masses_vs_facts(model):
 # --------------------------------------------------------------------------------------------
 # forward kinematics
 
+
 @pytest.mark.parametrize("side", SIDES)
 def test_fk_matches_published_chain(bullet, side):
     worst_p, worst_r = 0.0, 0.0
@@ -313,18 +310,33 @@ def test_fk_matches_dh(bullet, side):
 
 def test_fk_reference_checkpoints(bullet):
     # q = 0: joint origins in `base` from the facts' last column, and the endpoint.
-    at_zero = {"s0": (0.064, 0.259, 0.1296), "s1": (0.1128, 0.3078, 0.4), "e0": (0.1849, 0.3799, 0.4),
-               "e1": (0.3705, 0.5655, 0.331), "w0": (0.4437, 0.6388, 0.331), "w1": (0.6352, 0.8302, 0.321),
-               "w2": (0.7172, 0.9122, 0.321)}
-    child = {"s0": "upper_shoulder", "s1": "lower_shoulder", "e0": "upper_elbow", "e1": "lower_elbow",
-             "w0": "upper_forearm", "w1": "lower_forearm", "w2": "wrist"}
+    at_zero = {
+        "s0": (0.064, 0.259, 0.1296),
+        "s1": (0.1128, 0.3078, 0.4),
+        "e0": (0.1849, 0.3799, 0.4),
+        "e1": (0.3705, 0.5655, 0.331),
+        "w0": (0.4437, 0.6388, 0.331),
+        "w1": (0.6352, 0.8302, 0.321),
+        "w2": (0.7172, 0.9122, 0.321),
+    }
+    child = {
+        "s0": "upper_shoulder",
+        "s1": "lower_shoulder",
+        "e0": "upper_elbow",
+        "e1": "lower_elbow",
+        "w0": "upper_forearm",
+        "w1": "lower_forearm",
+        "w2": "wrist",
+    }
     for side in SIDES:
         s = side_sign(side)
         set_arm(bullet, side, [0] * 7)
         for j, (x, y, z) in at_zero.items():
             np.testing.assert_allclose(link_pose(bullet, f"{side}_{child[j]}")[:3, 3], [x, s * y, z], atol=1e-4)
         np.testing.assert_allclose(link_pose(bullet, f"{side}_hand")[:3, 3], [0.7975, s * 0.9925, 0.321], atol=1e-4)
-        np.testing.assert_allclose(link_pose(bullet, f"{side}_gripper_base")[:3, 3], [0.8151, s * 1.0101, 0.321], atol=1e-4)
+        np.testing.assert_allclose(
+            link_pose(bullet, f"{side}_gripper_base")[:3, 3], [0.8151, s * 1.0101, 0.321], atol=1e-4
+        )
         np.testing.assert_allclose(link_pose(bullet, f"{side}_gripper")[:3, 3], [0.909, s * 1.104, 0.321], atol=1e-3)
     # The reference's tucked pose puts right_gripper at (0.048, -0.587, -0.666) in `base`.
     set_arm(bullet, "right", TUCKED["right"])
@@ -345,8 +357,9 @@ def test_reach_matches_facts(bullet):
 
     def reach(q):
         set_arm(bullet, "right", q)
-        return float(np.linalg.norm(link_pose(bullet, "right_gripper")[:3, 3]
-                                    - link_pose(bullet, "right_upper_shoulder")[:3, 3]))
+        return float(
+            np.linalg.norm(link_pose(bullet, "right_gripper")[:3, 3] - link_pose(bullet, "right_upper_shoulder")[:3, 3])
+        )
 
     samples = [rng.uniform(lo, hi) for _ in range(300)]
     dists = [reach(q) for q in samples]
@@ -373,6 +386,7 @@ def test_head_pan_turns_the_screen(bullet):
 
 # --------------------------------------------------------------------------------------------
 # standard URDF checks
+
 
 def test_check_urdf(urdf_path):
     res = subprocess.run([str(CHECK_URDF), str(urdf_path)], capture_output=True, text=True, timeout=30)
@@ -408,6 +422,7 @@ def test_primitives_and_valid_inertias(model):
 # --------------------------------------------------------------------------------------------
 # library part
 
+
 @pytest.fixture(scope="module")
 def part():
     return Library().get("robots", "baxter").part
@@ -422,18 +437,24 @@ def test_library_part(part):
         assert arm.rest_rad == TUCKED[side]
         p = FINGER_PREFIX[side]
         assert part.gripper[side].joints == [f"{p}_gripper_l_finger_joint", f"{p}_gripper_r_finger_joint"]
-        assert {k: part.gripper[side].positions[k] for k in ("spoon", "none")} == {"spoon": 0.0, "none": 0.0}  # reference: feeding (0, 0)
+        assert {k: part.gripper[side].positions[k] for k in ("spoon", "none")} == {
+            "spoon": 0.0,
+            "none": 0.0,
+        }  # reference: feeding (0, 0)
 
 
 def test_base_height_puts_the_pedestal_on_the_floor(part, urdf_path):
     assert part.base_height_m == pytest.approx(0.925)  # the reference's load height
     cid = pb.connect(pb.DIRECT)
     try:
-        body = pb.loadURDF(str(urdf_path), [0, 0, part.base_height_m], [0, 0, 0, 1], useFixedBase=True,
-                           physicsClientId=cid)
+        body = pb.loadURDF(
+            str(urdf_path), [0, 0, part.base_height_m], [0, 0, 0, 1], useFixedBase=True, physicsClientId=cid
+        )
         pb.performCollisionDetection(physicsClientId=cid)
-        lowest = min(pb.getAABB(body, j, physicsClientId=cid)[0][2]
-                     for j in range(-1, pb.getNumJoints(body, physicsClientId=cid)))
+        lowest = min(
+            pb.getAABB(body, j, physicsClientId=cid)[0][2]
+            for j in range(-1, pb.getNumJoints(body, physicsClientId=cid))
+        )
         # AABBs carry Bullet's collision margin (a few mm); the foot's bottom face is at 0.
         assert -0.01 < lowest <= 0.0
         # s0 ends up 1.0546 m above the floor (paper §III-A).
@@ -470,8 +491,8 @@ def test_spoon_grip(part, bullet, tmp_path):
     np.testing.assert_allclose(centre, [0, 0, 0.1177], atol=1e-6)
     np.testing.assert_allclose(handle_end[:3, 3], centre, atol=1e-5)
     r = t_grip[:3, :3]
-    np.testing.assert_allclose(r[:, 1], [0, 0, 1], atol=1e-9)       # handle -> bowl = approach
-    assert abs(r[:, 2] @ np.array([0, 1, 0])) < 1e-9                 # opening _|_ finger axis
+    np.testing.assert_allclose(r[:, 1], [0, 0, 1], atol=1e-9)  # handle -> bowl = approach
+    assert abs(r[:, 2] @ np.array([0, 1, 0])) < 1e-9  # opening _|_ finger axis
     # The 12 mm handle fits between the closed pads (inner faces 16 mm apart).
     assert abs(pads[0][1] - pads[1][1]) - 0.0065 > 0.012
 
@@ -479,14 +500,21 @@ def test_spoon_grip(part, bullet, tmp_path):
 # --------------------------------------------------------------------------------------------
 # physics
 
+
 def test_position_hold_without_gravity(urdf_path):
     """Arm joints position-controlled at a random pose, gravity off: after 50 steps neither
     end effector has moved more than 1 mm."""
     cid = pb.connect(pb.DIRECT)
     try:
         pb.setGravity(0, 0, 0, physicsClientId=cid)
-        body = pb.loadURDF(str(urdf_path), [0, 0, 0.925], [0, 0, 0, 1], useFixedBase=True,
-                           flags=pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=cid)
+        body = pb.loadURDF(
+            str(urdf_path),
+            [0, 0, 0.925],
+            [0, 0, 0, 1],
+            useFixedBase=True,
+            flags=pb.URDF_USE_INERTIA_FROM_FILE,
+            physicsClientId=cid,
+        )
         joints, links = {}, {}
         for j in range(pb.getNumJoints(body, physicsClientId=cid)):
             info = pb.getJointInfo(body, j, physicsClientId=cid)
@@ -499,15 +527,23 @@ def test_position_hold_without_gravity(urdf_path):
             idx = [joints[n] for n in ARM_JOINTS[side]]
             for i, v in zip(idx, q):
                 pb.resetJointState(body, i, float(v), physicsClientId=cid)
-            pb.setJointMotorControlArray(body, idx, pb.POSITION_CONTROL, targetPositions=list(q),
-                                         forces=[ARM_LIMITS[s][2] for s in ARM_SUFFIXES], physicsClientId=cid)
-            start[side] = np.array(pb.getLinkState(body, links[f"{side}_gripper"], computeForwardKinematics=True,
-                                                   physicsClientId=cid)[4])
+            pb.setJointMotorControlArray(
+                body,
+                idx,
+                pb.POSITION_CONTROL,
+                targetPositions=list(q),
+                forces=[ARM_LIMITS[s][2] for s in ARM_SUFFIXES],
+                physicsClientId=cid,
+            )
+            start[side] = np.array(
+                pb.getLinkState(body, links[f"{side}_gripper"], computeForwardKinematics=True, physicsClientId=cid)[4]
+            )
         for _ in range(50):
             pb.stepSimulation(physicsClientId=cid)
         for side in SIDES:
-            end = np.array(pb.getLinkState(body, links[f"{side}_gripper"], computeForwardKinematics=True,
-                                           physicsClientId=cid)[4])
+            end = np.array(
+                pb.getLinkState(body, links[f"{side}_gripper"], computeForwardKinematics=True, physicsClientId=cid)[4]
+            )
             assert np.linalg.norm(end - start[side]) < 1e-3, side
     finally:
         pb.disconnect(cid)

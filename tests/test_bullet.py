@@ -8,16 +8,30 @@ from __future__ import annotations
 
 import pybullet as pb
 
-from assistive_compiler.bullet import BULLET_DEFAULT_CONTACT_BREAKING_THRESHOLD_M, connect, use_contact_breaking_threshold
+from assistive_compiler.bullet import (
+    BULLET_DEFAULT_CONTACT_BREAKING_THRESHOLD_M,
+    connect,
+    use_contact_breaking_threshold,
+)
 
 
 def _rolling_ball(client: int) -> int:
     pb.setGravity(0, 0, -9.81, physicsClientId=client)
     pb.setTimeStep(0.02, physicsClientId=client)
-    floor = pb.createMultiBody(0, pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[0.5, 0.5, 0.05], physicsClientId=client), -1,
-                               [0, 0, -0.05], physicsClientId=client)
-    ball = pb.createMultiBody(0.001, pb.createCollisionShape(pb.GEOM_SPHERE, radius=0.005, physicsClientId=client), -1,
-                              [0, 0, 0.005], physicsClientId=client)
+    floor = pb.createMultiBody(
+        0,
+        pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[0.5, 0.5, 0.05], physicsClientId=client),
+        -1,
+        [0, 0, -0.05],
+        physicsClientId=client,
+    )
+    ball = pb.createMultiBody(
+        0.001,
+        pb.createCollisionShape(pb.GEOM_SPHERE, radius=0.005, physicsClientId=client),
+        -1,
+        [0, 0, 0.005],
+        physicsClientId=client,
+    )
     pb.resetBaseVelocity(ball, [0.05, 0, 0], [0, 10.0, 0], physicsClientId=client)  # rolling at 5 cm/s
     return floor * 1000 + ball
 

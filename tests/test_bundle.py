@@ -57,4 +57,5 @@ def test_a_worker_with_other_code_refuses_naming_both(artifact, tmp_path):
     assert str(err.value) == (
         f"this worker's assistive-compiler 0.1.0 (source {ours}) differs from the driver's 0.0.9 (source ffffffffffff): the "
         f"compiled task {packed['content_hash'][:12]} (feeding, jaco) could run differently here; install the same "
-        "assistive-compiler on every machine of the cluster")
+        "assistive-compiler on every machine of the cluster"
+    )

@@ -7,9 +7,9 @@ import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from gymnasium.utils.env_checker import check_env
 import numpy as np
 import pytest
+from gymnasium.utils.env_checker import check_env
 
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.compile.external_checks import check_with_urdfdom
@@ -74,9 +74,12 @@ def test_unreachable_goals_fail_naming_robot_and_goal(tmp_path):
     [problem] = info.value.problems
     # Why, and located at the base search in force (the task's here).
     assert str(problem.location) == f"{display(bad)}:6:16"
-    assert re.fullmatch(r"robot 'kuka_iiwa' reaches the start pose from none of 10 sampled base poses: 10 left it out of reach "
-                        r"\(the closest the end effector came was 2\.\d\d m away\); set robot\.per_robot\.kuka_iiwa\.base_offset_m or "
-                        r"widen robot\.base_search \(x_range_m, y_range_m, yaw_noise_deg\)", problem.message), problem.message
+    assert re.fullmatch(
+        r"robot 'kuka_iiwa' reaches the start pose from none of 10 sampled base poses: 10 left it out of reach "
+        r"\(the closest the end effector came was 2\.\d\d m away\); set robot\.per_robot\.kuka_iiwa\.base_offset_m or "
+        r"widen robot\.base_search \(x_range_m, y_range_m, yaw_noise_deg\)",
+        problem.message,
+    ), problem.message
     assert not (tmp_path / "out").exists()
 
 
@@ -85,15 +88,19 @@ def test_a_failed_search_is_located_at_the_per_robot_search_in_force_and_names_w
     and the error points at the robot's own base_search (not the task's, an anchor or a parent)."""
     library = Library([DATA / "specs", specs_dir()])
     path = tmp_path / "feeding_kuka.yaml"
-    path.write_text(f"extends: {FEEDING}\nrobot:\n  supported: [jaco, kuka_iiwa]\n  per_robot:\n    kuka_iiwa:\n"
-                    "      base_offset_m: [0.0, 0.0, 0.0]\n"
-                    "      base_search: {attempts: 6, origin_m: [0.0, 0.0, 0.0], x_range_m: [-0.02, 0.02], y_range_m: [-0.02, 0.02]}\n")
+    path.write_text(
+        f"extends: {FEEDING}\nrobot:\n  supported: [jaco, kuka_iiwa]\n  per_robot:\n    kuka_iiwa:\n"
+        "      base_offset_m: [0.0, 0.0, 0.0]\n"
+        "      base_search: {attempts: 6, origin_m: [0.0, 0.0, 0.0], x_range_m: [-0.02, 0.02], y_range_m: [-0.02, 0.02]}\n"
+    )
     with pytest.raises(SpecError) as info:
         compile_task(path, "kuka_iiwa", tmp_path / "out", library=library)
     [problem] = info.value.problems
     assert str(problem.location) == f"{display(path)}:7:20"
-    assert problem.message.startswith("robot 'kuka_iiwa' reaches the start pose from none of 6 sampled base poses: 6 put the robot "
-                                      "(arm at rest) against "), problem.message
+    assert problem.message.startswith(
+        "robot 'kuka_iiwa' reaches the start pose from none of 6 sampled base poses: 6 put the robot "
+        "(arm at rest) against "
+    ), problem.message
     assert "widen robot.per_robot.kuka_iiwa.base_search (x_range_m" in problem.message
 
 

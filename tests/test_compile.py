@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from helpers import at
 
 from assistive_compiler.cli import main
 from assistive_compiler.compile.compiler import compile_task
@@ -33,7 +34,6 @@ from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.errors import SpecError
 from assistive_compiler.library import Library
 from assistive_compiler.paths import display, specs_dir
-from helpers import at
 
 REPO = Path(__file__).resolve().parents[1]
 FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
@@ -73,11 +73,18 @@ def compiled(tmp_path_factory) -> dict:
     rc, out, err = run_cli("compile", str(FEEDING), "--robot", "jaco", "--out", str(a))
     assert "Traceback" not in out + err
     assert (rc, err) == (0, ""), err
-    assert out.startswith(f"compiled: feeding for jaco -> {a}/ (7 bodies, id assistive_compiler/FeedingJaco-v1, content ")
+    assert out.startswith(
+        f"compiled: feeding for jaco -> {a}/ (7 bodies, id assistive_compiler/FeedingJaco-v1, content "
+    )
     env = dict(os.environ, PYTHONHASHSEED="12345")
     proc = subprocess.run(
         [sys.executable, "-m", "assistive_compiler.cli", "compile", str(FEEDING), "--robot", "jaco", "--out", str(b)],
-        capture_output=True, text=True, env=env, cwd=os.getcwd(), timeout=120, check=False,
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=os.getcwd(),
+        timeout=120,
+        check=False,
     )
     assert proc.returncode == 0, proc.stderr
     assert "Traceback" not in proc.stdout + proc.stderr
@@ -113,7 +120,9 @@ def test_recompile_unchanged_is_a_cache_hit_and_force_recompiles(compiled):
     a = compiled["a"]
     rc, out, err = run_cli("compile", str(FEEDING), "--robot", "jaco", "--out", str(a))
     assert (rc, err) == (0, "")
-    assert out.startswith(f"up to date (cache hit): feeding for jaco -> {a}/ (7 bodies, id assistive_compiler/FeedingJaco-v1, content ")
+    assert out.startswith(
+        f"up to date (cache hit): feeding for jaco -> {a}/ (7 bodies, id assistive_compiler/FeedingJaco-v1, content "
+    )
 
     hit = compile_task(FEEDING, "jaco", a)
     assert hit.cache_hit is True
@@ -122,7 +131,9 @@ def test_recompile_unchanged_is_a_cache_hit_and_force_recompiles(compiled):
 
     rc, out, err = run_cli("compile", str(FEEDING), "--robot", "jaco", "--out", str(a), "--force")
     assert (rc, err) == (0, "")
-    assert out.startswith(f"compiled: feeding for jaco -> {a}/ (7 bodies, id assistive_compiler/FeedingJaco-v1, content ")
+    assert out.startswith(
+        f"compiled: feeding for jaco -> {a}/ (7 bodies, id assistive_compiler/FeedingJaco-v1, content "
+    )
     assert snapshot(a) == compiled["files_a"]  # recompiled, to the same bytes
 
     # A fresh compile hands back the manifest exactly as a cache hit loads it, dict order included
@@ -172,7 +183,9 @@ def test_failed_compile_keeps_earlier_output(compiled, tmp_path):
     spec.write_text(UNREACHABLE, encoding="utf-8")
     with pytest.raises(SpecError) as info:
         compile_task(spec, "jaco", b)
-    assert [str(p) for p in info.value.problems] == [f"{display(spec)}:{at(UNREACHABLE, '[3, 3, 3]')}: {UNREACHABLE_MESSAGE}"]
+    assert [str(p) for p in info.value.problems] == [
+        f"{display(spec)}:{at(UNREACHABLE, '[3, 3, 3]')}: {UNREACHABLE_MESSAGE}"
+    ]
     assert snapshot(b) == before
     assert hidden_entries(b.parent) == []
 
@@ -187,7 +200,13 @@ def test_manifest_bodies_exist(compiled, manifest):
     assert manifest["robot_name"] == "jaco"
     assert manifest["gym_id"] == "assistive_compiler/FeedingJaco-v1"
     assert [b["name"] for b in manifest["bodies"]] == [
-        "robot", "wheelchair", "table", "bowl", "spoon", "person_male_50th", "person_female_50th"
+        "robot",
+        "wheelchair",
+        "table",
+        "bowl",
+        "spoon",
+        "person_male_50th",
+        "person_female_50th",
     ]
     for body in manifest["bodies"]:
         assert (a / body["urdf"]).is_file(), body["urdf"]
@@ -219,7 +238,12 @@ def test_manifest_reward_has_paper_preference_weights(manifest):
 
 
 def test_manifest_success_threshold(manifest):
-    assert manifest["success"] == {"term": "food_eaten", "aggregate": "sum", "threshold": 6.0, "fraction_of": None}  # 0.75 × 8 particles
+    assert manifest["success"] == {
+        "term": "food_eaten",
+        "aggregate": "sum",
+        "threshold": 6.0,
+        "fraction_of": None,
+    }  # 0.75 × 8 particles
 
 
 # --------------------------------------------------------------------------------------------
@@ -325,8 +349,15 @@ def bad_table(tmp_path) -> dict:
     task = tmp_path / "task.yaml"
     task.write_text(task_text, encoding="utf-8")
     library = Library([tmp_path / "lib", specs_dir()])
-    return {"template": template, "part": part, "part_text": part_text, "task": task, "task_text": task_text,
-            "library": library, "out": tmp_path / "out"}
+    return {
+        "template": template,
+        "part": part,
+        "part_text": part_text,
+        "task": task,
+        "task_text": task_text,
+        "library": library,
+        "out": tmp_path / "out",
+    }
 
 
 def test_bad_template_is_refused_naming_template_and_link(bad_table):
@@ -355,7 +386,9 @@ def test_a_closed_pipe_ends_the_cli_quietly():
     import subprocess
     import sys
 
-    proc = subprocess.Popen([sys.executable, "-m", "assistive_compiler.cli", "schema"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "assistive_compiler.cli", "schema"], stdout=subprocess.PIPE, stderr=subprocess.PIPE
+    )
     proc.stdout.close()  # the reader goes away before the CLI writes: its write fails with EPIPE
     stderr = proc.stderr.read().decode()
     assert proc.wait(timeout=60) == 0
@@ -378,6 +411,8 @@ def test_compile_of_a_spec_that_is_not_shipped_names_the_id_gymnasium_makes_it_w
     try:
         obs, _ = env.reset(seed=0)
         assert env.unwrapped.manifest.task == "my_feeding" and obs.shape == env.observation_space.shape
-        assert (tmp_path / "cache").is_dir() and [p.name.startswith("my_feeding-") for p in (tmp_path / "cache").iterdir()] == [True]
+        assert (tmp_path / "cache").is_dir() and [
+            p.name.startswith("my_feeding-") for p in (tmp_path / "cache").iterdir()
+        ] == [True]
     finally:
         env.close()

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
+from helpers import at
 from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 import assistive_compiler
@@ -25,14 +26,18 @@ from assistive_compiler.paths import display
 from assistive_compiler.registration import shipped_ids
 from assistive_compiler.runtime.env import AssistiveEnv
 
-from helpers import at
-
 TASKS = Path(__file__).resolve().parents[1] / "specs" / "tasks"
 NAMES = coop.ids()
 
 #: The reference's human action and observation sizes (paper §III-B).
-REFERENCE_HUMAN = {"Feeding": (4, 23), "Drinking": (4, 23), "ScratchItch": (10, 34), "BedBathing": (10, 28),
-                   "Dressing": (10, 28), "ArmManipulation": (10, 42)}
+REFERENCE_HUMAN = {
+    "Feeding": (4, 23),
+    "Drinking": (4, 23),
+    "ScratchItch": (10, 34),
+    "BedBathing": (10, 28),
+    "Dressing": (10, 28),
+    "ArmManipulation": (10, 42),
+}
 
 
 @pytest.fixture
@@ -49,10 +54,14 @@ def feeding(artifact):
 
 def test_names_follow_the_reference():
     assert len(NAMES) == 36 == len(shipped_ids())
-    assert "FeedingJacoHuman-v1" in NAMES and "ScratchItchPR2Human-v1" in NAMES and "ArmManipulationPandaHuman-v1" in NAMES
+    assert (
+        "FeedingJacoHuman-v1" in NAMES and "ScratchItchPR2Human-v1" in NAMES and "ArmManipulationPandaHuman-v1" in NAMES
+    )
     assert coop.coop_name("assistive_compiler/BedBathingSawyer-v1") == "BedBathingSawyerHuman-v1"
     assert coop.spec_of("assistive_compiler/DressingBaxterHuman-v1") == (TASKS / "dressing.yaml", "baxter")
-    with pytest.raises(ValueError, match=r"unknown co-optimisation env 'FeedingJacoHuman-v2' \(did you mean 'FeedingJacoHuman-v1'\?\)"):
+    with pytest.raises(
+        ValueError, match=r"unknown co-optimisation env 'FeedingJacoHuman-v2' \(did you mean 'FeedingJacoHuman-v1'\?\)"
+    ):
         coop.make("FeedingJacoHuman-v2")
 
 
@@ -99,7 +108,9 @@ def test_shared_reward_and_joint_episode_end(feeding):
         assert truncations["robot"] == truncations["human"] == (k == steps - 1)
         for agent in ("robot", "human"):
             assert {"terms", "task_success", "success_metric", "total_force_on_human"} <= set(infos[agent])
-        assert infos["human"]["terms"]["action"] == pytest.approx(np.linalg.norm(np.concatenate([actions["robot"], actions["human"]])))
+        assert infos["human"]["terms"]["action"] == pytest.approx(
+            np.linalg.norm(np.concatenate([actions["robot"], actions["human"]]))
+        )
     assert env.agents == []
     with pytest.raises(RuntimeError, match="call reset"):
         env.step({"robot": np.zeros(7), "human": np.zeros(4)})
@@ -109,7 +120,9 @@ def test_actions_must_name_both_agents(feeding):
     feeding.reset(seed=0)
     with pytest.raises(ValueError, match="actions has no entry for 'human'"):
         feeding.step({"robot": np.zeros(7)})
-    with pytest.raises(ValueError, match=r"unknown agent 'humans' in actions; expected 'robot' and 'human' \(did you mean 'human'\?\)"):
+    with pytest.raises(
+        ValueError, match=r"unknown agent 'humans' in actions; expected 'robot' and 'human' \(did you mean 'human'\?\)"
+    ):
         feeding.step({"robot": np.zeros(7), "humans": np.zeros(4)})
 
 
@@ -168,7 +181,8 @@ def test_a_person_with_nothing_to_control_is_a_located_error(tmp_path):
         assistive_compiler.parallel_env(path, robot="jaco", out_dir=tmp_path / "out")
     assert str(exc.value) == (
         f"{display(path)}:{at(text, '[]')}: person.control.policy_joints: the person controls no joints, so it cannot be a "
-        "co-optimisation agent; list the joint groups a human policy moves, e.g. [person.head] or [person.right_arm]")
+        "co-optimisation agent; list the joint groups a human policy moves, e.g. [person.head] or [person.right_arm]"
+    )
     assert not (tmp_path / "out").exists()  # refused before compiling
 
 
@@ -202,7 +216,9 @@ def test_fixed_robot_partner_exposes_the_human(feeding):
     head = feeding.env.manifest.person.policy_joints
     obs2, reward, terminated, truncated, info = env.step(np.ones(4, dtype=np.float32))
     assert seen == [(25,)] and "arm_limit_reverts" in info and not (terminated or truncated)
-    assert not np.array_equal(obs[3:3 + len(head)], obs2[3:3 + len(head)])  # the head moved (its joint angles are observed)
+    assert not np.array_equal(
+        obs[3 : 3 + len(head)], obs2[3 : 3 + len(head)]
+    )  # the head moved (its joint angles are observed)
     with pytest.raises(ValueError, match="unknown robot policy 'hold'; expected one of random, zero, scripted"):
         FixedPartner(feeding, fixed="robot", policy="hold")
 
@@ -217,7 +233,11 @@ def test_rollout_coop_with_a_holding_person_is_the_single_agent_rollout(feeding,
     finally:
         single.close()
     got = rollout_coop(feeding, "scripted", "hold", seed=3)
-    assert got["return"] == expected["return"] and got["success"] == expected["success"] and got["terms"] == expected["terms"]
+    assert (
+        got["return"] == expected["return"]
+        and got["success"] == expected["success"]
+        and got["terms"] == expected["terms"]
+    )
     moving = rollout_coop(feeding, "scripted", "random", seed=3)
     assert moving["return"] != expected["return"]
 
@@ -229,7 +249,20 @@ def test_rollout_coop_with_a_holding_person_is_the_single_agent_rollout(feeding,
 def test_cli_run_coop(artifact, capsys):
     from assistive_compiler.cli import main
 
-    base = ["run", str(TASKS / "feeding.yaml"), "--robot", "jaco", "--episodes", "1", "--seed", "3", "--json", "--quiet", "--out", str(artifact)]
+    base = [
+        "run",
+        str(TASKS / "feeding.yaml"),
+        "--robot",
+        "jaco",
+        "--episodes",
+        "1",
+        "--seed",
+        "3",
+        "--json",
+        "--quiet",
+        "--out",
+        str(artifact),
+    ]
     assert main(base) == 0
     plain = json.loads(capsys.readouterr().out)
     assert main(base + ["--coop", "--human-policy", "hold"]) == 0
@@ -243,11 +276,29 @@ def test_cli_run_coop(artifact, capsys):
 def test_cli_bench_coop(capsys):
     from assistive_compiler.cli import main
 
-    assert main(["bench", str(TASKS / "feeding.yaml"), "--robot", "jaco", "--coop", "--steps", "20", "--repeats", "1", "--json"]) == 0
+    assert (
+        main(
+            [
+                "bench",
+                str(TASKS / "feeding.yaml"),
+                "--robot",
+                "jaco",
+                "--coop",
+                "--steps",
+                "20",
+                "--repeats",
+                "1",
+                "--json",
+            ]
+        )
+        == 0
+    )
     out = json.loads(capsys.readouterr().out)
     assert out["name"] == "FeedingJacoHuman-v1" and (out["human_action_size"], out["human_obs_size"]) == (4, 23)
     assert out["single_agent_env_steps_per_s"] > 0 and out["multi_agent_env_steps_per_s"] > 0
-    assert out["multi_over_single"] == pytest.approx(out["multi_agent_env_steps_per_s"] / out["single_agent_env_steps_per_s"], rel=1e-2)
+    assert out["multi_over_single"] == pytest.approx(
+        out["multi_agent_env_steps_per_s"] / out["single_agent_env_steps_per_s"], rel=1e-2
+    )
 
 
 def test_bench_coop_goes_on_past_the_end_of_an_episode(tmp_path):
@@ -272,4 +323,6 @@ def test_cli_coop_refuses_a_person_with_nothing_to_control(tmp_path, capsys):
     assert main(["run", str(path), "--robot", "jaco", "--coop", "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     assert "Traceback" not in err
-    assert err.strip().startswith(f"{display(path)}:{at(text, '[]')}: person.control.policy_joints: the person controls no joints")
+    assert err.strip().startswith(
+        f"{display(path)}:{at(text, '[]')}: person.control.policy_joints: the person controls no joints"
+    )

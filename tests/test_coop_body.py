@@ -56,7 +56,9 @@ def person(env):
 
 def angles(env, joints) -> np.ndarray:
     p = person(env)
-    return np.array([s[0] for s in pb.getJointStates(p.id, [p.joints[j] for j in joints], physicsClientId=env.env.world.client)])
+    return np.array(
+        [s[0] for s in pb.getJointStates(p.id, [p.joints[j] for j in joints], physicsClientId=env.env.world.client)]
+    )
 
 
 def wrist(env, side: str) -> np.ndarray:
@@ -171,7 +173,9 @@ def test_the_arm_does_not_pass_through_the_chest(task, coop_envs):
     env = coop_envs(task, "none")
     side = SIDE[task]
     pairs = env.env.manifest.person.self_collision
-    assert {("chest", f"{side}_elbow"), ("chest", f"{side}_wrist")} <= set(pairs)  # forearm and hand vs the torso (head merged in)
+    assert {("chest", f"{side}_elbow"), ("chest", f"{side}_wrist")} <= set(
+        pairs
+    )  # forearm and hand vs the torso (head merged in)
     for seed in (0, 1):
         deepest, contacts, force = into_chest(env, side, seed)
         assert deepest > -0.01 and contacts > 0 and force > 1.0, (seed, deepest, contacts, force)

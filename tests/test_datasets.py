@@ -10,7 +10,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from conftest import FEEDING
 
 minari = pytest.importorskip("minari", reason='needs the "datasets" extra')
@@ -22,9 +21,32 @@ DATASET = "assistive_compiler/feeding-jaco/scripted-v0"
 def dataset(artifact, tmp_path_factory, monkeypatch_module):
     root = tmp_path_factory.mktemp("minari")
     monkeypatch_module.setenv("MINARI_DATASETS_PATH", str(root))
-    result = subprocess.run([sys.executable, "-m", "assistive_compiler.cli", "collect", str(FEEDING), "--robot", "jaco", "--policy", "scripted",
-                             "--episodes", "5", "--out", DATASET, "--root", str(root), "--artifact", str(artifact), "--quiet"],
-                            cwd=REPO, capture_output=True, text=True, timeout=300)
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "assistive_compiler.cli",
+            "collect",
+            str(FEEDING),
+            "--robot",
+            "jaco",
+            "--policy",
+            "scripted",
+            "--episodes",
+            "5",
+            "--out",
+            DATASET,
+            "--root",
+            str(root),
+            "--artifact",
+            str(artifact),
+            "--quiet",
+        ],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert result.returncode == 0, result.stderr
     assert f"wrote Minari dataset {DATASET} (5 episodes, 1000 steps" in result.stdout
     return minari.load_dataset(DATASET)
@@ -39,9 +61,31 @@ def monkeypatch_module():
 
 @pytest.mark.slow
 def test_dataset_matches_run_json(dataset, artifact):
-    run = subprocess.run([sys.executable, "-m", "assistive_compiler.cli", "run", str(FEEDING), "--robot", "jaco", "--policy", "scripted",
-                          "--episodes", "5", "--seed", "0", "--out", str(artifact), "--json", "--quiet"],
-                         cwd=REPO, capture_output=True, text=True, timeout=300)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "assistive_compiler.cli",
+            "run",
+            str(FEEDING),
+            "--robot",
+            "jaco",
+            "--policy",
+            "scripted",
+            "--episodes",
+            "5",
+            "--seed",
+            "0",
+            "--out",
+            str(artifact),
+            "--json",
+            "--quiet",
+        ],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert run.returncode == 0, run.stderr
     report = json.loads(run.stdout)
     meta = dataset.storage.metadata["assistive_compiler"]
@@ -89,7 +133,27 @@ def test_dataset_equals_a_direct_rollout(dataset, artifact):
 
 
 def test_collect_into_an_existing_id_is_a_clear_error(dataset, artifact):
-    result = subprocess.run([sys.executable, "-m", "assistive_compiler.cli", "collect", str(FEEDING), "--robot", "jaco", "--episodes", "1",
-                             "--out", DATASET, "--artifact", str(artifact), "--quiet"], cwd=REPO, capture_output=True, text=True, timeout=300)
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "assistive_compiler.cli",
+            "collect",
+            str(FEEDING),
+            "--robot",
+            "jaco",
+            "--episodes",
+            "1",
+            "--out",
+            DATASET,
+            "--artifact",
+            str(artifact),
+            "--quiet",
+        ],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert result.returncode == 2 and "Traceback" not in result.stderr
     assert f"collect: A Minari dataset with ID {DATASET} already exists and it cannot be overridden" in result.stderr

@@ -6,11 +6,11 @@ import json
 
 import numpy as np
 import pybullet as pb
+from conftest import FEEDING
 
 from assistive_compiler.cli import main
 from assistive_compiler.describe import axis_direction
 from assistive_compiler.runtime.env import AssistiveEnv
-from conftest import FEEDING
 
 
 def test_axis_direction_in_words():
@@ -36,7 +36,9 @@ def test_describe_reports_the_scene_as_pybullet_has_it(artifact, capsys):
         mouth = next(t for t in scene["targets"] if t["name"] == "mouth")
         assert mouth["on"] == "person.head" and not mouth["drawn_on_surface"]
         head = pb.getLinkState(handle.id, handle.links["head"], computeForwardKinematics=1, physicsClientId=w.client)
-        assert 0.05 < np.linalg.norm(np.subtract(mouth["position_m"], head[4])) < 0.2  # the mouth offset from the head frame
+        assert (
+            0.05 < np.linalg.norm(np.subtract(mouth["position_m"], head[4])) < 0.2
+        )  # the mouth offset from the head frame
         parked = [b for b in scene["bodies"] if b["kind"] == "person" and not b["shown"]]
         assert len(parked) == 1 and parked[0]["links"] == []
         assert scene["robot_links"]["end_effector"] == "j2s7s300_end_effector"
@@ -52,7 +54,10 @@ def test_describe_prints_a_table_per_body(artifact, capsys):
     assert "target mouth: (" in out and "(on person.head)" in out
     assert "\nwheelchair (furniture, 3 links)\n" in out
     assert ": parked, not this episode's person" in out
-    assert "5 links; the person's other links are static in this task and merged into these (all 43 and their frames: docs/person.md)" in out
+    assert (
+        "5 links; the person's other links are static in this task and merged into these (all 43 and their frames: docs/person.md)"
+        in out
+    )
 
 
 def test_render_frames_draws_labelled_axes_and_changes_nothing_else(artifact):

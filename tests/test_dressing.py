@@ -10,11 +10,11 @@ import math
 import numpy as np
 import pybullet as pb
 import pytest
+from helpers import compiled_env
 
 from assistive_compiler.cli import main
 from assistive_compiler.garment import ring_encloses_segment, sleeve_node_sets, sleeve_progress
 from assistive_compiler.paths import specs_dir
-from helpers import compiled_env
 
 DRESSING = specs_dir() / "tasks" / "dressing.yaml"
 
@@ -70,8 +70,16 @@ def test_upper_arm_counts_only_after_the_forearm_was_in_the_sleeve():
 
     points = {"s": S, "e": E, "w": W}
     snap = SimpleNamespace(node_positions=lambda h: snap.nodes, position=lambda h: points[h])
-    p = SimpleNamespace(opening=None, shoulder="s", elbow="e", wrist="w", hand_beyond_wrist_m=HAND, beyond_elbow_m=R,
-                        beyond_shoulder_m=R, ordered=True)
+    p = SimpleNamespace(
+        opening=None,
+        shoulder="s",
+        elbow="e",
+        wrist="w",
+        hand_beyond_wrist_m=HAND,
+        beyond_elbow_m=R,
+        beyond_shoulder_m=R,
+        ordered=True,
+    )
     upper, fore = ring([0.15, 0.0, 0.0], [1, 0, 0]), ring([0.28, -0.2, 0.0], [0, 1, 0])
     term = SleeveProgressTerm()
     snap.nodes = upper
@@ -113,7 +121,7 @@ def _validate(tmp_path, old: str, new: str) -> tuple[str, str, int]:
     buf = io.StringIO()
     with contextlib.redirect_stderr(buf):
         assert main(["validate", str(path)]) == 2
-    line = next(i for i, l in enumerate(text.splitlines(), 1) if new.strip() in l)
+    line = next(i for i, link in enumerate(text.splitlines(), 1) if new.strip() in link)
     return buf.getvalue(), str(path), line
 
 
@@ -128,7 +136,11 @@ def test_unknown_garment_and_grip_and_collision_body_are_located(tmp_path):
     err, path, line = _validate(tmp_path, "cloth: [sleeve]", "cloth: [sleve]")
     assert f"{path}:{line}:" in err and "unknown body 'sleve'" in err and "did you mean 'sleeve'" in err
     err, path, line = _validate(tmp_path, "grip: garment ", "grip: garmnet ")
-    assert f"{path}:{line}:" in err and "has no grip 'garmnet' to hold garment 'sleeve'" in err and "did you mean 'garment'" in err
+    assert (
+        f"{path}:{line}:" in err
+        and "has no grip 'garmnet' to hold garment 'sleeve'" in err
+        and "did you mean 'garment'" in err
+    )
     err, path, line = _validate(tmp_path, "collides_with: [person]", "collides_with: [persn]")
     assert f"{path}:{line}:" in err and "unknown body 'persn'" in err
 
@@ -222,14 +234,14 @@ def test_baxter_holding_the_opening_further_round_the_ring_dresses_the_upper_arm
 def _cloth_pixels(image: np.ndarray, xy: np.ndarray, half: int = 6) -> float:
     """Fraction of the (2·half)² pixels round pixel ``xy`` that have the sleeve's green."""
     x, y = (int(round(v)) for v in xy)
-    patch = image[max(y - half, 0):y + half, max(x - half, 0):x + half].astype(int)
+    patch = image[max(y - half, 0) : y + half, max(x - half, 0) : x + half].astype(int)
     r, g, b = patch[..., 0], patch[..., 1], patch[..., 2]
     return float(((g > r + 20) & (g > b + 40)).mean())
 
 
 def _pixel(env, point, width=480, height=360) -> np.ndarray:
     """Where world ``point`` (m) lands in a render of the task's camera, pixels (x right, y down)."""
-    from assistive_compiler.runtime.camera import clip_transform, camera_matrices
+    from assistive_compiler.runtime.camera import camera_matrices, clip_transform
 
     view_m, proj = camera_matrices(env.manifest.camera.model_dump(), width, height, env.world.client)
     clip = clip_transform(view_m, proj) @ np.array([*point, 1.0])

@@ -26,7 +26,9 @@ def obj_path(mesh, tmp_path_factory):
 
 
 def _edges(faces):
-    return Counter(tuple(sorted((int(u), int(v)))) for f in faces for u, v in ((f[0], f[1]), (f[1], f[2]), (f[2], f[0])))
+    return Counter(
+        tuple(sorted((int(u), int(v)))) for f in faces for u, v in ((f[0], f[1]), (f[1], f[2]), (f[2], f[0]))
+    )
 
 
 def test_counts_and_dtypes(mesh):
@@ -115,10 +117,23 @@ def deformable_client():
 def _load(cid, obj_path, pos=(0.0, 0.0, 1.0), orn=(0.0, 0.0, 0.0, 1.0)):
     # The parameters docs/dressing-study.md found stable at a 0.02 s step with 4 sub-steps.
     return p.loadSoftBody(
-        str(obj_path), basePosition=list(pos), baseOrientation=list(orn), scale=1.0, mass=0.1,
-        collisionMargin=0.01, useMassSpring=1, useBendingSprings=1, useNeoHookean=0,
-        springElasticStiffness=10.0, springDampingStiffness=0.002, springDampingAllDirections=1,
-        springBendingStiffness=0.1, useSelfCollision=0, frictionCoeff=0.5, physicsClientId=cid)
+        str(obj_path),
+        basePosition=list(pos),
+        baseOrientation=list(orn),
+        scale=1.0,
+        mass=0.1,
+        collisionMargin=0.01,
+        useMassSpring=1,
+        useBendingSprings=1,
+        useNeoHookean=0,
+        springElasticStiffness=10.0,
+        springDampingStiffness=0.002,
+        springDampingAllDirections=1,
+        springBendingStiffness=0.1,
+        useSelfCollision=0,
+        frictionCoeff=0.5,
+        physicsClientId=cid,
+    )
 
 
 def _nodes(cid, body):

@@ -48,7 +48,11 @@ def arm_env(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def limited_env(tmp_path_factory):
-    e = build(tmp_path_factory, "limited", "person:\n  impairments:\n    choices: [{kind: limited_range, joints: [person.right_arm], scale: 0.6}]\n")
+    e = build(
+        tmp_path_factory,
+        "limited",
+        "person:\n  impairments:\n    choices: [{kind: limited_range, joints: [person.right_arm], scale: 0.6}]\n",
+    )
     yield e
     e.close()
 
@@ -60,7 +64,9 @@ def person(env):
 
 def angles(env, joints) -> np.ndarray:
     p = person(env)
-    return np.array([s[0] for s in pb.getJointStates(p.id, [p.joints[j] for j in joints], physicsClientId=env.world.client)])
+    return np.array(
+        [s[0] for s in pb.getJointStates(p.id, [p.joints[j] for j in joints], physicsClientId=env.world.client)]
+    )
 
 
 def watch_physics_steps(env, check):
@@ -83,8 +89,17 @@ def test_human_spaces_and_observation(arm_env):
     m = arm_env.manifest
     policy = m.person.policy_joints
     assert policy == [
-        "right_pecs_x", "right_pecs_y", "right_pecs_z", "right_shoulder_x", "right_shoulder_y", "right_shoulder_z",
-        "right_elbow", "right_forearm", "right_wrist_x", "right_wrist_y"]
+        "right_pecs_x",
+        "right_pecs_y",
+        "right_pecs_z",
+        "right_shoulder_x",
+        "right_shoulder_y",
+        "right_shoulder_z",
+        "right_elbow",
+        "right_forearm",
+        "right_wrist_x",
+        "right_wrist_y",
+    ]
     assert arm_env.human_action_space.shape == (len(policy),)
     assert np.all(arm_env.human_action_space.low == -1) and np.all(arm_env.human_action_space.high == 1)
     size = sum(t.size for t in m.observations["human"])
@@ -139,8 +154,9 @@ def test_human_action_of_the_wrong_shape_is_refused(arm_env):
 def saturated_actions(n_joints: int, seed: int = 0) -> list[np.ndarray]:
     """100 steps of +1, 100 of −1, then 200 random ±1."""
     rng = np.random.default_rng(seed)
-    return ([np.ones(n_joints)] * 100 + [-np.ones(n_joints)] * 100
-            + [rng.choice([-1.0, 1.0], n_joints) for _ in range(200)])
+    return (
+        [np.ones(n_joints)] * 100 + [-np.ones(n_joints)] * 100 + [rng.choice([-1.0, 1.0], n_joints) for _ in range(200)]
+    )
 
 
 @pytest.mark.parametrize("which", ["urdf", "limited_range"])
@@ -196,8 +212,15 @@ def test_weaker_arm_reaches_less(tmp_path_factory):
     """Lifting the arm forward against gravity (shoulder flexion to 60°, the rest held by the same
     policy): with strength β = 0.25 the motors give a quarter of the torque and the elbow gets
     clearly less high than at full strength, for both body variants."""
-    strong = build(tmp_path_factory, "strong", "person:\n  impairments:\n    choices: [{kind: none}]\n", base=ARM_GRAVITY)
-    weak = build(tmp_path_factory, "weak", "person:\n  impairments:\n    choices: [{kind: weakness, strength: 0.25}]\n", base=ARM_GRAVITY)
+    strong = build(
+        tmp_path_factory, "strong", "person:\n  impairments:\n    choices: [{kind: none}]\n", base=ARM_GRAVITY
+    )
+    weak = build(
+        tmp_path_factory,
+        "weak",
+        "person:\n  impairments:\n    choices: [{kind: weakness, strength: 0.25}]\n",
+        base=ARM_GRAVITY,
+    )
     try:
         policy = strong.manifest.person.policy_joints
         assert weak.human.m.person.max_force == 12.0
@@ -303,7 +326,9 @@ def test_a_user_mlp_from_the_spec_limits_the_arm(tmp_path_factory):
 
 
 def test_tremor_on_policy_joints_flips_every_step(tmp_path_factory):
-    env = build(tmp_path_factory, "tremor", "person:\n  impairments:\n    choices: [{kind: tremor, amplitude_deg: 10}]\n")
+    env = build(
+        tmp_path_factory, "tremor", "person:\n  impairments:\n    choices: [{kind: tremor, amplitude_deg: 10}]\n"
+    )
     try:
         env.reset(seed=0)
         assert env.world.after_physics_step is not None  # a tremoring person is checked every physics step
@@ -351,7 +376,8 @@ def test_a_wrong_arm_limits_value_is_located(tmp_path, capsys):
     assert "Traceback" not in err
     assert err.strip().splitlines() == [
         f"{display(path)}:4:17: person.control.arm_limits: must be 'analytic', 'none' or the path of a .npz file, "
-        "got 'analytical' (did you mean 'analytic'?)"]
+        "got 'analytical' (did you mean 'analytic'?)"
+    ]
 
 
 def test_a_missing_arm_limits_file_is_located(tmp_path):

@@ -98,7 +98,11 @@ def test_a_patient_card_fixes_the_impairment(tmp_path):
     env = AssistiveEnv(compile_task(spec, "jaco", tmp_path / "out").out_dir)
     try:
         for seed in range(5):
-            assert env.reset(seed=seed)[1]["impairment"] == {"kind": "weakness", "joints": list(env.manifest.person.policy_joints), "strength": 0.4}
+            assert env.reset(seed=seed)[1]["impairment"] == {
+                "kind": "weakness",
+                "joints": list(env.manifest.person.policy_joints),
+                "strength": 0.4,
+            }
     finally:
         env.close()
 
@@ -107,8 +111,13 @@ def test_a_compliant_arm_yields_where_a_held_one_does_not(tmp_path):
     """control.compliant holds the named joints weakly (the reference's reactive hold): pushed by
     the same external torque, the compliant arm moves and the stiffly held one barely does."""
     moved = {}
-    for name, extra in (("compliant", "    compliant: {joints: [person.right_arm], max_force_nm: 1.0, position_gain: 0.01}\n"),
-                        ("held", "  randomize_deg: {head_x: {uniform: [-30, 30]}, head_y: {uniform: [-30, 30]}, head_z: {uniform: [-30, 30]}, right_elbow: {uniform: [-90, -90]}}\n")):
+    for name, extra in (
+        ("compliant", "    compliant: {joints: [person.right_arm], max_force_nm: 1.0, position_gain: 0.01}\n"),
+        (
+            "held",
+            "  randomize_deg: {head_x: {uniform: [-30, 30]}, head_y: {uniform: [-30, 30]}, head_z: {uniform: [-30, 30]}, right_elbow: {uniform: [-90, -90]}}\n",
+        ),
+    ):
         spec = tmp_path / f"{name}.yaml"
         text = f"extends: {FEEDING}\nperson:\n"
         text += ("  control:\n" + extra) if name == "compliant" else extra
@@ -120,7 +129,9 @@ def test_a_compliant_arm_yields_where_a_held_one_does_not(tmp_path):
         before = pb.getJointState(person.id, elbow, physicsClientId=c)[0]
         for _ in range(10):
             for _ in range(env.manifest.sim.frame_skip):
-                pb.applyExternalTorque(person.id, elbow, (20.0, 0, 0), pb.LINK_FRAME, physicsClientId=c)  # on the elbow joint's child link
+                pb.applyExternalTorque(
+                    person.id, elbow, (20.0, 0, 0), pb.LINK_FRAME, physicsClientId=c
+                )  # on the elbow joint's child link
                 pb.stepSimulation(physicsClientId=c)
         moved[name] = abs(pb.getJointState(person.id, elbow, physicsClientId=c)[0] - before)
         env.close()

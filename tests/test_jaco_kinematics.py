@@ -24,7 +24,6 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 import pytest
-
 from frames import body_indices, origin_matrix, rot_x, rot_z
 
 TEMPLATE = Path(__file__).resolve().parents[1] / "templates" / "robots" / "jaco.urdf.xacro"
@@ -80,10 +79,9 @@ def dh_fk(theta, d) -> np.ndarray:
     for th, alpha, di in zip(theta, DH_ALPHA, d):
         ct, st = math.cos(th), math.sin(th)
         ca, sa = math.cos(alpha), math.sin(alpha)
-        t = t @ np.array([[ct, -st * ca, st * sa, 0.0],
-                          [st, ct * ca, -ct * sa, 0.0],
-                          [0.0, sa, ca, di],
-                          [0.0, 0.0, 0.0, 1.0]])
+        t = t @ np.array(
+            [[ct, -st * ca, st * sa, 0.0], [st, ct * ca, -ct * sa, 0.0], [0.0, sa, ca, di], [0.0, 0.0, 0.0, 1.0]]
+        )
     return t
 
 
@@ -102,8 +100,14 @@ def bullet(urdf_path):
     """(client, body, joint index by joint name, link index by link name)."""
     cid = pb.connect(pb.DIRECT)
     # Loaded at the origin with identity orientation: world frame == URDF base frame.
-    body = pb.loadURDF(str(urdf_path), [0, 0, 0], [0, 0, 0, 1], useFixedBase=True,
-                       flags=pb.URDF_USE_SELF_COLLISION, physicsClientId=cid)
+    body = pb.loadURDF(
+        str(urdf_path),
+        [0, 0, 0],
+        [0, 0, 0, 1],
+        useFixedBase=True,
+        flags=pb.URDF_USE_SELF_COLLISION,
+        physicsClientId=cid,
+    )
     joints, links = body_indices(cid, body)
     yield cid, body, joints, links
     pb.disconnect(cid)
@@ -122,8 +126,7 @@ def bullet_ee(bullet, q) -> np.ndarray:
     cid, body, joints, links = bullet
     for name, v in zip(ARM_JOINTS, q):
         pb.resetJointState(body, joints[name], float(v), physicsClientId=cid)
-    ls = pb.getLinkState(body, links["j2s7s300_end_effector"], computeForwardKinematics=True,
-                         physicsClientId=cid)
+    ls = pb.getLinkState(body, links["j2s7s300_end_effector"], computeForwardKinematics=True, physicsClientId=cid)
     t = np.eye(4)
     t[:3, :3] = np.array(pb.getMatrixFromQuaternion(ls[5])).reshape(3, 3)
     t[:3, 3] = ls[4]
@@ -150,8 +153,7 @@ def test_names_and_tree(model):
 
 def test_joint_origins_exact(model):
     for name, (xyz, rpy) in JOINT_ORIGINS.items():
-        np.testing.assert_allclose(model.joint_map[name].origin, origin_matrix(xyz, rpy),
-                                   atol=1e-9, err_msg=name)
+        np.testing.assert_allclose(model.joint_map[name].origin, origin_matrix(xyz, rpy), atol=1e-9, err_msg=name)
 
 
 def test_link_masses_and_coms(model):

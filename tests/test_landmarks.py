@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pybullet as pb
 import pytest
+from conftest import FEEDING
 
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.errors import SpecError
@@ -13,7 +14,6 @@ from assistive_compiler.library import Library
 from assistive_compiler.person.landmarks import LANDMARKS, landmark_offsets
 from assistive_compiler.rotation import quat_rotate
 from assistive_compiler.runtime.env import AssistiveEnv
-from conftest import FEEDING
 
 
 def offsets(variant: str) -> dict:
@@ -25,7 +25,11 @@ def test_landmarks_follow_each_variants_body():
     assert set(male) == set(LANDMARKS)
     # The hand is a sphere hanging below the wrist joint (r 4.3 cm male, 3.5 cm female): the
     # fingertips are its far end, the palm its side toward the body (+x for the right hand).
-    assert male["right_fingertips"] == ("right_wrist", (0.0, 0.0, -0.086)) and female["right_fingertips"][1] == (0.0, 0.0, -0.071)
+    assert male["right_fingertips"] == ("right_wrist", (0.0, 0.0, -0.086)) and female["right_fingertips"][1] == (
+        0.0,
+        0.0,
+        -0.071,
+    )
     assert male["right_palm"][1] == (0.043, 0.0, -0.043) and male["left_palm"][1] == (-0.043, 0.0, -0.043)
     # The face: the mouth in front of the jaw, the nose above it, the chin below, cheeks to the sides.
     mouth, nose, chin = male["mouth"][1], male["nose"][1], male["chin"][1]
@@ -38,9 +42,11 @@ def test_landmarks_follow_each_variants_body():
 
 def test_a_landmark_is_a_point_and_a_target_link_in_a_compiled_task(tmp_path):
     spec = tmp_path / "chin.yaml"
-    spec.write_text(f"extends: {FEEDING}\nname: feeding_chin\ntargets:\n"
-                    "  chin_goal: {link: person.chin, offset_m: [0, -0.05, 0]}\n"
-                    "observations:\n  robot:\n    - {term: displacement, params: {of: spoon, to: person.nose}}\n")
+    spec.write_text(
+        f"extends: {FEEDING}\nname: feeding_chin\ntargets:\n"
+        "  chin_goal: {link: person.chin, offset_m: [0, -0.05, 0]}\n"
+        "observations:\n  robot:\n    - {term: displacement, params: {of: spoon, to: person.nose}}\n"
+    )
     result = compile_task(spec, "jaco", tmp_path / "out")
     m = result.manifest
     assert m.targets["chin_goal"].link == "head" and m.targets["person.nose"].link == "head"
@@ -50,7 +56,9 @@ def test_a_landmark_is_a_point_and_a_target_link_in_a_compiled_task(tmp_path):
             env.reset(seed=seed)
             variant = env.world.active_variant.name
             handle = env.world.bodies[env.world.active_variant.body]
-            state = pb.getLinkState(handle.id, handle.links["head"], computeForwardKinematics=1, physicsClientId=env.world.client)
+            state = pb.getLinkState(
+                handle.id, handle.links["head"], computeForwardKinematics=1, physicsClientId=env.world.client
+            )
             # The nose, which an observation term reads, where the variant's head has it.
             nose = np.asarray(state[4]) + quat_rotate(np.asarray(state[5]), np.asarray(offsets(variant)["nose"][1]))
             got = env.snap.position(env.snap.point({"target": "person.nose"}))

@@ -200,13 +200,10 @@ BROKEN_CASES = {
         "link 'forearm': principal moments (0.1, 0.1, 0.3) kg*m^2 break the triangle "
         "inequality: 0.3 > 0.1 + 0.1; expected each moment <= the sum of the other two"
     ],
-    "limits_reversed": [
-        "joint 'elbow': lower limit 1.5 is not below upper limit -1.5; expected lower < upper"
-    ],
+    "limits_reversed": ["joint 'elbow': lower limit 1.5 is not below upper limit -1.5; expected lower < upper"],
     "zero_axis": ["joint 'elbow': axis is (0.0, 0.0, 0.0); expected a non-zero unit vector"],
     "non_unit_axis": [
-        "joint 'elbow': axis (0.0, 0.0, 2.0) has length 2; expected a unit vector "
-        "(length 1 within 1e-6)"
+        "joint 'elbow': axis (0.0, 0.0, 2.0) has length 2; expected a unit vector (length 1 within 1e-6)"
     ],
     "no_effort_velocity": [
         "joint 'elbow': <limit> has no effort; expected effort > 0",
@@ -258,10 +255,7 @@ def _one_link(body: str, name: str = "solo") -> str:
 
 def _two_links(joint: str) -> str:
     inertial = INERTIAL.format(m=1.0, i=0.01)
-    return (
-        f'<robot name="r"><link name="a">{inertial}</link><link name="b">{inertial}</link>'
-        f"{joint}</robot>"
-    )
+    return f'<robot name="r"><link name="a">{inertial}</link><link name="b">{inertial}</link>{joint}</robot>'
 
 
 def _messages(xml: str, **kwargs) -> list[str]:
@@ -284,8 +278,7 @@ def test_malformed_document_is_one_problem() -> None:
 
 def test_missing_inertial_and_non_finite_numbers() -> None:
     assert _messages(_one_link("")) == [
-        "link 'solo': has no <inertial>; expected an <inertial> with a positive <mass value> "
-        "and an <inertia>"
+        "link 'solo': has no <inertial>; expected an <inertial> with a positive <mass value> and an <inertia>"
     ]
     body = INERTIAL.format(m="nan", i=0.01).replace('xyz="0 0 0"', 'xyz="0 inf 0"')
     assert _messages(_one_link(body)) == [
@@ -306,8 +299,7 @@ def test_geometry_sizes_and_unknown_shapes() -> None:
     assert _messages(_one_link(body)) == [
         "link 'solo': collision 1: box size is (0.1, 0.0, 0.1); expected three positive sizes",
         "link 'solo': collision 2: sphere radius is -0.1; expected a positive radius",
-        "link 'solo': collision 3: geometry <cone> is not supported; expected one of box, "
-        "cylinder, sphere, mesh",
+        "link 'solo': collision 3: geometry <cone> is not supported; expected one of box, cylinder, sphere, mesh",
         "link 'solo': visual 1: cylinder has no length; expected a positive length in metres",
     ]
 
@@ -345,10 +337,7 @@ def test_joint_types_limits_and_continuous_joints() -> None:
         "joint 'free': type 'floating' is not allowed in generated scenes; expected one of "
         "revolute, continuous, prismatic, fixed"
     ]
-    no_limit = (
-        '<joint name="spin" type="continuous"><parent link="a"/><child link="b"/>'
-        '<axis xyz="0 0 1"/></joint>'
-    )
+    no_limit = '<joint name="spin" type="continuous"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/></joint>'
     assert _messages(_two_links(no_limit)) == [
         "joint 'spin': continuous joint has no <limit>; expected <limit effort velocity> with "
         "effort > 0 and velocity > 0"
@@ -366,10 +355,8 @@ def test_joint_types_limits_and_continuous_joints() -> None:
 def test_structure_names_parents_and_cycles() -> None:
     missing = '<joint name="j" type="fixed"><parent link="a"/><child link="ghost"/></joint>'
     assert _messages(_two_links(missing)) == [
-        "joint 'j': child link 'ghost' does not exist; expected the name of a link in this "
-        "document",
-        "robot 'r': has 2 root links ('a', 'b'); expected exactly one root link (connect the "
-        "others with joints)",
+        "joint 'j': child link 'ghost' does not exist; expected the name of a link in this document",
+        "robot 'r': has 2 root links ('a', 'b'); expected exactly one root link (connect the others with joints)",
     ]
     cycle = (
         '<joint name="j1" type="fixed"><parent link="a"/><child link="b"/></joint>'
@@ -390,9 +377,7 @@ def test_structure_names_parents_and_cycles() -> None:
     inertial = INERTIAL.format(m=1.0, i=0.01)
     link = f'<link name="a">{inertial}</link>'
     duplicate = f'<robot name="r">{link}{link}</robot>'
-    assert _messages(duplicate) == [
-        "link 'a': name is used by 2 links; expected unique link names"
-    ]
+    assert _messages(duplicate) == ["link 'a': name is used by 2 links; expected unique link names"]
 
 
 # --------------------------------------------------------------------------- external checks
@@ -411,17 +396,13 @@ def test_urdfdom_reports_joint_with_missing_link(tmp_path: Path) -> None:
 
 
 def test_urdfdom_reports_capsule_even_with_exit_status_zero(tmp_path: Path) -> None:
-    capsule = VALID_URDF.replace(
-        '<sphere radius="0.03"/>', '<capsule radius="0.03" length="0.1"/>'
-    )
+    capsule = VALID_URDF.replace('<sphere radius="0.03"/>', '<capsule radius="0.03" length="0.1"/>')
     path = _write(tmp_path, "capsule.urdf", capsule)
     assert any("Could not parse collision element" in line for line in check_with_urdfdom(path))
     assert any("capsule" in line for line in check_with_yourdfpy(path))
 
 
-def test_pybullet_warnings_are_captured_and_fds_restored(
-    tmp_path: Path, capfd: pytest.CaptureFixture[str]
-) -> None:
+def test_pybullet_warnings_are_captured_and_fds_restored(tmp_path: Path, capfd: pytest.CaptureFixture[str]) -> None:
     no_inertial = (
         '<robot name="r"><link name="base"/><link name="tip"/>'
         '<joint name="j" type="fixed"><parent link="base"/><child link="tip"/></joint></robot>'
@@ -451,9 +432,7 @@ def test_pybullet_is_not_asked_to_load_a_forest(tmp_path: Path) -> None:
     assert check_with_urdfdom(path)
 
 
-def test_missing_check_urdf_names_the_pip_package(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_missing_check_urdf_names_the_pip_package(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(sys, "executable", str(tmp_path / "python"))
     monkeypatch.setenv("PATH", str(tmp_path))
     with pytest.raises(FileNotFoundError, match="cmeel-urdfdom"):

@@ -35,8 +35,9 @@ TEMPLATE = REPO / "templates" / "person" / "person.urdf.xacro"
 HEAD_CHAIN = ("neck", "head_x", "head_y", "head_z")
 # Seated posture: arms bent forward, thighs forward, knees bent; every other joint at 0.
 POSTURE = {name: 0.0 for name in REVOLUTE_JOINTS if name not in HEAD_CHAIN}
-POSTURE.update(right_elbow=-1.5708, left_elbow=-1.5708, right_hip_x=-1.5708, left_hip_x=-1.5708,
-               right_knee=1.396, left_knee=1.396)
+POSTURE.update(
+    right_elbow=-1.5708, left_elbow=-1.5708, right_hip_x=-1.5708, left_hip_x=-1.5708, right_knee=1.396, left_knee=1.396
+)
 # Where both bodies stand: the chest frame's world pose (tilted, so no frame is world-aligned).
 BASE_POS = (0.3, -0.2, 1.1)
 BASE_ORN = p.getQuaternionFromEuler((0.05, -0.1, 0.4))
@@ -62,8 +63,7 @@ def person(tmp_path_factory):
     for name, text in (("original", original), ("merged", merged), ("kept", kept)):
         paths[name] = out / f"{name}.urdf"
         paths[name].write_text(text)
-    return dict(original=original, merged=merged, frames=frames, kept=kept,
-                kept_frames=kept_frames, paths=paths)
+    return dict(original=original, merged=merged, frames=frames, kept=kept, kept_frames=kept_frames, paths=paths)
 
 
 @pytest.fixture()
@@ -85,13 +85,14 @@ def two_clients():
 
 
 def load(cid: int, path: Path, *, fixed: bool = True, flags: int = 0) -> int:
-    return p.loadURDF(str(path), BASE_POS, BASE_ORN, useFixedBase=fixed, flags=flags,
-                      physicsClientId=cid)
+    return p.loadURDF(str(path), BASE_POS, BASE_ORN, useFixedBase=fixed, flags=flags, physicsClientId=cid)
 
 
 def joints_by_name(cid: int, bid: int) -> dict[str, int]:
-    return {p.getJointInfo(bid, i, physicsClientId=cid)[1].decode(): i
-            for i in range(p.getNumJoints(bid, physicsClientId=cid))}
+    return {
+        p.getJointInfo(bid, i, physicsClientId=cid)[1].decode(): i
+        for i in range(p.getNumJoints(bid, physicsClientId=cid))
+    }
 
 
 def set_head(cid: int, bid: int, angles) -> None:
@@ -184,8 +185,9 @@ def world_inertia_from_urdf(xml: str, frames: dict[str, np.ndarray]) -> tuple[fl
             continue
         t = frames[link.get("name")] @ origin_of(inertial)
         v = {k: float(inertial.find("inertia").get(k)) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
-        local = np.array([[v["ixx"], v["ixy"], v["ixz"]], [v["ixy"], v["iyy"], v["iyz"]],
-                          [v["ixz"], v["iyz"], v["izz"]]])
+        local = np.array(
+            [[v["ixx"], v["ixy"], v["ixz"]], [v["ixy"], v["iyy"], v["iyz"]], [v["ixz"], v["iyz"], v["izz"]]]
+        )
         r, c, m = t[:3, :3], t[:3, 3], float(inertial.find("mass").get("value"))
         total += m
         first += m * c
@@ -271,8 +273,9 @@ def ray_hits(cid: int, bid: int, starts, ends) -> tuple[np.ndarray, np.ndarray]:
 
 def test_merged_person_has_only_the_head_chain_and_the_same_mass(person, client):
     merged = load(client, person["paths"]["merged"], fixed=False)
-    infos = [p.getJointInfo(merged, i, physicsClientId=client)
-             for i in range(p.getNumJoints(merged, physicsClientId=client))]
+    infos = [
+        p.getJointInfo(merged, i, physicsClientId=client) for i in range(p.getNumJoints(merged, physicsClientId=client))
+    ]
     assert [info[1].decode() for info in infos] == list(HEAD_CHAIN)
     assert all(info[2] == p.JOINT_REVOLUTE for info in infos)
     assert p.getBodyInfo(merged, physicsClientId=client)[0].decode() == "chest"
@@ -285,8 +288,10 @@ def test_merged_person_has_only_the_head_chain_and_the_same_mass(person, client)
     assert p.getNumJoints(original, physicsClientId=client) == 42
 
     def weigh(bid: int) -> float:
-        return sum(p.getDynamicsInfo(bid, i, physicsClientId=client)[0]
-                   for i in range(-1, p.getNumJoints(bid, physicsClientId=client)))
+        return sum(
+            p.getDynamicsInfo(bid, i, physicsClientId=client)[0]
+            for i in range(-1, p.getNumJoints(bid, physicsClientId=client))
+        )
 
     assert weigh(merged) == pytest.approx(weigh(original), rel=1e-9)
     assert sum(urdf_masses(person["merged"])) == pytest.approx(sum(urdf_masses(person["original"])), rel=1e-9)
@@ -330,15 +335,17 @@ def test_whole_body_com_and_inertia_match(person, two_clients):
     base[:3, 3] = BASE_POS
     for head in HEAD_ANGLES[:2]:
         angles = dict(zip(HEAD_CHAIN, head))
-        m0, c0, i0 = world_inertia_from_urdf(person["original"], {
-            k: base @ v for k, v in numpy_fk(person["original"], angles).items()})
-        m1, c1, i1 = world_inertia_from_urdf(person["merged"], {
-            k: base @ v for k, v in numpy_fk(person["merged"], angles).items()})
+        m0, c0, i0 = world_inertia_from_urdf(
+            person["original"], {k: base @ v for k, v in numpy_fk(person["original"], angles).items()}
+        )
+        m1, c1, i1 = world_inertia_from_urdf(
+            person["merged"], {k: base @ v for k, v in numpy_fk(person["merged"], angles).items()}
+        )
         assert m1 == pytest.approx(m0, rel=1e-9)
         assert np.allclose(c1, c0, rtol=0, atol=1e-9)
         assert np.allclose(i1, i0, rtol=0, atol=1e-9 * np.abs(i0).max())
     # The merged chest really carries off-diagonal inertia (the bent limbs), written unrotated.
-    chest = next(l for l in ET.fromstring(person["merged"]).iter("link") if l.get("name") == "chest")
+    chest = next(link for link in ET.fromstring(person["merged"]).iter("link") if link.get("name") == "chest")
     assert chest.find("inertial/origin").get("rpy") == "0.0 0.0 0.0"
     assert float(chest.find("inertial/inertia").get("iyz")) != 0.0
 
@@ -373,8 +380,14 @@ def test_collision_geometry_is_equivalent(person, two_clients):
         assert len(after) == len(before) > 0
         unused = list(after)
         for desc, pos, rot in before:
-            match = next((s for s in unused if s[0] == desc and np.abs(s[1] - pos).max() < 1e-6
-                          and cylinder_axis_free(desc, s[2], rot)), None)
+            match = next(
+                (
+                    s
+                    for s in unused
+                    if s[0] == desc and np.abs(s[1] - pos).max() < 1e-6 and cylinder_axis_free(desc, s[2], rot)
+                ),
+                None,
+            )
             assert match is not None, (tag, desc, pos)
             unused.remove(match)
 
@@ -405,8 +418,7 @@ def test_merged_urdf_passes_check_urdf_and_lint(person):
     if not exe.is_file():
         pytest.skip("check_urdf (cmeel-urdfdom) not installed next to the interpreter")
     for name in ("merged", "kept"):
-        res = subprocess.run([str(exe), str(person["paths"][name])], capture_output=True, text=True,
-                             timeout=30)
+        res = subprocess.run([str(exe), str(person["paths"][name])], capture_output=True, text=True, timeout=30)
         assert res.returncode == 0, res.stdout + res.stderr
         assert "Successfully Parsed XML" in res.stdout
         assert "error" not in (res.stdout + res.stderr).lower()
@@ -419,8 +431,9 @@ def test_keep_leaves_a_link_on_its_fixed_joint(person, two_clients):
     c_orig, c_kept = two_clients
     original = load(c_orig, person["paths"]["original"])
     kept = load(c_kept, person["paths"]["kept"])
-    infos = [p.getJointInfo(kept, i, physicsClientId=c_kept)
-             for i in range(p.getNumJoints(kept, physicsClientId=c_kept))]
+    infos = [
+        p.getJointInfo(kept, i, physicsClientId=c_kept) for i in range(p.getNumJoints(kept, physicsClientId=c_kept))
+    ]
     assert len(infos) == 5
     wrist = next(info for info in infos if info[12].decode() == "right_wrist")
     assert wrist[1].decode() == "right_wrist_y" and wrist[2] == p.JOINT_FIXED
@@ -476,9 +489,10 @@ SMALL = """<?xml version="1.0"?>
 def test_small_merge_by_hand():
     out, frames = merge_fixed_links(SMALL)
     root = ET.fromstring(out)
-    assert [l.get("name") for l in root.iter("link")] == ["base", "tip"]
-    assert frames == {"arm": MergedFrame("base", (1.0, 0.0, 0.0),
-                                         (0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4)))}
+    assert [link.get("name") for link in root.iter("link")] == ["base", "tip"]
+    assert frames == {
+        "arm": MergedFrame("base", (1.0, 0.0, 0.0), (0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4)))
+    }
     base = root.find("link")
     # arm's tensor: Ry(90deg) swaps x and z -> diag(6, 5, 4); Rz(90deg) swaps x and y ->
     # diag(5, 6, 4). COM at (0.5, 0, 0); each 2 kg mass 0.5 m off along x adds 0.5 to iyy, izz.
@@ -503,7 +517,7 @@ def test_small_merge_by_hand():
     with pytest.raises(ValueError, match="armm"):
         merge_fixed_links(SMALL, keep=["armm"])
     kept, none = merge_fixed_links(SMALL, keep=["arm"])
-    assert none == {} and [l.get("name") for l in ET.fromstring(kept).iter("link")] == ["base", "arm", "tip"]
+    assert none == {} and [link.get("name") for link in ET.fromstring(kept).iter("link")] == ["base", "arm", "tip"]
 
 
 # --------------------------------------------------------------------------- step time
@@ -520,9 +534,14 @@ def test_step_time_original_vs_merged(person):
             p.setGravity(0, 0, -9.81, physicsClientId=cid)
             bid = load(cid, path, flags=p.URDF_USE_INERTIA_FROM_FILE)
             index = joints_by_name(cid, bid)
-            p.setJointMotorControlArray(bid, [index[j] for j in HEAD_CHAIN], p.POSITION_CONTROL,
-                                        targetPositions=[0.1, -0.2, 0.15, 0.3], forces=[40, 30, 30, 20],
-                                        physicsClientId=cid)
+            p.setJointMotorControlArray(
+                bid,
+                [index[j] for j in HEAD_CHAIN],
+                p.POSITION_CONTROL,
+                targetPositions=[0.1, -0.2, 0.15, 0.3],
+                forces=[40, 30, 30, 20],
+                physicsClientId=cid,
+            )
             for _ in range(20):
                 p.stepSimulation(physicsClientId=cid)
             start = time.perf_counter()
@@ -537,7 +556,9 @@ def test_step_time_original_vs_merged(person):
         for name in times:  # interleaved, so drift hits both alike
             times[name].append(one_run(person["paths"][name]))
     med = {name: statistics.median(ts) for name, ts in times.items()}
-    print(f"\nstepSimulation x300 (median of 5): original (43 links) {med['original'] * 1e3:.2f} ms "
-          f"= {med['original'] / 300 * 1e6:.1f} us/step; merged (5 links) {med['merged'] * 1e3:.2f} ms "
-          f"= {med['merged'] / 300 * 1e6:.1f} us/step; speed-up x{med['original'] / med['merged']:.2f}")
+    print(
+        f"\nstepSimulation x300 (median of 5): original (43 links) {med['original'] * 1e3:.2f} ms "
+        f"= {med['original'] / 300 * 1e6:.1f} us/step; merged (5 links) {med['merged'] * 1e3:.2f} ms "
+        f"= {med['merged'] / 300 * 1e6:.1f} us/step; speed-up x{med['original'] / med['merged']:.2f}"
+    )
     assert med["merged"] < med["original"]

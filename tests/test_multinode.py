@@ -44,9 +44,16 @@ def _namespaces_work(tmp_path: Path) -> str | None:
         return "no unshare command"
     probe = tmp_path / "probe"
     probe.mkdir()
-    result = subprocess.run(["unshare", "--mount", "--propagation", "private", "sh", "-c", f"mount -t tmpfs tmpfs {probe}"],
-                            capture_output=True, text=True)
-    return None if result.returncode == 0 else f"mount namespaces unavailable here ({result.stderr.strip() or result.returncode})"
+    result = subprocess.run(
+        ["unshare", "--mount", "--propagation", "private", "sh", "-c", f"mount -t tmpfs tmpfs {probe}"],
+        capture_output=True,
+        text=True,
+    )
+    return (
+        None
+        if result.returncode == 0
+        else f"mount namespaces unavailable here ({result.stderr.strip() or result.returncode})"
+    )
 
 
 def forget_cluster(port: int) -> None:
@@ -89,11 +96,23 @@ class Cluster:
         self.env.update(HOME=str(home), RAY_AUTH_MODE="token")
         self.port = _free_port()
         self.address = f"127.0.0.1:{self.port}"
-        self.ray_cli = [sys.executable, "-m", "ray.scripts.scripts", "start", "--block", "--object-store-memory=150000000"]
-        self.temp = tempfile.mkdtemp(prefix="rayt-", dir="/tmp")  # short (Unix socket paths); keeps the address file out of /tmp/ray
+        self.ray_cli = [
+            sys.executable,
+            "-m",
+            "ray.scripts.scripts",
+            "start",
+            "--block",
+            "--object-store-memory=150000000",
+        ]
+        self.temp = tempfile.mkdtemp(
+            prefix="rayt-", dir="/tmp"
+        )  # short (Unix socket paths); keeps the address file out of /tmp/ray
         self.log = root / "ray.log"
         self.procs: list[subprocess.Popen] = []
-        self._start(self.ray_cli + ["--head", f"--port={self.port}", "--num-cpus=0", "--include-dashboard=false", f"--temp-dir={self.temp}"])
+        self._start(
+            self.ray_cli
+            + ["--head", f"--port={self.port}", "--num-cpus=0", "--include-dashboard=false", f"--temp-dir={self.temp}"]
+        )
         _wait_for_port(self.port)
 
     @property
@@ -102,8 +121,15 @@ class Cluster:
 
     def _start(self, command: list[str]) -> subprocess.Popen:
         with self.log.open("a") as out:
-            proc = subprocess.Popen(command, env=self.env if command[0] != "unshare" else {**self.env, "ASSISTIVE_COMPILER_CACHE": str(self.hidden / "worker-cache")},
-                                    stdout=out, stderr=out, start_new_session=True)
+            proc = subprocess.Popen(
+                command,
+                env=self.env
+                if command[0] != "unshare"
+                else {**self.env, "ASSISTIVE_COMPILER_CACHE": str(self.hidden / "worker-cache")},
+                stdout=out,
+                stderr=out,
+                start_new_session=True,
+            )
         self.procs.append(proc)
         return proc
 
@@ -111,8 +137,17 @@ class Cluster:
         """A worker node with ``cpus`` CPUs that cannot see ``hidden``; returns once the head counts
         ``cluster_cpus`` in all."""
         worker_cmd = " ".join(self.ray_cli + [f"--address={self.address}", f"--num-cpus={cpus}"])
-        worker = self._start(["unshare", "--mount", "--propagation", "private", "sh", "-c",
-                              f"mount -t tmpfs tmpfs {self.hidden} && exec {worker_cmd}"])
+        worker = self._start(
+            [
+                "unshare",
+                "--mount",
+                "--propagation",
+                "private",
+                "sh",
+                "-c",
+                f"mount -t tmpfs tmpfs {self.hidden} && exec {worker_cmd}",
+            ]
+        )
         _wait_for_worker_node(self.port, self.env, self.log, cpus=cluster_cpus)
         return worker
 
@@ -160,20 +195,48 @@ def cluster(tmp_path_factory):
 
 def _wait_for_worker_node(port: int, env: dict, log: Path, seconds: float = 90, cpus: int = 2) -> None:
     """Until the head counts ``cpus`` CPUs (the worker nodes'); fails with the nodes' log otherwise."""
-    probe = ("import ray, time, sys\n"
-             f"ray.init(address='127.0.0.1:{port}', log_to_driver=False)\n"
-             f"deadline = time.time() + {seconds}\n"
-             f"while ray.cluster_resources().get('CPU', 0) < {cpus} and time.time() < deadline:\n"
-             "    time.sleep(1)\n"
-             f"sys.exit(0 if ray.cluster_resources().get('CPU', 0) >= {cpus} else 1)\n")
-    result = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True, timeout=seconds + 60)
+    probe = (
+        "import ray, time, sys\n"
+        f"ray.init(address='127.0.0.1:{port}', log_to_driver=False)\n"
+        f"deadline = time.time() + {seconds}\n"
+        f"while ray.cluster_resources().get('CPU', 0) < {cpus} and time.time() < deadline:\n"
+        "    time.sleep(1)\n"
+        f"sys.exit(0 if ray.cluster_resources().get('CPU', 0) >= {cpus} else 1)\n"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", probe], env=env, capture_output=True, text=True, timeout=seconds + 60
+    )
     assert result.returncode == 0, f"the worker node did not join: {log.read_text()[-2000:]}"
 
 
 def _train(address: str, out: Path, env: dict, config: Path, *extra: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "assistive_compiler.cli", "train", str(FEEDING), "--robot", "jaco", "--config",
-                           str(config), "--engine", "rllib", "--address", address, "--out", str(out), "--quiet", "--json", *extra],
-                          env=env, capture_output=True, text=True, timeout=300, cwd=REPO)
+    return subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "assistive_compiler.cli",
+            "train",
+            str(FEEDING),
+            "--robot",
+            "jaco",
+            "--config",
+            str(config),
+            "--engine",
+            "rllib",
+            "--address",
+            address,
+            "--out",
+            str(out),
+            "--quiet",
+            "--json",
+            *extra,
+        ],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=REPO,
+    )
 
 
 @pytest.mark.slow
@@ -187,8 +250,14 @@ def test_train_on_a_worker_that_cannot_see_the_drivers_files(cluster, coop, tmp_
     assert result.returncode == 0, result.stderr[-3000:]
     summary = json.loads(result.stdout)
     assert summary["steps"] >= 200 and summary["engine"] == "rllib"
-    evaluation = subprocess.run([sys.executable, "-m", "assistive_compiler.cli", "evaluate", str(out), "--episodes", "1", "--json"],
-                                env=env, capture_output=True, text=True, timeout=300, cwd=REPO)
+    evaluation = subprocess.run(
+        [sys.executable, "-m", "assistive_compiler.cli", "evaluate", str(out), "--episodes", "1", "--json"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=REPO,
+    )
     assert evaluation.returncode == 0, evaluation.stderr[-3000:]
     assert json.loads(evaluation.stdout)["coop"] is coop
 
@@ -196,9 +265,28 @@ def test_train_on_a_worker_that_cannot_see_the_drivers_files(cluster, coop, tmp_
 def _train_and_kill_a_node_mid_run(c: Cluster, config: Path, out: Path, node: subprocess.Popen):
     """Start ``train --address`` in the background, SIGKILL ``node`` once the run's first checkpoint
     is written (the run still going), and wait for the driver: (driver, stdout, stderr)."""
-    command = [sys.executable, "-m", "assistive_compiler.cli", "train", str(FEEDING), "--robot", "jaco", "--config", str(config),
-               "--engine", "rllib", "--address", c.address, "--out", str(out), "--quiet", "--json"]
-    driver = subprocess.Popen(command, env=c.driver_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO)
+    command = [
+        sys.executable,
+        "-m",
+        "assistive_compiler.cli",
+        "train",
+        str(FEEDING),
+        "--robot",
+        "jaco",
+        "--config",
+        str(config),
+        "--engine",
+        "rllib",
+        "--address",
+        c.address,
+        "--out",
+        str(out),
+        "--quiet",
+        "--json",
+    ]
+    driver = subprocess.Popen(
+        command, env=c.driver_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO
+    )
     try:
         deadline = time.time() + 240
         while not list((out / "checkpoints").glob("step_*")) and time.time() < deadline and driver.poll() is None:
@@ -229,8 +317,10 @@ def test_a_worker_node_lost_mid_run_stops_with_a_checkpoint_and_resume_finishes(
         out = c.hidden / "run"
         driver, stdout, stderr = _train_and_kill_a_node_mid_run(c, config, out, worker)
         assert driver.returncode == 130, stderr[-3000:]
-        assert "stopped: all 2 env runners were lost (the node they ran on died or left the cluster); checkpoint written: " \
-               "start a worker node again and run the same command with --resume" in stderr, stderr[-3000:]
+        assert (
+            "stopped: all 2 env runners were lost (the node they ran on died or left the cluster); checkpoint written: "
+            "start a worker node again and run the same command with --resume" in stderr
+        ), stderr[-3000:]
         summary = json.loads(stdout)
         assert summary["interrupted"] and 200 <= summary["steps"] < 1_000_000
         stopped_at = summary["steps"]

@@ -11,14 +11,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import cli
 
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.errors import SpecError
 from assistive_compiler.paths import specs_dir
 from assistive_compiler.runtime.env import AssistiveEnv
 from assistive_compiler.terms.registry import terms
-
-from helpers import cli
 
 TASKS = specs_dir() / "tasks"
 FEEDING = TASKS / "feeding.yaml"
@@ -67,8 +66,19 @@ def test_schema_terms_prints_each_description_whole():
 
 @pytest.mark.slow
 def test_bench_over_two_specs_prints_a_progress_line_per_spec():
-    status, out, err = cli("bench", str(FEEDING), str(TASKS / "drinking.yaml"), "--robot", "jaco",
-                           "--steps", "10", "--repeats", "1", "--resets", "2")
+    status, out, err = cli(
+        "bench",
+        str(FEEDING),
+        str(TASKS / "drinking.yaml"),
+        "--robot",
+        "jaco",
+        "--steps",
+        "10",
+        "--repeats",
+        "1",
+        "--resets",
+        "2",
+    )
     assert status == 0, err
     lines = [line for line in err.splitlines() if line.startswith("[")]
     assert [line[:5] for line in lines] == ["[1/2]", "[2/2]"]
@@ -96,8 +106,22 @@ def _gif_ms(path: Path) -> int:
 def test_mp4_output(feeding, tmp_path):
     import av
 
-    status, out, err = cli("render", str(FEEDING), "--robot", "jaco", "--out-dir", str(feeding), "--width", "65", "--height", "49",
-                           "--every", "10", "--out", str(tmp_path / "e.mp4"))
+    status, out, err = cli(
+        "render",
+        str(FEEDING),
+        "--robot",
+        "jaco",
+        "--out-dir",
+        str(feeding),
+        "--width",
+        "65",
+        "--height",
+        "49",
+        "--every",
+        "10",
+        "--out",
+        str(tmp_path / "e.mp4"),
+    )
     assert status == 0, err
     with av.open(str(tmp_path / "e.mp4")) as container:
         stream = container.streams.video[0]
@@ -107,9 +131,13 @@ def test_mp4_output(feeding, tmp_path):
 
 
 def test_camera_option_is_parsed_and_misuse_is_explained(feeding, tmp_path):
-    status, _, err = cli("render", str(FEEDING), "--out-dir", str(feeding), "--out", str(tmp_path / "x.png"), "--camera", "eye=1,2")
+    status, _, err = cli(
+        "render", str(FEEDING), "--out-dir", str(feeding), "--out", str(tmp_path / "x.png"), "--camera", "eye=1,2"
+    )
     assert status == 2 and "--camera:1:1: 'eye=1,2': expected eye=X,Y,Z, target=X,Y,Z or fov=DEG" in err
-    env = AssistiveEnv(feeding, render_mode="rgb_array", render_size=(64, 48), camera={"eye": (0.0, -2.0, 1.2), "fov_deg": 30.0})
+    env = AssistiveEnv(
+        feeding, render_mode="rgb_array", render_size=(64, 48), camera={"eye": (0.0, -2.0, 1.2), "fov_deg": 30.0}
+    )
     env.reset(seed=0)
     default = AssistiveEnv(feeding, render_mode="rgb_array", render_size=(64, 48))
     default.reset(seed=0)
@@ -120,11 +148,27 @@ def test_camera_option_is_parsed_and_misuse_is_explained(feeding, tmp_path):
 def _returns(command: str, spec: Path, robot: str, tmp_path: Path) -> float:
     out = tmp_path / f"{spec.stem}-{robot}"
     if command == "run":
-        status, text, err = cli("run", str(spec), "--robot", robot, "--episodes", "1", "--json", "--quiet", "--out", str(out))
+        status, text, err = cli(
+            "run", str(spec), "--robot", robot, "--episodes", "1", "--json", "--quiet", "--out", str(out)
+        )
         assert status == 0, err
         return json.loads(text)["episodes"][0]["return"]
-    status, text, err = cli("render", str(spec), "--robot", robot, "--out-dir", str(out), "--out", str(tmp_path / f"{spec.stem}.png"),
-                            "--width", "32", "--height", "24", "--every", "1")
+    status, text, err = cli(
+        "render",
+        str(spec),
+        "--robot",
+        robot,
+        "--out-dir",
+        str(out),
+        "--out",
+        str(tmp_path / f"{spec.stem}.png"),
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--every",
+        "1",
+    )
     assert status == 0, err
     return float(re.search(r"return (-?[\d.]+)", text)[1])
 

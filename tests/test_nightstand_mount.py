@@ -48,6 +48,7 @@ NIGHTSTAND_POS = (-0.75, -0.35, 0.0)
 # --------------------------------------------------------------------------------------------
 # helpers
 
+
 def render(out_dir: Path, template: Path = TEMPLATE, **args) -> tuple[Path, str]:
     mappings = {k: str(v) for k, v in args.items()}
     text = xacro.process_file(str(template), mappings=mappings).toprettyxml(indent="  ")
@@ -87,8 +88,9 @@ def captured_c_output():
 
 def load_quiet(cid: int, path: Path, pos=(0, 0, 0), orn=(0, 0, 0, 1)) -> tuple[int, str]:
     with captured_c_output() as out:
-        body = pb.loadURDF(str(path), list(pos), list(orn), useFixedBase=True,
-                           flags=pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=cid)
+        body = pb.loadURDF(
+            str(path), list(pos), list(orn), useFixedBase=True, flags=pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=cid
+        )
     return body, out[0]
 
 
@@ -114,11 +116,13 @@ def yaw_matrix(yaw: float) -> np.ndarray:
 # --------------------------------------------------------------------------------------------
 # (a) the template
 
+
 def test_warning_capture_works(cid, tmp_path):
     """Positive control: a link without <inertial> makes PyBullet print a warning."""
     bad = tmp_path / "bad.urdf"
-    bad.write_text('<robot name="bad"><link name="a"><visual><geometry><box size="1 1 1"/>'
-                   '</geometry></visual></link></robot>')
+    bad.write_text(
+        '<robot name="bad"><link name="a"><visual><geometry><box size="1 1 1"/></geometry></visual></link></robot>'
+    )
     _, text = load_quiet(cid, bad)
     assert "warning" in text.lower()
 
@@ -143,8 +147,9 @@ def test_nightstand_urdf_checks(args, tmp_path, cid):
         inertial = link.find("inertial")
         assert float(inertial.find("mass").get("value")) > 0
         i = {k: float(v) for k, v in inertial.find("inertia").attrib.items()}
-        ev = np.linalg.eigvalsh([[i["ixx"], i["ixy"], i["ixz"]], [i["ixy"], i["iyy"], i["iyz"]],
-                                 [i["ixz"], i["iyz"], i["izz"]]])
+        ev = np.linalg.eigvalsh(
+            [[i["ixx"], i["ixy"], i["ixz"]], [i["ixy"], i["iyy"], i["iyz"]], [i["ixz"], i["iyz"], i["izz"]]]
+        )
         assert ev.min() > 0 and ev[0] + ev[1] >= ev[2] * (1 - 1e-9)
         for geom in link.iter("geometry"):
             assert {child.tag for child in geom} <= {"box", "cylinder", "sphere"}
@@ -207,6 +212,7 @@ def test_nightstand_part():
 
 # --------------------------------------------------------------------------------------------
 # (b) mounting Jaco on the nightstand beside the wheelchair
+
 
 def write_task(directory: Path, nightstand_params: dict | None = None) -> Path:
     x, y, z = NIGHTSTAND_POS

@@ -30,15 +30,13 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 import pytest
-
 import xacro
 import yourdfpy
+from frames import body_indices, homogeneous, origin_matrix, rot_x, rot_z
 
+from assistive_compiler.compile.external_checks import captured_c_output
 from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.library import Library
-from assistive_compiler.compile.external_checks import captured_c_output
-
-from frames import body_indices, homogeneous, origin_matrix, rot_x, rot_z
 
 REPO = Path(__file__).resolve().parents[1]
 TEMPLATE = REPO / "templates" / "robots" / "panda.urdf.xacro"
@@ -144,8 +142,13 @@ def dh_fk(q) -> dict[str, np.ndarray]:
     frames = {}
     t = np.eye(4)
     for i, qi in enumerate(q):
-        t = t @ homogeneous(rot_x(DH_ALPHA[i])) @ homogeneous(xyz=(DH_A[i], 0, 0)) \
-            @ homogeneous(rot_z(qi)) @ homogeneous(xyz=(0, 0, DH_D[i]))
+        t = (
+            t
+            @ homogeneous(rot_x(DH_ALPHA[i]))
+            @ homogeneous(xyz=(DH_A[i], 0, 0))
+            @ homogeneous(rot_z(qi))
+            @ homogeneous(xyz=(0, 0, DH_D[i]))
+        )
         frames[ARM_LINKS[i]] = t
     frames["panda_link8"] = t @ homogeneous(xyz=(0, 0, FLANGE_D))
     frames["panda_hand"] = frames["panda_link8"] @ homogeneous(rot_z(-PI / 4))
@@ -172,12 +175,19 @@ def random_configs(n=30, seed=0):
 # --------------------------------------------------------------------------------------------
 # fixtures
 
+
 @pytest.fixture(scope="module")
 def bullet(urdf_path):
     """(client, body, joint index by name, link index by name); base at the world origin."""
     cid = pb.connect(pb.DIRECT)
-    body = pb.loadURDF(str(urdf_path), [0, 0, 0], [0, 0, 0, 1], useFixedBase=True,
-                       flags=pb.URDF_USE_SELF_COLLISION, physicsClientId=cid)
+    body = pb.loadURDF(
+        str(urdf_path),
+        [0, 0, 0],
+        [0, 0, 0, 1],
+        useFixedBase=True,
+        flags=pb.URDF_USE_SELF_COLLISION,
+        physicsClientId=cid,
+    )
     joints, links = body_indices(cid, body)
     yield cid, body, joints, links
     pb.disconnect(cid)
@@ -194,12 +204,20 @@ def set_arm(bullet, q, fingers: float = 0.0) -> None:
 # --------------------------------------------------------------------------------------------
 # structure, numbers from the facts
 
+
 def test_names_and_tree(model):
     assert model.base_link == "panda_link0"
     expected = set(ARM_JOINTS) | set(FINGER_JOINTS) | set(FIXED_ORIGINS)
     assert set(model.joint_map) == expected
-    assert set(model.link_map) == {"panda_link0", *ARM_LINKS, "panda_link8", "panda_hand",
-                                   "panda_leftfinger", "panda_rightfinger", "panda_fingercenter"}
+    assert set(model.link_map) == {
+        "panda_link0",
+        *ARM_LINKS,
+        "panda_link8",
+        "panda_hand",
+        "panda_leftfinger",
+        "panda_rightfinger",
+        "panda_fingercenter",
+    }
     parent = "panda_link0"
     for name, link in zip(ARM_JOINTS, ARM_LINKS):
         j = model.joint_map[name]
@@ -219,14 +237,11 @@ def test_names_and_tree(model):
 
 def test_joint_origins_exact(model):
     for name, (xyz, rpy) in ARM_ORIGINS.items():
-        np.testing.assert_allclose(model.joint_map[name].origin, origin_matrix(xyz, rpy),
-                                   atol=1e-9, err_msg=name)
+        np.testing.assert_allclose(model.joint_map[name].origin, origin_matrix(xyz, rpy), atol=1e-9, err_msg=name)
     for name, (_, _, xyz, rpy) in FIXED_ORIGINS.items():
-        np.testing.assert_allclose(model.joint_map[name].origin, origin_matrix(xyz, rpy),
-                                   atol=1e-9, err_msg=name)
+        np.testing.assert_allclose(model.joint_map[name].origin, origin_matrix(xyz, rpy), atol=1e-9, err_msg=name)
     for name in FINGER_JOINTS:
-        np.testing.assert_allclose(model.joint_map[name].origin,
-                                   origin_matrix((0, 0, 0.0584), (0, 0, 0)), atol=1e-9)
+        np.testing.assert_allclose(model.joint_map[name].origin, origin_matrix((0, 0, 0.0584), (0, 0, 0)), atol=1e-9)
 
 
 def test_joint_limits(model):
@@ -265,6 +280,7 @@ def test_masses_match_the_facts(model):
 
 # --------------------------------------------------------------------------------------------
 # forward kinematics
+
 
 def test_formulations_agree():
     """The published chain and Franka's DH table describe the same frames (a check of the
@@ -352,7 +368,7 @@ def test_reach_matches_the_facts(bullet):
 
     def best(link: str, extra: float = 0.0) -> tuple[float, np.ndarray]:
         tip = np.linalg.inv(zero["panda_link6"]) @ zero[link] @ np.array([0, 0, extra, 1.0])
-        grid = np.stack(np.meshgrid(*[np.linspace(l, h, 9) for l, h in zip(lo, hi)]), -1).reshape(-1, 3)
+        grid = np.stack(np.meshgrid(*[np.linspace(link, h, 9) for link, h in zip(lo, hi)]), -1).reshape(-1, 3)
         values = reach(grid, tip)
         directions = np.array([d for d in np.ndindex(3, 3, 3) if d != (1, 1, 1)]) - 1
         found, arg = 0.0, grid[0]
@@ -376,10 +392,12 @@ def test_reach_matches_the_facts(bullet):
         p = link_pose(cid, body, links[link]) @ np.array([0, 0, extra, 1.0])
         return float(np.linalg.norm(p[:3] - [0, 0, 0.333]))
 
-    for link, extra, fact in [("panda_link6", 0.0, 0.7194),  # wrist
-                              ("panda_link8", 0.0, 0.8579),  # flange
-                              ("panda_fingercenter", 0.0, 0.9466),  # the reference's EE
-                              ("panda_fingercenter", 0.0025, 0.9489)]:  # PB's grasp target
+    for link, extra, fact in [
+        ("panda_link6", 0.0, 0.7194),  # wrist
+        ("panda_link8", 0.0, 0.8579),  # flange
+        ("panda_fingercenter", 0.0, 0.9466),  # the reference's EE
+        ("panda_fingercenter", 0.0025, 0.9489),
+    ]:  # PB's grasp target
         value, x = best(link, extra)
         assert value == pytest.approx(fact, abs=1e-4), link
         assert bullet_reach(link, extra, x) == pytest.approx(value, abs=1e-6), link
@@ -387,6 +405,7 @@ def test_reach_matches_the_facts(bullet):
 
 # --------------------------------------------------------------------------------------------
 # URDF validity
+
 
 def test_check_urdf_passes(urdf_path):
     res = subprocess.run([str(CHECK_URDF), str(urdf_path)], capture_output=True, text=True, timeout=30)
@@ -426,6 +445,7 @@ def test_every_link_has_collision_geometry_but_the_frames(model):
 # --------------------------------------------------------------------------------------------
 # the part YAML and the spoon grip
 
+
 def test_part_yaml_loads():
     part = Library().get("robots", "panda").part
     assert (part.name, part.title, part.base_link) == ("panda", "Panda", "panda_link0")
@@ -436,7 +456,10 @@ def test_part_yaml_loads():
     assert arm.end_effector == arm.tool_mount == EE
     grip = part.gripper["right"]
     assert grip.joints == FINGER_JOINTS
-    assert {k: grip.positions[k] for k in ("spoon", "none")} == {"spoon": 0.001, "none": 0.001}  # paper §III-A: feeding (and dressing)
+    assert {k: grip.positions[k] for k in ("spoon", "none")} == {
+        "spoon": 0.001,
+        "none": 0.001,
+    }  # paper §III-A: feeding (and dressing)
     assert part.mountable is True
     assert part.base_height_m == 0.0
     assert "spoon" in part.grips
@@ -480,6 +503,7 @@ def _write(path: Path, text: str) -> Path:
 # --------------------------------------------------------------------------------------------
 # collisions: self, and on the wheelchair mount
 
+
 def test_no_self_collision_at_ready_pose_with_spoon_grip(bullet):
     cid, body, joints, _ = bullet
     set_arm(bullet, READY, fingers=0.001)
@@ -520,6 +544,7 @@ def test_base_fits_the_wheelchair_mount(side, urdf_path, tmp_path):
 # --------------------------------------------------------------------------------------------
 # physics
 
+
 def test_position_control_holds_a_random_pose_without_gravity(urdf_path):
     """Arm position-controlled at a random pose (and fingers at the spoon grip), gravity off,
     loaded as the runtime loads robots: after 50 steps of 0.02 s the tool frame has moved
@@ -528,8 +553,14 @@ def test_position_control_holds_a_random_pose_without_gravity(urdf_path):
     try:
         pb.setGravity(0, 0, 0, physicsClientId=cid)
         pb.setTimeStep(0.02, physicsClientId=cid)
-        body = pb.loadURDF(str(urdf_path), [0, 0, 0.5], [0, 0, 0, 1], useFixedBase=True,
-                           flags=pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=cid)
+        body = pb.loadURDF(
+            str(urdf_path),
+            [0, 0, 0.5],
+            [0, 0, 0, 1],
+            useFixedBase=True,
+            flags=pb.URDF_USE_INERTIA_FROM_FILE,
+            physicsClientId=cid,
+        )
         joints, links = body_indices(cid, body)
         rng = np.random.default_rng(7)
         q = rng.uniform([LIMITS[j][4] for j in ARM_JOINTS], [LIMITS[j][5] for j in ARM_JOINTS])
@@ -539,8 +570,9 @@ def test_position_control_holds_a_random_pose_without_gravity(urdf_path):
         for i, v in zip(idx, targets):
             pb.resetJointState(body, i, float(v), physicsClientId=cid)
         forces = [LIMITS[n][2] for n in ARM_JOINTS] + [20.0, 20.0]
-        pb.setJointMotorControlArray(body, idx, pb.POSITION_CONTROL, targetPositions=targets,
-                                     forces=forces, physicsClientId=cid)
+        pb.setJointMotorControlArray(
+            body, idx, pb.POSITION_CONTROL, targetPositions=targets, forces=forces, physicsClientId=cid
+        )
         before = link_pose(cid, body, links[EE])[:3, 3]
         for _ in range(50):
             pb.stepSimulation(physicsClientId=cid)

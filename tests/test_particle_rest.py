@@ -62,7 +62,11 @@ def inside_cup(env, slack: float = 0.0) -> np.ndarray:
     on a tilted wall presses a few millimetres into it (see templates/tools/cup.urdf.xacro)."""
     box = env.manifest.particles[0].outside_of
     local = water_in_cup_frame(env)
-    return (np.hypot(local[:, 0], local[:, 1]) <= box.radius + slack) & (local[:, 2] >= -box.radius) & (local[:, 2] <= box.height)
+    return (
+        (np.hypot(local[:, 0], local[:, 1]) <= box.radius + slack)
+        & (local[:, 2] >= -box.radius)
+        & (local[:, 2] <= box.height)
+    )
 
 
 def tip_cup(env, start_deg: float, end_deg: float, steps: int) -> None:
@@ -73,7 +77,9 @@ def tip_cup(env, start_deg: float, end_deg: float, steps: int) -> None:
     cid = w.tool_constraints["cup"]
     for k in range(1, steps + 1):
         angle = math.radians(start_deg + (end_deg - start_deg) * k / steps)
-        pb.changeConstraint(cid, jointChildFrameOrientation=pb.getQuaternionFromEuler([-angle, 0, 0]), maxForce=500, physicsClientId=c)
+        pb.changeConstraint(
+            cid, jointChildFrameOrientation=pb.getQuaternionFromEuler([-angle, 0, 0]), maxForce=500, physicsClientId=c
+        )
         env.step(np.zeros(env.action_space.shape))
 
 
@@ -139,9 +145,13 @@ def test_water_at_rest_in_a_held_tilted_cup_is_carried_until_the_cup_turns_furth
     tip_cup(env, 0, 30, 5)
     assert steps_until_carried(env, 30) is not None
     w = env.world
-    down = np.asarray(pb.getMatrixFromQuaternion(w.base_frame(w.bodies["cup"])[1])).reshape(3, 3)[2] * -1.0  # world −z in the cup frame
+    down = (
+        np.asarray(pb.getMatrixFromQuaternion(w.base_frame(w.bodies["cup"])[1])).reshape(3, 3)[2] * -1.0
+    )  # world −z in the cup frame
     downhill = down[:2] / np.linalg.norm(down[:2])
-    assert water_in_cup_frame(env)[:, :2].mean(axis=0) @ downhill > 0.01  # the heap lies on the low side (it started centred)
+    assert (
+        water_in_cup_frame(env)[:, :2].mean(axis=0) @ downhill > 0.01
+    )  # the heap lies on the low side (it started centred)
     for _ in range(20):
         env.step(np.zeros(env.action_space.shape))
         assert env.particles.carried["water"].all()
@@ -202,9 +212,13 @@ def test_renders_draw_carried_water_in_the_cup(artifact):
     try:
         e.reset(seed=0)
         w, c = e.world, e.world.client
-        before = [pb.getBasePositionAndOrientation(b, physicsClientId=c) for b in range(pb.getNumBodies(physicsClientId=c))]
+        before = [
+            pb.getBasePositionAndOrientation(b, physicsClientId=c) for b in range(pb.getNumBodies(physicsClientId=c))
+        ]
         e.render()
-        after = [pb.getBasePositionAndOrientation(b, physicsClientId=c) for b in range(pb.getNumBodies(physicsClientId=c))]
+        after = [
+            pb.getBasePositionAndOrientation(b, physicsClientId=c) for b in range(pb.getNumBodies(physicsClientId=c))
+        ]
         assert before == after
         cup_pos = np.asarray(w.base_frame(w.bodies["cup"])[0])
         spheres = e.particles.visual_spheres()
@@ -221,12 +235,20 @@ def validate_at(tmp_path, capsys, text: str, token: str) -> tuple[int, str, str]
     path.write_text(text, encoding="utf-8")
     rc = main(["validate", str(path)])
     at = text.index(token)
-    return rc, capsys.readouterr().err, f"{display(path)}:{text.count(chr(10), 0, at) + 1}:{at - text.rfind(chr(10), 0, at)}"
+    return (
+        rc,
+        capsys.readouterr().err,
+        f"{display(path)}:{text.count(chr(10), 0, at) + 1}:{at - text.rfind(chr(10), 0, at)}",
+    )
 
 
 def test_rest_container_must_be_a_tool_with_a_container(tmp_path, capsys):
-    rc, err, where = validate_at(tmp_path, capsys, f"extends: {DRINKING}\nparticles:\n  water:\n    rest: {{container: wheelchair}}\n",
-                                 "wheelchair}")
+    rc, err, where = validate_at(
+        tmp_path,
+        capsys,
+        f"extends: {DRINKING}\nparticles:\n  water:\n    rest: {{container: wheelchair}}\n",
+        "wheelchair}",
+    )
     assert rc == 2
     assert err.splitlines() == [f"{where}: 'wheelchair' is not a tool with a container; tools with one: 'cup'"]
 
@@ -286,8 +308,13 @@ def test_food_rides_in_the_spoon_on_the_way_and_is_simulated_near_the_person(fee
 
 
 def test_simulated_near_names_a_known_body(tmp_path, capsys):
-    rc, err, where = validate_at(tmp_path, capsys, f"extends: {FOOD_RESTS}\nparticles:\n  food:\n    rest:\n      container: spoon\n"
-                                 "      simulated_near: {body: persn, distance_m: 0.1}\n", "persn")
+    rc, err, where = validate_at(
+        tmp_path,
+        capsys,
+        f"extends: {FOOD_RESTS}\nparticles:\n  food:\n    rest:\n      container: spoon\n"
+        "      simulated_near: {body: persn, distance_m: 0.1}\n",
+        "persn",
+    )
     assert rc == 2
     assert err.splitlines()[0].startswith(f"{where}: unknown body 'persn'; ")
     assert "did you mean 'person'" in err

@@ -30,13 +30,42 @@ LANDMARK_HEIGHTS = {
     "female": dict(shoulder=1.280, elbow=1.016, wrist=0.755, head=1.400, hip=0.848, knee=0.457, ankle=0.068),
 }
 REVOLUTE = (
-    [f"right_{j}" for j in ("pecs_x", "pecs_y", "pecs_z", "shoulder_x", "shoulder_y", "shoulder_z",
-                            "elbow", "forearm", "wrist_x", "wrist_y")]
-    + [f"left_{j}" for j in ("pecs_x", "pecs_y", "pecs_z", "shoulder_x", "shoulder_y", "shoulder_z",
-                             "elbow", "forearm", "wrist_x", "wrist_y")]
+    [
+        f"right_{j}"
+        for j in (
+            "pecs_x",
+            "pecs_y",
+            "pecs_z",
+            "shoulder_x",
+            "shoulder_y",
+            "shoulder_z",
+            "elbow",
+            "forearm",
+            "wrist_x",
+            "wrist_y",
+        )
+    ]
+    + [
+        f"left_{j}"
+        for j in (
+            "pecs_x",
+            "pecs_y",
+            "pecs_z",
+            "shoulder_x",
+            "shoulder_y",
+            "shoulder_z",
+            "elbow",
+            "forearm",
+            "wrist_x",
+            "wrist_y",
+        )
+    ]
     + ["neck", "head_x", "head_y", "head_z", "waist_x", "waist_y", "waist_z"]
-    + [f"{s}_{j}" for s in ("right", "left")
-       for j in ("hip_x", "hip_y", "hip_z", "knee", "ankle_x", "ankle_y", "ankle_z")]
+    + [
+        f"{s}_{j}"
+        for s in ("right", "left")
+        for j in ("hip_x", "hip_y", "hip_z", "knee", "ankle_x", "ankle_y", "ankle_z")
+    ]
 )
 
 
@@ -110,15 +139,22 @@ def test_joints(urdfs, client, sex):
         assert info[10] > 0 and info[11] > 0  # effort, velocity
     assert body.JOINT_AXES["right_shoulder_x"] == "y" and body.JOINT_AXES["right_shoulder_y"] == "x"
     assert sum(len(g) for g in body.JOINT_GROUPS.values()) == 41
-    assert len(body.JOINT_GROUPS["right_arm"]) == 10 and body.JOINT_GROUPS["head"] == ("neck", "head_x", "head_y", "head_z")
+    assert len(body.JOINT_GROUPS["right_arm"]) == 10 and body.JOINT_GROUPS["head"] == (
+        "neck",
+        "head_x",
+        "head_y",
+        "head_z",
+    )
 
 
 @pytest.mark.parametrize("sex", SEXES)
 def test_total_mass(urdfs, client, sex):
     # pybullet reports mass 0 for a fixed base, so weigh a free-base copy.
     bid = load(client, urdfs[sex], sex, fixed=False)
-    masses = [p.getDynamicsInfo(bid, i, physicsClientId=client)[0]
-              for i in range(-1, p.getNumJoints(bid, physicsClientId=client))]
+    masses = [
+        p.getDynamicsInfo(bid, i, physicsClientId=client)[0]
+        for i in range(-1, p.getNumJoints(bid, physicsClientId=client))
+    ]
     assert min(masses) > 0
     assert sum(masses) == pytest.approx(MASS[sex], rel=1e-3)
     assert body.body_measurements(sex).total_mass_kg == pytest.approx(MASS[sex], rel=1e-12)
@@ -146,7 +182,11 @@ def test_standing_height_and_landmarks(urdfs, client, sex):
             assert pos[2] == pytest.approx(expected, abs=0.02), name
             assert pos == pytest.approx(model[name], abs=1e-6), name
     # Right is -X.
-    assert frame_pose(client, bid, links["right_shoulder"])[0][0] < 0 < frame_pose(client, bid, links["left_shoulder"])[0][0]
+    assert (
+        frame_pose(client, bid, links["right_shoulder"])[0][0]
+        < 0
+        < frame_pose(client, bid, links["left_shoulder"])[0][0]
+    )
 
 
 def test_fixed_joints_bake_posture(tmp_path, client):
@@ -154,8 +194,10 @@ def test_fixed_joints_bake_posture(tmp_path, client):
     path = tmp_path / "bent.urdf"
     path.write_text(render(m.xacro_args(fixed_joints="right_elbow=-1.5708")))
     bid = load(client, path, "male")
-    infos = {p.getJointInfo(bid, i, physicsClientId=client)[1].decode(): p.getJointInfo(bid, i, physicsClientId=client)
-             for i in range(p.getNumJoints(bid, physicsClientId=client))}
+    infos = {
+        p.getJointInfo(bid, i, physicsClientId=client)[1].decode(): p.getJointInfo(bid, i, physicsClientId=client)
+        for i in range(p.getNumJoints(bid, physicsClientId=client))
+    }
     assert len(infos) == 42
     assert infos["right_elbow"][2] == p.JOINT_FIXED
     assert infos["right_elbow"][12].decode() == "right_elbow_link"
@@ -174,7 +216,7 @@ def test_fixed_joints_bake_posture(tmp_path, client):
 
 @pytest.mark.parametrize("bad", ["right_elbo=0.1", "stomach=0.1", "right_elbow", "right_elbow=abc"])
 def test_fixed_joints_rejects_unknown_names(bad):
-    with pytest.raises(Exception):
+    with pytest.raises(xacro.XacroException):
         render({"fixed_joints": bad})
     with pytest.raises(ValueError):
         body.format_fixed_joints({"right_elbo": 0.1})
@@ -218,14 +260,19 @@ def test_template_defaults_are_the_male_and_args_match():
         assert float(defaults[name]) == pytest.approx(float(value), rel=1e-12, abs=1e-15), name
     # Same inputs, same bytes.
     assert render(male.xacro_args()) == render(male.xacro_args())
-    assert set(male.xacro_args(strength=0.5, skin_rgba=(0.5, 0.4, 0.3, 1.0), fixed_joints={},
-                               cloth_spheres=True)) == declared
+    assert (
+        set(male.xacro_args(strength=0.5, skin_rgba=(0.5, 0.4, 0.3, 1.0), fixed_joints={}, cloth_spheres=True))
+        == declared
+    )
 
 
 def test_strength_scales_efforts_and_scales_apply():
     def efforts(xml: str) -> dict[str, float]:
-        return {j.get("name"): float(j.find("limit").get("effort"))
-                for j in ET.fromstring(xml).iter("joint") if j.get("type") == "revolute"}
+        return {
+            j.get("name"): float(j.find("limit").get("effort"))
+            for j in ET.fromstring(xml).iter("joint")
+            if j.get("type") == "revolute"
+        }
 
     m = body.body_measurements("female")
     full, half = efforts(render(m.xacro_args())), efforts(render(m.xacro_args(strength=0.5)))
@@ -254,8 +301,15 @@ def test_cloth_spheres_add_collision_shapes(tmp_path, client):
 def test_self_collision_groups():
     groups = body.SELF_COLLISION_GROUPS
     assert set(groups) == {"right_arm", "left_arm", "right_leg", "left_leg"}
-    assert groups["right_arm"].links == ("right_shoulder_x_link", "right_shoulder_y_link", "right_shoulder",
-                                         "right_elbow_link", "right_elbow", "right_wrist_x_link", "right_wrist")
+    assert groups["right_arm"].links == (
+        "right_shoulder_x_link",
+        "right_shoulder_y_link",
+        "right_shoulder",
+        "right_elbow_link",
+        "right_elbow",
+        "right_wrist_x_link",
+        "right_wrist",
+    )
     assert "chest" in groups["right_arm"].against and "right_pecs" not in groups["right_arm"].against
     assert "waist" not in groups["right_leg"].against and "left_ankle" in groups["right_leg"].against
     known = {"chest", *body.LINK_NAMES}

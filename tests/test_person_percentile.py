@@ -30,8 +30,10 @@ NEW_PEOPLE = [("male", 5), ("male", 95), ("female", 5), ("female", 95)]
 def expected(sex: str, p: int) -> tuple[float, float]:
     """The documented formula: the paper's 50th-percentile body x the table's ratio to its median."""
     rows = TABLE[sex]
-    return (PAPER[sex][0] * rows["height_cm"][p] / rows["height_cm"][50],
-            PAPER[sex][1] * rows["weight_kg"][p] / rows["weight_kg"][50])
+    return (
+        PAPER[sex][0] * rows["height_cm"][p] / rows["height_cm"][50],
+        PAPER[sex][1] * rows["weight_kg"][p] / rows["weight_kg"][50],
+    )
 
 
 @pytest.mark.parametrize("sex", ["male", "female"])
@@ -78,13 +80,22 @@ def test_between_tabulated_percentiles_the_table_is_linear():
 def test_the_rendered_body_stands_that_tall(sex, p, tmp_path):
     body = Library().get("people", f"{sex}_{p}th").part.measurements()
     urdf = tmp_path / "p.urdf"
-    urdf.write_text(xacro.process_file(str(templates_dir() / "person" / "person.urdf.xacro"), mappings=body.xacro_args()).toprettyxml())
+    urdf.write_text(
+        xacro.process_file(
+            str(templates_dir() / "person" / "person.urdf.xacro"), mappings=body.xacro_args()
+        ).toprettyxml()
+    )
     c = pb.connect(pb.DIRECT)
     try:
         bid = pb.loadURDF(str(urdf), useFixedBase=False, physicsClientId=c)  # a fixed base reports mass 0
-        boxes = [pb.getAABB(bid, link, physicsClientId=c) for link in range(-1, pb.getNumJoints(bid, physicsClientId=c))]
+        boxes = [
+            pb.getAABB(bid, link, physicsClientId=c) for link in range(-1, pb.getNumJoints(bid, physicsClientId=c))
+        ]
         measured = max(b[1][2] for b in boxes) - min(b[0][2] for b in boxes)
-        mass = sum(pb.getDynamicsInfo(bid, link, physicsClientId=c)[0] for link in range(-1, pb.getNumJoints(bid, physicsClientId=c)))
+        mass = sum(
+            pb.getDynamicsInfo(bid, link, physicsClientId=c)[0]
+            for link in range(-1, pb.getNumJoints(bid, physicsClientId=c))
+        )
     finally:
         pb.disconnect(c)
     height, expected_mass = expected(sex, p)
@@ -129,23 +140,29 @@ def test_part_file_errors_are_located_at_the_field(tmp_path):
 def test_out_of_range_part_file_error_is_located(tmp_path):
     problem = _library_problem(tmp_path, "name: someone\nsex: female\npercentile: 99\n")
     assert (problem.location.line, problem.location.column) == (3, 13)
-    assert problem.message.startswith("percentile: 99 is outside the tabulated 5th-95th percentiles of the source table (CDC/NCHS")
+    assert problem.message.startswith(
+        "percentile: 99 is outside the tabulated 5th-95th percentiles of the source table (CDC/NCHS"
+    )
 
 
 def test_render_person_draws_percentile_people(tmp_path, capsys):
     feeding = (specs_dir() / "tasks" / "feeding.yaml").read_text(encoding="utf-8")
     # extends cannot drop the parent's per-variant mouth offset for female_50th, so edit a copy.
-    text = (feeding.replace("variants: [male_50th, female_50th]", "variants: [female_5th, male_50th, male_95th]")
-            .replace("offset_by_variant: {female_50th:", "offset_by_variant: {female_5th:"))
+    text = feeding.replace(
+        "variants: [male_50th, female_50th]", "variants: [female_5th, male_50th, male_95th]"
+    ).replace("offset_by_variant: {female_50th:", "offset_by_variant: {female_5th:")
     assert text.count("female_5th") == 2
     spec = tmp_path / "feeding_sizes.yaml"
     spec.write_text(text, encoding="utf-8")
     out = tmp_path / "people.png"
-    assert main(["render-person", str(spec), "--robot", "jaco", "--out", str(out), "--out-dir", str(tmp_path / "art")]) == 0
+    assert (
+        main(["render-person", str(spec), "--robot", "jaco", "--out", str(out), "--out-dir", str(tmp_path / "art")])
+        == 0
+    )
     assert "female_5th, male_50th, male_95th" in capsys.readouterr().out
     picture = np.asarray(Image.open(out))
     assert picture.shape == (480, 3 * 360, 3)
-    panels = [picture[:, i * 360:(i + 1) * 360].astype(int) for i in range(3)]
+    panels = [picture[:, i * 360 : (i + 1) * 360].astype(int) for i in range(3)]
     assert all(panel.std() > 20 for panel in panels)
     assert np.abs(panels[0] - panels[1]).mean() > 1 and np.abs(panels[1] - panels[2]).mean() > 1
 

@@ -20,14 +20,12 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 import pytest
-
 import xacro
+from frames import body_indices
 
+from assistive_compiler.compile.external_checks import captured_c_output
 from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.library import Library
-from assistive_compiler.compile.external_checks import captured_c_output
-
-from frames import body_indices
 
 ROOT = Path(__file__).resolve().parents[1]
 TEMPLATE = ROOT / "templates" / "robots" / "pr2.urdf.xacro"
@@ -36,8 +34,7 @@ CHECK_URDF = Path(sys.executable).parent / "check_urdf"
 PI = math.pi
 TWO_PI = 2 * PI
 
-ARM = ["shoulder_pan", "shoulder_lift", "upper_arm_roll", "elbow_flex", "forearm_roll",
-       "wrist_flex", "wrist_roll"]
+ARM = ["shoulder_pan", "shoulder_lift", "upper_arm_roll", "elbow_flex", "forearm_roll", "wrist_flex", "wrist_roll"]
 FINGERS = ["l_finger", "l_finger_tip", "r_finger", "r_finger_tip"]
 
 
@@ -53,6 +50,7 @@ def finger_joints(s: str) -> list[str]:
 # Frames above the arms (base_footprint -> torso_lift_link): ERD base_footprint_joint and the
 # reference's fixed torso (ERD 0.739675 + 0.33).
 BASE_TO_TORSO = [(0.0, 0.0, 0.051), (-0.05, 0.0, 1.069675)]
+
 
 # Arm chain (§2.3/2.4): (joint, origin xyz, axis); None = fixed. Every rpy is 0.
 def arm_chain(s: str):
@@ -123,15 +121,29 @@ BODY_INERTIA = {
 }
 # Group masses (§2.2).
 TOTAL_MASS = 257.164
-ARM_MASS = 41.334          # shoulder_pan_link and everything below it
-GRIPPER_MASS = 1.360       # palm and below
+ARM_MASS = 41.334  # shoulder_pan_link and everything below it
+GRIPPER_MASS = 1.360  # palm and below
 BASE_GROUP_MASS = 134.416
 HEAD_MASS = 3.781
-ARM_GROUP_SUFFIXES = ["shoulder_pan_link", "shoulder_lift_link", "upper_arm_roll_link",
-                      "upper_arm_link", "elbow_flex_link", "forearm_roll_link", "forearm_link",
-                      "wrist_flex_link", "wrist_roll_link"]
-GRIPPER_SUFFIXES = ["gripper_palm_link", "gripper_tool_frame", "gripper_l_finger_link",
-                    "gripper_l_finger_tip_link", "gripper_r_finger_link", "gripper_r_finger_tip_link"]
+ARM_GROUP_SUFFIXES = [
+    "shoulder_pan_link",
+    "shoulder_lift_link",
+    "upper_arm_roll_link",
+    "upper_arm_link",
+    "elbow_flex_link",
+    "forearm_roll_link",
+    "forearm_link",
+    "wrist_flex_link",
+    "wrist_roll_link",
+]
+GRIPPER_SUFFIXES = [
+    "gripper_palm_link",
+    "gripper_tool_frame",
+    "gripper_l_finger_link",
+    "gripper_l_finger_tip_link",
+    "gripper_r_finger_link",
+    "gripper_r_finger_tip_link",
+]
 
 # The reference's tucked pose (§2.9) and where it puts the tool frames.
 TUCKED = {"r": (-1.75, 1.25, -1.5, -0.5, -1, 0, -1), "l": (1.75, 1.25, 1.5, -0.5, 1, 0, 1)}
@@ -181,8 +193,14 @@ def bullet(urdf_path):
     """(client, body, joint index by name, link index by name, what loadURDF printed)."""
     cid = pb.connect(pb.DIRECT)
     with captured_c_output() as out:
-        body = pb.loadURDF(str(urdf_path), [0, 0, 0], [0, 0, 0, 1], useFixedBase=True,
-                           flags=pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=cid)
+        body = pb.loadURDF(
+            str(urdf_path),
+            [0, 0, 0],
+            [0, 0, 0, 1],
+            useFixedBase=True,
+            flags=pb.URDF_USE_INERTIA_FROM_FILE,
+            physicsClientId=cid,
+        )
     joints, links = body_indices(cid, body)
     yield cid, body, joints, links, out[0]
     pb.disconnect(cid)
@@ -315,7 +333,9 @@ def test_group_and_total_masses(model):
     total = sum(link.inertial.mass for link in model.robot.links)
     # Unmodelled sensor frames (forearm cameras, fingertip frames, ~0.01 kg per arm) are missing.
     assert total == pytest.approx(TOTAL_MASS, abs=0.03)
-    assert mass("base_footprint") + mass("base_link") == pytest.approx(BASE_GROUP_MASS, abs=1e-3)  # the table rounds to 1 g
+    assert mass("base_footprint") + mass("base_link") == pytest.approx(
+        BASE_GROUP_MASS, abs=1e-3
+    )  # the table rounds to 1 g
     for s in "rl":
         arm = sum(mass(f"{s}_{x}") for x in ARM_GROUP_SUFFIXES)
         grip = sum(mass(f"{s}_{x}") for x in GRIPPER_SUFFIXES)
@@ -434,8 +454,14 @@ def test_position_control_holds_pose_without_gravity(urdf_path):
     not moved more than 1 mm."""
     cid = pb.connect(pb.DIRECT)
     try:
-        body = pb.loadURDF(str(urdf_path), [0, 0, 0], [0, 0, 0, 1], useFixedBase=True,
-                           flags=pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=cid)
+        body = pb.loadURDF(
+            str(urdf_path),
+            [0, 0, 0],
+            [0, 0, 0, 1],
+            useFixedBase=True,
+            flags=pb.URDF_USE_INERTIA_FROM_FILE,
+            physicsClientId=cid,
+        )
         joints, links = {}, {}
         for j in range(pb.getNumJoints(body, physicsClientId=cid)):
             info = pb.getJointInfo(body, j, physicsClientId=cid)
@@ -445,19 +471,28 @@ def test_position_control_holds_pose_without_gravity(urdf_path):
         pb.setGravity(0, 0, 0, physicsClientId=cid)
         pb.setTimeStep(0.02, physicsClientId=cid)
         all_j = list(range(pb.getNumJoints(body, physicsClientId=cid)))
-        pb.setJointMotorControlArray(body, all_j, pb.VELOCITY_CONTROL, forces=[0.0] * len(all_j),
-                                     physicsClientId=cid)
+        pb.setJointMotorControlArray(body, all_j, pb.VELOCITY_CONTROL, forces=[0.0] * len(all_j), physicsClientId=cid)
         start = {}
         for s, seed in (("r", 11), ("l", 12)):
             q = random_configs(s, n=1, seed=seed)[0]
             set_arm(sim, s, q, grip=FEEDING_GRIP)
-            pb.setJointMotorControlArray(body, [joints[j] for j in arm_joints(s)], pb.POSITION_CONTROL,
-                                         targetPositions=list(q),
-                                         forces=[arm_limits(s)[j][2] for j in arm_joints(s)],
-                                         physicsClientId=cid)
-            pb.setJointMotorControlArray(body, [joints[j] for j in finger_joints(s)], pb.POSITION_CONTROL,
-                                         targetPositions=[FEEDING_GRIP] * 4, positionGains=[0.05] * 4,
-                                         forces=[500.0] * 4, physicsClientId=cid)
+            pb.setJointMotorControlArray(
+                body,
+                [joints[j] for j in arm_joints(s)],
+                pb.POSITION_CONTROL,
+                targetPositions=list(q),
+                forces=[arm_limits(s)[j][2] for j in arm_joints(s)],
+                physicsClientId=cid,
+            )
+            pb.setJointMotorControlArray(
+                body,
+                [joints[j] for j in finger_joints(s)],
+                pb.POSITION_CONTROL,
+                targetPositions=[FEEDING_GRIP] * 4,
+                positionGains=[0.05] * 4,
+                forces=[500.0] * 4,
+                physicsClientId=cid,
+            )
             start[s] = link_tf(sim, f"{s}_gripper_tool_frame")[:3, 3]
         for _ in range(50):
             pb.stepSimulation(physicsClientId=cid)

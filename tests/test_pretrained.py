@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import FEEDING
 from PIL import Image
 
 from assistive_compiler.cli import main
@@ -19,8 +20,6 @@ from assistive_compiler.episode import rollout
 from assistive_compiler.policies import make_policy
 from assistive_compiler.policies.pretrained import pretrained_dir, shipped_info, shipped_names
 from assistive_compiler.runtime.env import AssistiveEnv
-
-from conftest import FEEDING
 
 REPO = Path(__file__).resolve().parents[1]
 SHIPPED = shipped_names()
@@ -63,7 +62,10 @@ def test_shipped_policy_is_small_and_says_what_it_is(name):
         coop = AssistiveParallelEnv(env.artifact_dir)
         for agent in ("robot", "human"):
             part = pair.agent(agent)
-            assert (part.obs_dim, part.action_dim) == (coop.observation_space(agent).shape[0], coop.action_space(agent).shape[0])
+            assert (part.obs_dim, part.action_dim) == (
+                coop.observation_space(agent).shape[0],
+                coop.action_space(agent).shape[0],
+            )
         coop.close()
     else:
         policy = make_policy(f"pretrained:{name}", env)
@@ -93,21 +95,31 @@ def test_shipped_policy_still_succeeds_on_the_current_code(name):
     success = float(np.mean([r["success"] for r in runs]))
     assert success >= reg["success_rate"] - TOLERANCE, (
         f"pretrained:{name} succeeds on {success:.0%} of {seeds}, exported at {reg['success_rate']:.0%}: a physics or "
-        "runtime change broke it; retrain or re-export it")
+        "runtime change broke it; retrain or re-export it"
+    )
     mean_return = float(np.mean([r["return"] for r in runs]))
     floor = reg["mean_return"] - 0.5 * info["evaluation"]["std_return"]
-    assert mean_return >= floor, (f"pretrained:{name} returns {mean_return:.1f} on {seeds}, exported at "
-                                  f"{reg['mean_return']:.1f} (floor {floor:.1f}): a physics or runtime change broke it")
+    assert mean_return >= floor, (
+        f"pretrained:{name} returns {mean_return:.1f} on {seeds}, exported at "
+        f"{reg['mean_return']:.1f} (floor {floor:.1f}): a physics or runtime change broke it"
+    )
 
 
 def test_unknown_or_misfit_pretrained_policies_are_clear_errors(capsys):
-    assert main(["run", str(FEEDING), "--robot", "jaco", "--policy", "pretrained:feeding-jacco", "--episodes", "1"]) == 2
+    assert (
+        main(["run", str(FEEDING), "--robot", "jaco", "--policy", "pretrained:feeding-jacco", "--episodes", "1"]) == 2
+    )
     err = capsys.readouterr().err.strip()
     assert err.startswith("error: --policy pretrained:feeding-jacco: no shipped policy of that name; shipped: ")
     assert err.endswith("(did you mean 'feeding-jaco'?)")
     assert main(["run", str(FEEDING), "--robot", "pr2", "--policy", "pretrained:feeding-jaco", "--episodes", "1"]) == 2
-    assert capsys.readouterr().err.strip().endswith(
-        "error: --policy pretrained:feeding-jaco: trained for feeding with jaco, but the env is feeding with pr2")
+    assert (
+        capsys.readouterr()
+        .err.strip()
+        .endswith(
+            "error: --policy pretrained:feeding-jaco: trained for feeding with jaco, but the env is feeding with pr2"
+        )
+    )
 
 
 @pytest.mark.slow
@@ -116,8 +128,25 @@ def test_every_rollout_command_plays_a_shipped_policy(capsys, tmp_path, monkeypa
     pretrained:feeding-jaco, and agree on its episodes."""
     name, seed = "feeding-jaco", 1_000_000
     source = f"pretrained:{name}"
-    assert main(["run", str(FEEDING), "--robot", "jaco", "--policy", source, "--episodes", "2", "--seed", str(seed), "--json",
-                 "--quiet"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                str(FEEDING),
+                "--robot",
+                "jaco",
+                "--policy",
+                source,
+                "--episodes",
+                "2",
+                "--seed",
+                str(seed),
+                "--json",
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     report = json.loads(capsys.readouterr().out)
     returns = [round(e["return"], 3) for e in report["episodes"]]
     assert report["policy"] == source and returns == shipped_info(name)["evaluation"]["returns"][:2]
@@ -126,11 +155,30 @@ def test_every_rollout_command_plays_a_shipped_policy(capsys, tmp_path, monkeypa
     assert [round(e["return"], 3) for e in json.loads(capsys.readouterr().out)["per_episode"]] == returns
 
     png = tmp_path / "feeding.png"
-    assert main(["render", str(FEEDING), "--robot", "jaco", "--policy", source, "--seed", str(seed), "--out", str(png)]) == 0
+    assert (
+        main(["render", str(FEEDING), "--robot", "jaco", "--policy", source, "--seed", str(seed), "--out", str(png)])
+        == 0
+    )
     assert f"return {returns[0]:.1f}" in capsys.readouterr().out and Image.open(png).size[0] > 500
 
-    assert main(["compare", str(FEEDING), "--robots", "jaco", "--policy", "pretrained", "--episodes", "2", "--seed", str(seed),
-                 "--json"]) == 0
+    assert (
+        main(
+            [
+                "compare",
+                str(FEEDING),
+                "--robots",
+                "jaco",
+                "--policy",
+                "pretrained",
+                "--episodes",
+                "2",
+                "--seed",
+                str(seed),
+                "--json",
+            ]
+        )
+        == 0
+    )
     row = json.loads(capsys.readouterr().out)[0]
     assert row["return"] == round(float(np.mean(returns)), 1)
 
@@ -141,9 +189,32 @@ def test_every_rollout_command_plays_a_shipped_policy(capsys, tmp_path, monkeypa
 
     pytest.importorskip("minari", reason='needs the "datasets" extra')
     root = tmp_path / "minari"
-    result = subprocess.run([sys.executable, "-m", "assistive_compiler.cli", "collect", str(FEEDING), "--robot", "jaco", "--policy",
-                             source, "--episodes", "1", "--seed", str(seed), "--out", "assistive_compiler/feeding-jaco/sac-v0",
-                             "--root", str(root), "--quiet"], cwd=REPO, capture_output=True, text=True, timeout=300)
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "assistive_compiler.cli",
+            "collect",
+            str(FEEDING),
+            "--robot",
+            "jaco",
+            "--policy",
+            source,
+            "--episodes",
+            "1",
+            "--seed",
+            str(seed),
+            "--out",
+            "assistive_compiler/feeding-jaco/sac-v0",
+            "--root",
+            str(root),
+            "--quiet",
+        ],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert result.returncode == 0, result.stderr
     import minari
 
@@ -155,10 +226,12 @@ def test_every_rollout_command_plays_a_shipped_policy(capsys, tmp_path, monkeypa
 
 
 def test_a_shipped_policy_runs_without_torch(tmp_path):
-    code = ("import sys; sys.modules['torch'] = None; sys.modules['stable_baselines3'] = None\n"
-            "from assistive_compiler.cli import main\n"
-            f"sys.exit(main(['run', {str(FEEDING)!r}, '--robot', 'jaco', '--policy', 'pretrained:feeding-jaco', "
-            "'--episodes', '1', '--quiet']))")
+    code = (
+        "import sys; sys.modules['torch'] = None; sys.modules['stable_baselines3'] = None\n"
+        "from assistive_compiler.cli import main\n"
+        f"sys.exit(main(['run', {str(FEEDING)!r}, '--robot', 'jaco', '--policy', 'pretrained:feeding-jaco', "
+        "'--episodes', '1', '--quiet']))"
+    )
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=REPO)
     assert proc.returncode == 0, proc.stderr
     assert "policy=pretrained:feeding-jaco" in proc.stdout

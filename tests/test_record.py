@@ -43,7 +43,13 @@ def test_replay_reproduces_poses_and_terms(env, recorded):
     read from the file equal what a fresh simulation of seed 0 shows at each step."""
     rec = load_recording(recorded)
     h = rec.header
-    assert (h["format"], h["format_version"], h["seed"], h["policy"], h["complete"]) == ("assistive-compiler-episode", 1, 0, "scripted", True)
+    assert (h["format"], h["format_version"], h["seed"], h["policy"], h["complete"]) == (
+        "assistive-compiler-episode",
+        1,
+        0,
+        "scripted",
+        True,
+    )
     assert h["content_hash"] == env.manifest.content_hash and len(h["content_hash"]) == 64
     assert h["gym_id"] == "assistive_compiler/FeedingJaco-v1" and h["dt"] == pytest.approx(0.1)
     w = env.world
@@ -60,7 +66,11 @@ def test_replay_reproduces_poses_and_terms(env, recorded):
         assert np.array_equal(quat, w.link_frame(w.robot, w.robot.links[ee])[1])
         assert np.array_equal(rec.pose(k, "spoon", spoon_link)[0], w.base_frame(w.bodies["spoon"])[0])
         assert np.array_equal(rec.arrays["observations"][k], obs)
-        assert np.allclose(rec.arrays["target_pos"][k, h["targets"].index("mouth")], env.snap.position(env.snap.point({"target": "mouth"})), atol=1e-12)
+        assert np.allclose(
+            rec.arrays["target_pos"][k, h["targets"].index("mouth")],
+            env.snap.position(env.snap.point({"target": "mouth"})),
+            atol=1e-12,
+        )
         assert np.array_equal(rec.arrays["particles_active/food"][k], env.particles.active["food"])
     # Food was eaten in this episode, and the file saw it happen.
     active = rec.arrays["particles_active/food"]
@@ -77,8 +87,14 @@ def test_recording_layout_and_header(recorded, env):
     assert a["terms"].shape == (T, len(h["terms"])) and set(h["terms"]) == set(h["term_weights"])
     assert {b["name"] for b in h["bodies"]} == {b.name for b in env.manifest.bodies}
     assert sum(len(b["links"]) for b in h["bodies"]) == L
-    assert h["particles"] == [{"name": "food", "count": 8, "radius": env.manifest.particles[0].radius,
-                               "colors": [list(c) for c in env.manifest.particles[0].colors]}]
+    assert h["particles"] == [
+        {
+            "name": "food",
+            "count": 8,
+            "radius": env.manifest.particles[0].radius,
+            "colors": [list(c) for c in env.manifest.particles[0].colors],
+        }
+    ]
     assert set(h["term_categories"].values()) == {"reward", "preference"}  # Feeding's preference costs are recorded too
 
 
@@ -139,15 +155,41 @@ def test_run_record_writes_the_episodes_it_reports(artifact, tmp_path):
 
     from conftest import FEEDING
 
-    out = subprocess.run([sys.executable, "-m", "assistive_compiler.cli", "run", str(FEEDING), "--robot", "jaco", "--episodes", "2", "--seed", "3",
-                          "--out", str(artifact), "--record", str(tmp_path / "rec"), "--json", "--quiet"],
-                         cwd=Path(__file__).resolve().parents[1], capture_output=True, text=True, timeout=300)
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "assistive_compiler.cli",
+            "run",
+            str(FEEDING),
+            "--robot",
+            "jaco",
+            "--episodes",
+            "2",
+            "--seed",
+            "3",
+            "--out",
+            str(artifact),
+            "--record",
+            str(tmp_path / "rec"),
+            "--json",
+            "--quiet",
+        ],
+        cwd=Path(__file__).resolve().parents[1],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert out.returncode == 0, out.stderr
     report = json.loads(out.stdout)
     files = episode_files(tmp_path / "rec")
     assert [f.name for f in files] == ["episode-0000.npz", "episode-0001.npz"]
     for f, e in zip(files, report["episodes"]):
         rec = load_recording(f)
-        assert (rec.header["seed"], rec.header["success"], rec.header["policy"]) == (e["seed"], e["success"], "scripted")
+        assert (rec.header["seed"], rec.header["success"], rec.header["policy"]) == (
+            e["seed"],
+            e["success"],
+            "scripted",
+        )
         assert rec.header["return"] == pytest.approx(e["return"], abs=1e-9)
         assert dict(zip(rec.header["terms"], rec.arrays["terms"].sum(axis=0))) == pytest.approx(e["terms"], abs=1e-9)

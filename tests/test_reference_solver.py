@@ -8,8 +8,13 @@ import pybullet as pb
 import pytest
 
 from assistive_compiler.spec.load import load_spec
-from assistive_compiler.spec.reference_solver import (PYBULLET_DEFAULT_SOLVER, REFERENCE_SOLVER, reference_solver, solver_settings,
-                                                       write_reference_variant)
+from assistive_compiler.spec.reference_solver import (
+    PYBULLET_DEFAULT_SOLVER,
+    REFERENCE_SOLVER,
+    reference_solver,
+    solver_settings,
+    write_reference_variant,
+)
 
 TASKS = Path(__file__).resolve().parents[1] / "specs" / "tasks"
 

@@ -37,4 +37,3 @@ def test_render_person_sees_a_supine_person_from_above(tmp_path, capsys):
     picture = np.asarray(Image.open(out).convert("RGB"))
     for panel in (picture[:, :360], picture[:, 360:]):
         assert skin_fraction(panel) > 0.05  # the whole body is in view (~11% of the panel)
-

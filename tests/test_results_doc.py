@@ -35,8 +35,11 @@ def test_the_block_reports_the_papers_figures_beside_ours():
     row = next(line for line in block.splitlines() if line.startswith("| Feeding | Jaco |"))
     cells = [c.strip() for c in row.strip("|").split("|")]
     assert cells[3] == f"{feeding['trained_steps']:,}"
-    assert cells[6:9] == [f"{e['mean_return']:.1f} ± {e['std_return']:.1f}", f"{100 * e['success_rate']:.0f}%",
-                          f"{e['mean_force_on_human_n']:.2f}"]
+    assert cells[6:9] == [
+        f"{e['mean_return']:.1f} ± {e['std_return']:.1f}",
+        f"{100 * e['success_rate']:.0f}%",
+        f"{e['mean_force_on_human_n']:.2f}",
+    ]
     assert cells[9:11] == ["83.8", "88%"]  # the paper's Table I: Jaco's Feeding return, the best robot's success
     assert "### Table II (active person, co-optimisation)" in block
 
@@ -52,7 +55,7 @@ def test_the_claim_pairs_a_coop_cell_with_the_static_cell_of_its_algorithm():
     coop.update(name="feeding-jaco-coop", coop=True, trained_steps=360_000)
     coop["evaluation"] = {**coop["evaluation"], "success_rate": 0.81}
     block = results_block(records + [coop])
-    claim = block[block.index("### The paper's claim"):block.index("### Each cell")]
+    claim = block[block.index("### The paper's claim") : block.index("### Each cell")]
     static_cell = f"{100 * static_ppo['evaluation']['success_rate']:.0f}% ({static_ppo['trained_steps']:,} steps)"
     assert f"| Feeding | Jaco | PPO | {static_cell} | 81% (360,000 steps) |" in claim
     assert "Not measured yet" in results_block([r for r in records if not r["coop"]])

@@ -8,8 +8,17 @@ import pybullet as pb
 import pytest
 
 from assistive_compiler.rotation import (
-    axis_rotation, matrix_quat, matrix_rpy, quat_about, quat_angle, quat_from_rpy, quat_rotate, quat_towards, rpy_matrix,
-    vec_angle, wxyz,
+    axis_rotation,
+    matrix_quat,
+    matrix_rpy,
+    quat_about,
+    quat_angle,
+    quat_from_rpy,
+    quat_rotate,
+    quat_towards,
+    rpy_matrix,
+    vec_angle,
+    wxyz,
 )
 
 
@@ -33,11 +42,15 @@ def test_quat_towards_turns_at_most_the_step_along_the_shortest_way():
     step = quat_towards(a, b, math.radians(30))
     assert quat_angle(a, step) == pytest.approx(math.radians(30), abs=1e-9)
     assert quat_angle(step, b) == pytest.approx(math.radians(60), abs=1e-9)
-    assert quat_rotate(step, (1.0, 0.0, 0.0)) == pytest.approx([math.cos(math.radians(30)), math.sin(math.radians(30)), 0.0])
+    assert quat_rotate(step, (1.0, 0.0, 0.0)) == pytest.approx(
+        [math.cos(math.radians(30)), math.sin(math.radians(30)), 0.0]
+    )
     assert quat_towards(a, b, math.radians(120)) is b  # already within reach: the goal itself
 
 
-@pytest.mark.parametrize("rpy", [(0.3, -0.2, 1.0), (-2.9, 1.2, -0.4), (0.0, 0.0, 0.0), (1.0, math.pi / 2, 0.5), (0.2, -math.pi / 2, -1.1)])
+@pytest.mark.parametrize(
+    "rpy", [(0.3, -0.2, 1.0), (-2.9, 1.2, -0.4), (0.0, 0.0, 0.0), (1.0, math.pi / 2, 0.5), (0.2, -math.pi / 2, -1.1)]
+)
 def test_rpy_matrix_is_pybullets_and_converts_back_to_the_same_rotation(rpy):
     """URDF's fixed-axis roll-pitch-yaw (R = Rz Ry Rx) matches pybullet's Euler convention; the
     inverse reproduces the matrix even at gimbal lock (pitch ±π/2), and the quaternion of the

@@ -265,8 +265,15 @@ def test_env_step_equals_frame_skip_physics_steps(make_env):
     q = np.array([s[0] for s in pb.getJointStates(w.robot.id, by_hand.arm_idx, physicsClientId=c)])
     target = np.clip(q + by_hand.delta_scale * action, by_hand.lower, by_hand.upper)
     m = by_hand.manifest.robot
-    pb.setJointMotorControlArray(w.robot.id, by_hand.arm_idx, pb.POSITION_CONTROL, targetPositions=target.tolist(),
-                                 positionGains=[m.position_gain] * 7, forces=[m.max_force] * 7, physicsClientId=c)
+    pb.setJointMotorControlArray(
+        w.robot.id,
+        by_hand.arm_idx,
+        pb.POSITION_CONTROL,
+        targetPositions=target.tolist(),
+        positionGains=[m.position_gain] * 7,
+        forces=[m.max_force] * 7,
+        physicsClientId=c,
+    )
     for _ in range(by_hand.manifest.sim.frame_skip):
         w._apply_gravity_compensation()
         pb.stepSimulation(physicsClientId=c)
@@ -482,7 +489,22 @@ def test_cli_render_writes_a_picture(artifact, tmp_path, capsys, suffix):
 def test_cli_run_json(artifact, capsys):
     from assistive_compiler.cli import main
 
-    rc = main(["run", str(SPEC), "--robot", "jaco", "--policy", "zero", "--episodes", "2", "--quiet", "--json", "--out", str(artifact)])
+    rc = main(
+        [
+            "run",
+            str(SPEC),
+            "--robot",
+            "jaco",
+            "--policy",
+            "zero",
+            "--episodes",
+            "2",
+            "--quiet",
+            "--json",
+            "--out",
+            str(artifact),
+        ]
+    )
     assert rc == 0
     report = json.loads(capsys.readouterr().out)
     assert len(report["episodes"]) == 2
@@ -493,7 +515,9 @@ def test_cli_run_json(artifact, capsys):
     assert report["success_rate"] == 0.0
     # terms are unweighted episode sums; with term_weights they add up to the return
     for ep in report["episodes"]:
-        assert sum(report["term_weights"][k] * v for k, v in ep["terms"].items()) == pytest.approx(ep["return"], rel=1e-9, abs=1e-9)
+        assert sum(report["term_weights"][k] * v for k, v in ep["terms"].items()) == pytest.approx(
+            ep["return"], rel=1e-9, abs=1e-9
+        )
 
 
 @pytest.mark.slow
@@ -506,7 +530,22 @@ def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, 
 
     fewer = tmp_path / "feeding_fewer_iterations.yaml"  # a user's spec of the reference's task, at settings of its own
     fewer.write_text(f"extends: {SPEC}\nsim:\n  solver: {{iterations: 10, contact_breaking_threshold_m: 0.002}}\n")
-    rc = main(["bench", str(SPEC), str(fewer), "--robot", "jaco", "--steps", "10", "--repeats", "1", "--resets", "2", "--json"])
+    rc = main(
+        [
+            "bench",
+            str(SPEC),
+            str(fewer),
+            "--robot",
+            "jaco",
+            "--steps",
+            "10",
+            "--repeats",
+            "1",
+            "--resets",
+            "2",
+            "--json",
+        ]
+    )
     assert rc == 0
     feeding, fewer_r = json.loads(capsys.readouterr().out)
     reference = {"sub_steps": 0, "iterations": 50, "contact_breaking_threshold_m": 0.02}
@@ -526,19 +565,46 @@ def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, 
     assert fewer_r["vs_reference_at_reference_solver"] == round(fewer_r["env_steps_per_s_reference_solver"] / 348, 2)
     rc = main(["bench", str(SPEC), str(fewer), "--robot", "jaco", "--steps", "10", "--repeats", "1", "--resets", "2"])
     out = capsys.readouterr().out
-    assert out.splitlines()[0].split() == ["task", "robot", "env_steps_per_s", "env_steps_per_s_reference_solver", "raw_physics_steps_per_s",
-                                           "env_over_raw", "reset_ms_median", "reference_env_steps_per_s", "vs_reference",
-                                           "vs_reference_at_reference_solver"]
+    assert out.splitlines()[0].split() == [
+        "task",
+        "robot",
+        "env_steps_per_s",
+        "env_steps_per_s_reference_solver",
+        "raw_physics_steps_per_s",
+        "env_over_raw",
+        "reset_ms_median",
+        "reference_env_steps_per_s",
+        "vs_reference",
+        "vs_reference_at_reference_solver",
+    ]
     rows = [line.split() for line in out.splitlines() if line.split()[:1] == ["feeding"]]
     assert len(rows) == 2 and all(r[1] == "jaco" and r[7] == "348" for r in rows)
     assert float(rows[0][2]) == float(rows[0][3])  # shipped = reference settings: the same figure in both columns
     assert "reference_env_steps_per_s of feeding/jaco, feeding/jaco: measured side by side on 2026-11-27" in out
     # Figures measured beside ours: the harness's lines, the reference on its fork (gravity emulation's share removed).
     lines = tmp_path / "reference.jsonl"
-    lines.write_text('{"side": "ag", "env": "FeedingJaco", "steps_per_s": 300.0, "gravity_shim_share": 0.25}\n'
-                     '{"side": "ag", "env": "FeedingJaco", "steps_per_s": 330.0, "gravity_shim_share": 0.25}\n'
-                     '{"side": "ours", "env": "FeedingJaco", "steps_per_s": 900.0}\n')
-    rc = main(["bench", str(SPEC), "--robot", "jaco", "--steps", "10", "--repeats", "1", "--resets", "2", "--json", "--reference-json", str(lines)])
+    lines.write_text(
+        '{"side": "ag", "env": "FeedingJaco", "steps_per_s": 300.0, "gravity_shim_share": 0.25}\n'
+        '{"side": "ag", "env": "FeedingJaco", "steps_per_s": 330.0, "gravity_shim_share": 0.25}\n'
+        '{"side": "ours", "env": "FeedingJaco", "steps_per_s": 900.0}\n'
+    )
+    rc = main(
+        [
+            "bench",
+            str(SPEC),
+            "--robot",
+            "jaco",
+            "--steps",
+            "10",
+            "--repeats",
+            "1",
+            "--resets",
+            "2",
+            "--json",
+            "--reference-json",
+            str(lines),
+        ]
+    )
     beside = json.loads(capsys.readouterr().out)
     assert rc == 0 and beside["reference_env_steps_per_s"] == 420.0  # median of 400 and 440
     assert beside["reference_figure"] == f"{lines}: measured beside ours with the reference harness"
@@ -551,11 +617,32 @@ def test_cli_bench_takes_several_robots_one_row_per_spec_and_robot(capsys):
     takes compare's comma list; each robot is measured once, one row per spec x robot, in order."""
     from assistive_compiler.cli import main
 
-    rc = main(["bench", str(SPEC), "--robot", "jaco", "--robots", "stretch,jaco", "--steps", "5", "--repeats", "1", "--resets", "1", "--json"])
+    rc = main(
+        [
+            "bench",
+            str(SPEC),
+            "--robot",
+            "jaco",
+            "--robots",
+            "stretch,jaco",
+            "--steps",
+            "5",
+            "--repeats",
+            "1",
+            "--resets",
+            "1",
+            "--json",
+        ]
+    )
     assert rc == 0
     rows = json.loads(capsys.readouterr().out)
-    assert [(r["task"], r["robot"], r["action_size"]) for r in rows] == [("feeding", "jaco", 7), ("feeding", "stretch", 5)]
-    assert rows[0]["reference_env_steps_per_s"] == 348 and rows[1]["reference_env_steps_per_s"] is None  # not measured for Stretch
+    assert [(r["task"], r["robot"], r["action_size"]) for r in rows] == [
+        ("feeding", "jaco", 7),
+        ("feeding", "stretch", 5),
+    ]
+    assert (
+        rows[0]["reference_env_steps_per_s"] == 348 and rows[1]["reference_env_steps_per_s"] is None
+    )  # not measured for Stretch
     assert rows[1]["reference_figure"] is None
     for r in rows:
         assert r["env_over_raw"] == pytest.approx(r["env_steps_per_s"] / r["raw_physics_steps_per_s"], abs=2e-3)
@@ -573,5 +660,7 @@ def test_package_import_is_light(tmp_path):
         "print(json.dumps(sorted(m for m in heavy if m in sys.modules)))\n"
     )
     env = dict(os.environ, ASSISTIVE_COMPILER_CACHE=str(tmp_path / "cache"))
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=tmp_path, check=True)
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=tmp_path, check=True
+    )
     assert json.loads(out.stdout.strip().splitlines()[-1]) == []

@@ -28,15 +28,13 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 import pytest
-
 import xacro
 import yourdfpy
+from frames import body_indices, origin_matrix, rot_z
 
+from assistive_compiler.compile.external_checks import captured_c_output
 from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.library import Library
-from assistive_compiler.compile.external_checks import captured_c_output
-
-from frames import body_indices, origin_matrix, rot_z
 
 ROOT = Path(__file__).resolve().parents[1]
 TEMPLATE = ROOT / "templates" / "robots" / "sawyer.urdf.xacro"
@@ -77,8 +75,15 @@ LIMITS = {
     "right_j6": (-4.7124, 4.7124, 9, 4.545),
 }
 # The reference's ranges (paper §III-A), rounded there to 3 decimals.
-REFERENCE_RANGES = [(-3.05, 3.05), (-3.818, 2.282), (-3.051, 3.051), (-3.051, 3.051),
-                    (-2.984, 2.984), (-2.984, 2.984), (-4.71, 4.71)]
+REFERENCE_RANGES = [
+    (-3.05, 3.05),
+    (-3.818, 2.282),
+    (-3.051, 3.051),
+    (-3.051, 3.051),
+    (-2.984, 2.984),
+    (-2.984, 2.984),
+    (-4.71, 4.71),
+]
 REFERENCE_EFFORTS = [80, 80, 40, 40, 9, 9, 9]
 
 # Child masses from the Sawyer table (facts); pedestal 60.864 kg at z -0.5.
@@ -119,10 +124,14 @@ def dh_fk(q, d) -> np.ndarray:
         th = qi + off
         ct, st = math.cos(th), math.sin(th)
         ca, sa = math.cos(alpha), math.sin(alpha)
-        t = t @ np.array([[ct, -st * ca, st * sa, ai * ct],
-                          [st, ct * ca, -ct * sa, ai * st],
-                          [0.0, sa, ca, di],
-                          [0.0, 0.0, 0.0, 1.0]])
+        t = t @ np.array(
+            [
+                [ct, -st * ca, st * sa, ai * ct],
+                [st, ct * ca, -ct * sa, ai * st],
+                [0.0, sa, ca, di],
+                [0.0, 0.0, 0.0, 1.0],
+            ]
+        )
     fix = np.eye(4)
     fix[:3, :3] = rot_z(J6_PITCH)
     return t @ fix
@@ -139,14 +148,14 @@ def random_configs(n=30, seed=0):
 # --------------------------------------------------------------------------------------------
 # fixtures
 
+
 @pytest.fixture(scope="module")
 def bullet(urdf_path):
     """(client, body, joint index by joint name, link index by link name, load output)."""
     cid = pb.connect(pb.DIRECT)
     # Loaded at the origin with identity orientation: world frame == URDF base frame.
     with captured_c_output() as out:
-        body = pb.loadURDF(str(urdf_path), [0, 0, 0], [0, 0, 0, 1], useFixedBase=True,
-                           physicsClientId=cid)
+        body = pb.loadURDF(str(urdf_path), [0, 0, 0], [0, 0, 0, 1], useFixedBase=True, physicsClientId=cid)
     joints, links = body_indices(cid, body)
     yield cid, body, joints, links, out[0]
     pb.disconnect(cid)
@@ -170,6 +179,7 @@ def link_pose(bullet, link: str) -> np.ndarray:
 # --------------------------------------------------------------------------------------------
 # structure and facts
 
+
 def test_names_and_tree(model):
     assert model.base_link == "base"
     for name, (parent, child, _, _) in JOINT_ORIGINS.items():
@@ -192,11 +202,11 @@ def test_names_and_tree(model):
 
 def test_joint_origins_exact(model):
     for name, (_, _, xyz, rpy) in JOINT_ORIGINS.items():
-        np.testing.assert_allclose(model.joint_map[name].origin, origin_matrix(xyz, rpy),
-                                   atol=1e-9, err_msg=name)
+        np.testing.assert_allclose(model.joint_map[name].origin, origin_matrix(xyz, rpy), atol=1e-9, err_msg=name)
     for name, y in zip(FINGER_JOINTS, (-0.0015, 0.0015)):
-        np.testing.assert_allclose(model.joint_map[name].origin, origin_matrix((0, y, 0.02), (0, 0, 0)),
-                                   atol=1e-12, err_msg=name)
+        np.testing.assert_allclose(
+            model.joint_map[name].origin, origin_matrix((0, y, 0.02), (0, 0, 0)), atol=1e-12, err_msg=name
+        )
 
 
 def test_joint_limits_efforts_velocities(model):
@@ -221,8 +231,9 @@ def test_link_masses(model):
     np.testing.assert_allclose(model.link_map["pedestal"].inertial.origin[:3, 3], [0, 0, -0.5])
     arm = sum(model.link_map[n].inertial.mass for n in ARM_MASS_LINKS)
     assert arm == pytest.approx(19.16, abs=0.01)  # facts: base_link ... l6 = 19.16 kg
-    gripper = sum(model.link_map[n].inertial.mass
-                  for n in ("right_gripper_base", "r_gripper_l_finger", "r_gripper_r_finger"))
+    gripper = sum(
+        model.link_map[n].inertial.mass for n in ("right_gripper_base", "r_gripper_l_finger", "r_gripper_r_finger")
+    )
     assert gripper == pytest.approx(0.36, abs=1e-9)  # 0.3 body + 2 x (0.02 finger + 0.01 tip)
     total = sum(link.inertial.mass for link in model.robot.links)
     assert total == pytest.approx(60.864 + 19.155 + 1.5795 + 0.36, abs=0.01)
@@ -230,6 +241,7 @@ def test_link_masses(model):
 
 def test_collision_shapes_follow_upstream(model):
     """A sample of the upstream primitive collision shapes, in their links' frames."""
+
     def shapes(link):
         out = []
         for c in model.link_map[link].collisions:
@@ -261,6 +273,7 @@ def test_collision_shapes_follow_upstream(model):
 
 # --------------------------------------------------------------------------------------------
 # forward kinematics
+
 
 def test_fk_matches_dh_table_within_2mm(bullet):
     worst_p, worst_r = 0.0, 0.0
@@ -300,6 +313,7 @@ def test_tool_mount_and_end_effector_on_the_approach_axis(bullet):
 # --------------------------------------------------------------------------------------------
 # standard URDF checks, library part
 
+
 def test_check_urdf_passes(urdf_path):
     res = subprocess.run([str(CHECK_URDF), str(urdf_path)], capture_output=True, text=True, timeout=30)
     assert res.returncode == 0, res.stdout + res.stderr
@@ -330,7 +344,10 @@ def test_library_part():
     assert arm.joints == ARM_JOINTS
     assert (arm.end_effector, arm.tool_mount) == ("right_gripper", "right_gripper_base")
     assert part.gripper["right"].joints == FINGER_JOINTS
-    assert {k: part.gripper["right"].positions[k] for k in ("spoon", "none")} == {"spoon": 0.0, "none": 0.0}  # facts: feeding 0
+    assert {k: part.gripper["right"].positions[k] for k in ("spoon", "none")} == {
+        "spoon": 0.0,
+        "none": 0.0,
+    }  # facts: feeding 0
     assert not part.mountable
     assert part.base_height_m == BASE_HEIGHT
 
@@ -340,8 +357,7 @@ def test_stands_on_the_floor_at_the_reference_height(urdf_path):
     point is on the floor, and right_j1 (the shoulder) is 0.975 + 0.317 m up."""
     cid = pb.connect(pb.DIRECT)
     try:
-        body = pb.loadURDF(str(urdf_path), [0, 0, BASE_HEIGHT], [0, 0, 0, 1], useFixedBase=True,
-                           physicsClientId=cid)
+        body = pb.loadURDF(str(urdf_path), [0, 0, BASE_HEIGHT], [0, 0, 0, 1], useFixedBase=True, physicsClientId=cid)
         pb.performCollisionDetection(physicsClientId=cid)
         n = pb.getNumJoints(body, physicsClientId=cid)
         lowest = min(pb.getAABB(body, j, physicsClientId=cid)[0][2] for j in range(-1, n))
@@ -356,6 +372,7 @@ def test_stands_on_the_floor_at_the_reference_height(urdf_path):
 
 # --------------------------------------------------------------------------------------------
 # spoon grip
+
 
 def test_spoon_grip_centres_the_handle_end_between_the_fingertips(bullet, tmp_path):
     part = Library().get("robots", "sawyer").part
@@ -380,11 +397,11 @@ def test_spoon_grip_centres_the_handle_end_between_the_fingertips(bullet, tmp_pa
     mid = (pads[0] + pads[1]) / 2
     assert np.linalg.norm(end_world - mid) < 0.002
 
-    approach = mount[:3, 2]          # out of the hand
-    closing = pads[0] - pads[1]      # the fingers close along this line
+    approach = mount[:3, 2]  # out of the hand
+    closing = pads[0] - pads[1]  # the fingers close along this line
     closing /= np.linalg.norm(closing)
-    np.testing.assert_allclose(t_spoon[:3, 1], approach, atol=1e-6)       # spoon +y along approach
-    assert abs(float(t_spoon[:3, 2] @ closing)) < 1e-6                    # bowl opening ⟂ closing
+    np.testing.assert_allclose(t_spoon[:3, 1], approach, atol=1e-6)  # spoon +y along approach
+    assert abs(float(t_spoon[:3, 2] @ closing)) < 1e-6  # bowl opening ⟂ closing
     # The 12 mm handle fits between the closed paddles (16 mm apart).
     assert np.linalg.norm(pads[0] - pads[1]) - 0.0065 == pytest.approx(0.016, abs=1e-6)
 
@@ -392,22 +409,37 @@ def test_spoon_grip_centres_the_handle_end_between_the_fingertips(bullet, tmp_pa
 # --------------------------------------------------------------------------------------------
 # physics
 
+
 def test_position_control_holds_a_random_pose(urdf_path):
     cid = pb.connect(pb.DIRECT)
     try:
-        body = pb.loadURDF(str(urdf_path), [0, 0, BASE_HEIGHT], [0, 0, 0, 1], useFixedBase=True,
-                           flags=pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=cid)
+        body = pb.loadURDF(
+            str(urdf_path),
+            [0, 0, BASE_HEIGHT],
+            [0, 0, 0, 1],
+            useFixedBase=True,
+            flags=pb.URDF_USE_INERTIA_FROM_FILE,
+            physicsClientId=cid,
+        )
         pb.setGravity(0, 0, 0, physicsClientId=cid)
-        idx = {pb.getJointInfo(body, j, physicsClientId=cid)[1].decode(): j
-               for j in range(pb.getNumJoints(body, physicsClientId=cid))}
+        idx = {
+            pb.getJointInfo(body, j, physicsClientId=cid)[1].decode(): j
+            for j in range(pb.getNumJoints(body, physicsClientId=cid))
+        }
         ee = idx["right_endpoint"]  # joint index == child link index (right_gripper)
         arm = [idx[j] for j in ARM_JOINTS]
         q = random_configs(n=1, seed=4)[0]
         for i, v in zip(arm, q):
             pb.resetJointState(body, i, float(v), physicsClientId=cid)
         start = np.array(pb.getLinkState(body, ee, computeForwardKinematics=True, physicsClientId=cid)[4])
-        pb.setJointMotorControlArray(body, arm, pb.POSITION_CONTROL, targetPositions=list(q),
-                                     forces=[LIMITS[j][2] for j in ARM_JOINTS], physicsClientId=cid)
+        pb.setJointMotorControlArray(
+            body,
+            arm,
+            pb.POSITION_CONTROL,
+            targetPositions=list(q),
+            forces=[LIMITS[j][2] for j in ARM_JOINTS],
+            physicsClientId=cid,
+        )
         for _ in range(50):
             pb.stepSimulation(physicsClientId=cid)
         end = np.array(pb.getLinkState(body, ee, computeForwardKinematics=True, physicsClientId=cid)[4])

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers import compiled_env
 
 from assistive_compiler.paths import specs_dir
-from helpers import compiled_env
 
 SCRATCH_ITCH = specs_dir() / "tasks" / "scratch_itch.yaml"
 

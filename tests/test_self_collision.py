@@ -92,7 +92,11 @@ def test_arm_pairs_are_the_reference_groups_minus_touching_at_rest(arm_env):
     assert pairs, "a moving arm collides with the body"
     assert pairs <= self_collision_pairs()  # link names of the reference's groups
     assert all(ARM_LINKS & set(pair) for pair in pairs)  # only the moving arm's group
-    assert {("chest", "right_elbow"), ("chest", "right_wrist"), ("head", "right_wrist")} <= pairs  # forearm, hand vs torso/legs; hand vs head
+    assert {
+        ("chest", "right_elbow"),
+        ("chest", "right_wrist"),
+        ("head", "right_wrist"),
+    } <= pairs  # forearm, hand vs torso/legs; hand vs head
     assert ("chest", "right_shoulder") not in pairs  # the upper arm overlaps the chest capsule at rest
     assert not any("pecs" in a or "pecs" in b for a, b in pairs)  # girdles never collide
 
@@ -112,9 +116,9 @@ def test_the_plan_is_exact_on_the_unmerged_body():
     """person_self_collision on a rendered body: every pair of geometry links lands on surviving
     links whose pair decision is the reference's (for the moving groups)."""
     from assistive_compiler.library import PERSON_TEMPLATE_RELPATH
-    from assistive_compiler.templates import expand_template
     from assistive_compiler.paths import templates_dir
     from assistive_compiler.person.body import REVOLUTE_JOINTS, body_measurements, format_fixed_joints
+    from assistive_compiler.templates import expand_template
 
     movable = {"right_elbow", "head_x", "head_y", "head_z"}  # only the forearm of the right arm moves
     fixed = {j: 0.0 for j in REVOLUTE_JOINTS if j not in movable}
@@ -126,8 +130,10 @@ def test_the_plan_is_exact_on_the_unmerged_body():
     assert {"right_shoulder", "right_pecs"} <= keep
     assert ("chest", "right_elbow_link") in pairs and ("right_elbow_link", "right_shoulder") not in pairs
     nothing_moves = {j: 0.0 for j in REVOLUTE_JOINTS}
-    xml = expand_template(templates_dir() / PERSON_TEMPLATE_RELPATH,
-                          body_measurements("male").xacro_args(fixed_joints=format_fixed_joints(nothing_moves)))
+    xml = expand_template(
+        templates_dir() / PERSON_TEMPLATE_RELPATH,
+        body_measurements("male").xacro_args(fixed_joints=format_fixed_joints(nothing_moves)),
+    )
     assert person_self_collision(xml, set()) == (set(), [])
 
 

@@ -16,14 +16,13 @@ from pathlib import Path
 
 import pytest
 import yaml
+from helpers import at
 
 from assistive_compiler.cli import main
 from assistive_compiler.errors import SpecError, one_of
 from assistive_compiler.library import Library
 from assistive_compiler.paths import display
-from assistive_compiler.spec.load import load_spec
 from assistive_compiler.yamlsrc import loads_located
-from helpers import at
 
 REPO = Path(__file__).resolve().parents[1]
 FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
@@ -74,8 +73,10 @@ def feeding_location(needle: str, offset: int = 0) -> str:
     return f"{display(FEEDING)}:{line}:{int(column) + offset}"
 
 
-LANDMARKS_TAIL = "; landmarks: mouth, chin, nose, right_cheek, left_cheek, right_palm, left_palm, right_fingertips, left_fingertips, " \
-                 "right_heel, left_heel, right_toes, left_toes"
+LANDMARKS_TAIL = (
+    "; landmarks: mouth, chin, nose, right_cheek, left_cheek, right_palm, left_palm, right_fingertips, left_fingertips, "
+    "right_heel, left_heel, right_toes, left_toes"
+)
 
 
 def inherited(section: str, parent: Path, child: Path) -> str:
@@ -85,8 +86,10 @@ def inherited(section: str, parent: Path, child: Path) -> str:
 
 def relative_to_food_note(child: Path) -> str:
     """The note on a success threshold checked against Feeding's inherited ``relative_to: food``."""
-    return (f" (relative_to: food is inherited from {feeding_location('relative_to: ', len('relative_to: '))}; remove it in "
-            f"{display(child)} with success: {{$delete: [relative_to]}}, or rewrite success whole with success: {{$replace: {{...}}}})")
+    return (
+        f" (relative_to: food is inherited from {feeding_location('relative_to: ', len('relative_to: '))}; remove it in "
+        f"{display(child)} with success: {{$delete: [relative_to]}}, or rewrite success whole with success: {{$replace: {{...}}}})"
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -113,7 +116,10 @@ def test_yaml_11_boolean_words_are_refused_as_keys(tmp_path, capsys):
     path = write(tmp_path, text)
     rc, out, err = run_cli(capsys, "validate", str(path))
     assert rc == 2
-    assert err == f"{path}:{at(text, 'on:')}: 'on' is a YAML 1.1 boolean word (PyYAML reads it as True), so no spec key may be one (did you mean 'onto'?)\n"
+    assert (
+        err
+        == f"{path}:{at(text, 'on:')}: 'on' is a YAML 1.1 boolean word (PyYAML reads it as True), so no spec key may be one (did you mean 'onto'?)\n"
+    )
     with pytest.raises(SpecError) as info:
         loads_located("yes: 1\nOff: 2\n", "keys.yaml")
     assert [str(p) for p in info.value.problems] == [
@@ -136,7 +142,11 @@ def test_duplicate_key_names_first_definition(tmp_path, capsys):
     text = EXTENDS + "sim:\n  frame_skip: 5\n  episode_steps: 100\n  frame_skip: 6\n"
     path = write(tmp_path, text)
     first = at(text, "frame_skip").split(":")
-    check(capsys, path, f"{at(text, 'frame_skip', 2)}: duplicate key 'frame_skip' (first defined at line {first[0]}, column {first[1]})")
+    check(
+        capsys,
+        path,
+        f"{at(text, 'frame_skip', 2)}: duplicate key 'frame_skip' (first defined at line {first[0]}, column {first[1]})",
+    )
     assert first == ["3", "3"]
 
 
@@ -156,7 +166,11 @@ def test_top_level_list(tmp_path, capsys):
 
 def test_top_level_scalar(tmp_path, capsys):
     path = write(tmp_path, "feeding\n")
-    check(capsys, path, "1:1: top level is a single value ('feeding'); expected a mapping of spec fields (e.g. 'name: my_task')")
+    check(
+        capsys,
+        path,
+        "1:1: top level is a single value ('feeding'); expected a mapping of spec fields (e.g. 'name: my_task')",
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -175,7 +189,11 @@ def test_extends_missing_file(tmp_path, capsys):
     text = "name: x\nextends: base/missing.yaml\n"
     path = write(tmp_path, text)
     missing = display(tmp_path / "base" / "missing.yaml")
-    check(capsys, path, f"{at(text, 'base/')}: extends: file not found: {missing} (paths are relative to {display(tmp_path)}/)")
+    check(
+        capsys,
+        path,
+        f"{at(text, 'base/')}: extends: file not found: {missing} (paths are relative to {display(tmp_path)}/)",
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -196,7 +214,11 @@ def test_unknown_key_did_you_mean(tmp_path, capsys):
 def test_wrong_type(tmp_path, capsys):
     text = EXTENDS + "sim:\n  frame_skip: five\n"
     path = write(tmp_path, text)
-    check(capsys, path, f"{at(text, 'five')}: sim.frame_skip: must be a valid integer, unable to parse string as an integer, got 'five'")
+    check(
+        capsys,
+        path,
+        f"{at(text, 'five')}: sim.frame_skip: must be a valid integer, unable to parse string as an integer, got 'five'",
+    )
 
 
 def test_list_where_mapping_expected(tmp_path, capsys):
@@ -223,7 +245,11 @@ def test_vector_of_wrong_length(tmp_path, capsys):
 def test_number_or_uniform_given_a_word(tmp_path, capsys):
     text = EXTENDS + "sim:\n  ground: {friction: slippery}\n"
     path = write(tmp_path, text)
-    check(capsys, path, f"{at(text, 'slippery')}: sim.ground.friction: expected a number or {{uniform: [low, high]}}, got 'slippery'")
+    check(
+        capsys,
+        path,
+        f"{at(text, 'slippery')}: sim.ground.friction: expected a number or {{uniform: [low, high]}}, got 'slippery'",
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -248,7 +274,9 @@ def test_success_fraction_out_of_range(tmp_path, capsys):
     lines = problems(capsys, path)
     assert len(lines) == 1
     assert lines[0].startswith(f"{display(path)}:{at(text, '1.5')}: ")
-    assert lines[0].endswith(f"threshold 1.5 is a fraction of 'food' and must lie in (0, 1]{relative_to_food_note(path)}")
+    assert lines[0].endswith(
+        f"threshold 1.5 is a fraction of 'food' and must lie in (0, 1]{relative_to_food_note(path)}"
+    )
 
 
 def test_success_fraction_out_of_range_message(tmp_path, capsys):
@@ -256,7 +284,9 @@ def test_success_fraction_out_of_range_message(tmp_path, capsys):
     text = EXTENDS + "success: {threshold: 1.5}\n"
     path = write(tmp_path, text)
     [line] = problems(capsys, path)
-    assert line.endswith(f": success.threshold: threshold 1.5 is a fraction of 'food' and must lie in (0, 1]{relative_to_food_note(path)}")
+    assert line.endswith(
+        f": success.threshold: threshold 1.5 is a fraction of 'food' and must lie in (0, 1]{relative_to_food_note(path)}"
+    )
 
 
 def test_success_threshold_absolute_without_relative_to(tmp_path, capsys):
@@ -362,13 +392,19 @@ def test_default_robot_not_supported_message(tmp_path, capsys):
     text = EXTENDS + "robot:\n  default: jacco\n"
     path = write(tmp_path, text)
     [line] = problems(capsys, path)
-    assert line.endswith(f": robot.default: default robot 'jacco' is not in supported {SUPPORTED} (did you mean 'jaco'?)")
+    assert line.endswith(
+        f": robot.default: default robot 'jacco' is not in supported {SUPPORTED} (did you mean 'jaco'?)"
+    )
 
 
 def test_unknown_tool_part(tmp_path, capsys):
     text = EXTENDS + "tools:\n  spoon: {part: spon}\n"
     path = write(tmp_path, text)
-    check(capsys, path, f"{at(text, 'spon}')}: unknown tool 'spon'; expected one of 'cup', 'scooper', 'scratcher', 'spoon', 'wiper' (did you mean 'spoon'?)")
+    check(
+        capsys,
+        path,
+        f"{at(text, 'spon}')}: unknown tool 'spon'; expected one of 'cup', 'scooper', 'scratcher', 'spoon', 'wiper' (did you mean 'spoon'?)",
+    )
 
 
 def test_unknown_furniture_part(tmp_path, capsys):
@@ -422,9 +458,13 @@ def test_a_body_part_by_its_everyday_name_names_the_link_that_is_it(tmp_path, ca
     not the spelling-nearest 'right_ankle'."""
     text = EXTENDS + "targets:\n  mouth:\n    link: person.right_hand\n"
     path = write(tmp_path, text)
-    check(capsys, path, f"{at(text, 'person.right_hand')}: unknown link 'right_hand' of person; the hand is link 'right_wrist' "
-                        "(limb links are named after the joint at their top), and person points on it: person.right_palm, "
-                        f"person.right_fingertips; all 43 links of the person and their frames: docs/person.md{LANDMARKS_TAIL}")
+    check(
+        capsys,
+        path,
+        f"{at(text, 'person.right_hand')}: unknown link 'right_hand' of person; the hand is link 'right_wrist' "
+        "(limb links are named after the joint at their top), and person points on it: person.right_palm, "
+        f"person.right_fingertips; all 43 links of the person and their frames: docs/person.md{LANDMARKS_TAIL}",
+    )
 
 
 def test_unknown_robot_link_in_term_param(tmp_path, capsys):
@@ -440,7 +480,11 @@ def test_unknown_robot_link_in_term_param(tmp_path, capsys):
 
 
 def test_unknown_target_in_term_param(tmp_path, capsys):
-    text = EXTENDS + "reward:\n  - {name: to_mouth, term: distance, weight: -1.0, params: {a: spoon, b: mouht}}\n" + FOOD_EATEN
+    text = (
+        EXTENDS
+        + "reward:\n  - {name: to_mouth, term: distance, weight: -1.0, params: {a: spoon, b: mouht}}\n"
+        + FOOD_EATEN
+    )
     path = write(tmp_path, text)
     check(
         capsys,
@@ -452,11 +496,17 @@ def test_unknown_target_in_term_param(tmp_path, capsys):
 
 def test_unknown_target_in_term_param_is_located(tmp_path, capsys):
     """Whatever its wording, the problem is located at the misspelt target and suggests 'mouth'."""
-    text = EXTENDS + "reward:\n  - {name: to_mouth, term: distance, weight: -1.0, params: {a: spoon, b: mouht}}\n" + FOOD_EATEN
+    text = (
+        EXTENDS
+        + "reward:\n  - {name: to_mouth, term: distance, weight: -1.0, params: {a: spoon, b: mouht}}\n"
+        + FOOD_EATEN
+    )
     path = write(tmp_path, text)
     [line] = problems(capsys, path)
     assert line.startswith(f"{display(path)}:{at(text, 'mouht')}: unknown ")
-    assert line.endswith("'mouht'; expected one of 'bowl', 'mouth', 'person', 'robot', 'spoon', 'table', 'wheelchair' (did you mean 'mouth'?)")
+    assert line.endswith(
+        "'mouht'; expected one of 'bowl', 'mouth', 'person', 'robot', 'spoon', 'table', 'wheelchair' (did you mean 'mouth'?)"
+    )
 
 
 def test_unknown_preference(tmp_path, capsys):
@@ -471,9 +521,13 @@ def test_unknown_preference(tmp_path, capsys):
 
 
 def test_unknown_particle_set(tmp_path, capsys):
-    text = EXTENDS + "reward:\n  - {name: food_eaten, term: particles_consumed, weight: 20.0, params: {particles: fod}}\n"
+    text = (
+        EXTENDS + "reward:\n  - {name: food_eaten, term: particles_consumed, weight: 20.0, params: {particles: fod}}\n"
+    )
     path = write(tmp_path, text)
-    check(capsys, path, f"{at(text, 'fod}')}: unknown particle set 'fod'; expected one of 'food' (did you mean 'food'?)")
+    check(
+        capsys, path, f"{at(text, 'fod}')}: unknown particle set 'fod'; expected one of 'food' (did you mean 'food'?)"
+    )
 
 
 def test_unknown_joint_group(tmp_path, capsys):
@@ -524,8 +578,10 @@ def test_unknown_seat_furniture(tmp_path, capsys):
 # furniture only under a mounted robot; mount furniture carried under a searched base
 
 BATHING = REPO / "specs" / "tasks" / "bed_bathing.yaml"
-CONDITIONAL = ("is in the scene only when the robot is mounted on it (only_when_mounted: true), so nothing may refer to it; "
-               "refer to furniture that is always there")
+CONDITIONAL = (
+    "is in the scene only when the robot is mounted on it (only_when_mounted: true), so nothing may refer to it; "
+    "refer to furniture that is always there"
+)
 
 
 def bathing_location(needle: str, offset: int = 0) -> str:
@@ -537,11 +593,13 @@ def bathing_location(needle: str, offset: int = 0) -> str:
 def test_only_when_mounted_is_for_the_mount_furniture_and_unreferenced(tmp_path, capsys):
     text = f"extends: {BATHING}\nscene:\n  furniture:\n    bed: {{part: bed, position_m: [-0.1, 0, 0], only_when_mounted: true}}\n"
     path = write(tmp_path, text)
-    assert sorted(problems(capsys, path)) == sorted([  # one in each file
-        f"{bathing_location('bed]}}')}: furniture 'bed' {CONDITIONAL}{inherited('observations.robot[6].params.b[1]', BATHING, path)}",
-        f"{display(path)}:{at(text, 'true')}: furniture 'bed' is only_when_mounted but the robot mounts on 'nightstand' "
-        "(robot.mount_on); only the mount furniture can be left out for robots that stand on the floor",
-    ])
+    assert sorted(problems(capsys, path)) == sorted(
+        [  # one in each file
+            f"{bathing_location('bed]}}')}: furniture 'bed' {CONDITIONAL}{inherited('observations.robot[6].params.b[1]', BATHING, path)}",
+            f"{display(path)}:{at(text, 'true')}: furniture 'bed' is only_when_mounted but the robot mounts on 'nightstand' "
+            "(robot.mount_on); only the mount furniture can be left out for robots that stand on the floor",
+        ]
+    )
 
 
 def test_referring_to_furniture_present_only_when_mounted(tmp_path, capsys):
@@ -554,16 +612,22 @@ def test_scripted_per_robot_names_known_robots(tmp_path, capsys):
     text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    jacco:\n      waypoints: [{{to: person.right_elbow}}]\n"
     path = write(tmp_path, text)
     robots = Library().names("robots")
-    check(capsys, path, f"{at(text, 'jacco')}: per_robot names unknown robot 'jacco'; expected one of {one_of(robots)} (did you mean 'jaco'?)")
+    check(
+        capsys,
+        path,
+        f"{at(text, 'jacco')}: per_robot names unknown robot 'jacco'; expected one of {one_of(robots)} (did you mean 'jaco'?)",
+    )
 
 
 def test_per_robot_arm_rest_has_one_value_per_arm_joint(tmp_path, capsys):
     text = f"extends: {BATHING}\nrobot:\n  per_robot:\n    jaco:\n      arm_rest_rad: [0.0, 1.0]\n"
     path = write(tmp_path, text)
     lines = problems(capsys, path)
-    assert lines == [f"{display(path)}:{at(text, '[0.0, 1.0]')}: arm_rest_rad has 2 values "
-                     "but the arm of 'jaco' has 7 joints (j2s7s300_joint_1, j2s7s300_joint_2, j2s7s300_joint_3, j2s7s300_joint_4, "
-                     "j2s7s300_joint_5, j2s7s300_joint_6, j2s7s300_joint_7)"]
+    assert lines == [
+        f"{display(path)}:{at(text, '[0.0, 1.0]')}: arm_rest_rad has 2 values "
+        "but the arm of 'jaco' has 7 joints (j2s7s300_joint_1, j2s7s300_joint_2, j2s7s300_joint_3, j2s7s300_joint_4, "
+        "j2s7s300_joint_5, j2s7s300_joint_6, j2s7s300_joint_7)"
+    ]
 
 
 def test_scripted_per_robot_waypoints_are_checked_where_written(tmp_path, capsys):
@@ -572,16 +636,26 @@ def test_scripted_per_robot_waypoints_are_checked_where_written(tmp_path, capsys
     text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    panda:\n      waypoints: [{{to: person.right_elbow}}]\n      repeat_from: 1\n"
     path = write(tmp_path, text)
     line, column = at(text, "repeat_from: 1").split(":")
-    check(capsys, path, f"{line}:{int(column) + len('repeat_from: ')}: scripted.per_robot.panda.repeat_from: "
-                        "repeat_from 1 is not a waypoint index (0..0)")
+    check(
+        capsys,
+        path,
+        f"{line}:{int(column) + len('repeat_from: ')}: scripted.per_robot.panda.repeat_from: "
+        "repeat_from 1 is not a waypoint index (0..0)",
+    )
     text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    panda:\n      waypoints: [{{to: person.right_elbw}}]\n      repeat_from: 0\n"
     path = write(tmp_path, text)
     lines = problems(capsys, path)
-    assert len(lines) == 1 and lines[0].startswith(f"{display(path)}:{at(text, 'person.right_elbw')}: ") \
-        and "unknown link 'right_elbw' of person" in lines[0] and "(did you mean 'right_elbow'?); all 43 links of the person" in lines[0]
+    assert (
+        len(lines) == 1
+        and lines[0].startswith(f"{display(path)}:{at(text, 'person.right_elbw')}: ")
+        and "unknown link 'right_elbw' of person" in lines[0]
+        and "(did you mean 'right_elbow'?); all 43 links of the person" in lines[0]
+    )
 
 
-SHIPPED_SEGMENTS = "'forearm_level', 'lane_40', 'onto_forearm', 'side_lanes'"  # the shipped bed-bathing spec's scripted.segments
+SHIPPED_SEGMENTS = (
+    "'forearm_level', 'lane_40', 'onto_forearm', 'side_lanes'"  # the shipped bed-bathing spec's scripted.segments
+)
 
 
 def test_segment_uses_name_a_segment_and_segments_splice_none(tmp_path, capsys):
@@ -589,29 +663,51 @@ def test_segment_uses_name_a_segment_and_segments_splice_none(tmp_path, capsys):
     key, and a segment holds waypoints only (one level: a reader looks a name up once)."""
     text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    panda:\n      waypoints: [{{segment: side_lane}}]\n"
     path = write(tmp_path, text)
-    check(capsys, path, f"{at(text, 'side_lane}')}: unknown segment 'side_lane'; expected one of {SHIPPED_SEGMENTS} "
-                        "(did you mean 'side_lanes'?)")
+    check(
+        capsys,
+        path,
+        f"{at(text, 'side_lane}')}: unknown segment 'side_lane'; expected one of {SHIPPED_SEGMENTS} "
+        "(did you mean 'side_lanes'?)",
+    )
     text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    panda:\n      waypoints: [{{segment: lane_40, step_m: 0.1}}]\n"
     path = write(tmp_path, text)
-    check(capsys, path, f"{at(text, 'step_m')}: unknown key 'step_m' in scripted.per_robot.panda.waypoints[0]; expected one of 'segment'")
-    text = (f"extends: {BATHING}\nscripted:\n  segments:\n    both: [{{segment: lane_40}}, {{to: person.right_elbow}}]\n"
-            "  per_robot:\n    panda:\n      waypoints: [{segment: both}]\n")
+    check(
+        capsys,
+        path,
+        f"{at(text, 'step_m')}: unknown key 'step_m' in scripted.per_robot.panda.waypoints[0]; expected one of 'segment'",
+    )
+    text = (
+        f"extends: {BATHING}\nscripted:\n  segments:\n    both: [{{segment: lane_40}}, {{to: person.right_elbow}}]\n"
+        "  per_robot:\n    panda:\n      waypoints: [{segment: both}]\n"
+    )
     path = write(tmp_path, text)
-    check(capsys, path, f"{at(text, 'lane_40')}: segment 'both' uses segment 'lane_40'; a segment holds waypoints only: "
-                        "write them here, or splice both segments into the script one after the other")
+    check(
+        capsys,
+        path,
+        f"{at(text, 'lane_40')}: segment 'both' uses segment 'lane_40'; a segment holds waypoints only: "
+        "write them here, or splice both segments into the script one after the other",
+    )
 
 
 def test_segments_are_not_empty_and_each_one_a_spec_defines_is_used(tmp_path, capsys):
     """An empty segment and one the spec file defines but no script uses are errors (a dead segment
     drifts from the scripts a reader thinks use it); one inherited through extends may go unused."""
-    text = (f"extends: {BATHING}\nscripted:\n  segments:\n    none: []\n    spare: [{{to: person.right_elbow}}]\n"
-            "  per_robot:\n    panda:\n      waypoints: [{segment: none}, {to: person.right_wrist}]\n")
+    text = (
+        f"extends: {BATHING}\nscripted:\n  segments:\n    none: []\n    spare: [{{to: person.right_elbow}}]\n"
+        "  per_robot:\n    panda:\n      waypoints: [{segment: none}, {to: person.right_wrist}]\n"
+    )
     path = write(tmp_path, text)
-    check(capsys, path, f"{at(text, '[]')}: segment 'none' has no waypoints; give it at least one, or delete it",
-          f"{at(text, 'spare')}: segment 'spare' is never used; splice it into a script with {{segment: spare}}, or delete it")
+    check(
+        capsys,
+        path,
+        f"{at(text, '[]')}: segment 'none' has no waypoints; give it at least one, or delete it",
+        f"{at(text, 'spare')}: segment 'spare' is never used; splice it into a script with {{segment: spare}}, or delete it",
+    )
     # Scripts of their own for every robot: the shipped spec's segments, inherited, are used by none.
-    text = (f"extends: {BATHING}\nscripted:\n  waypoints: [{{to: person.right_elbow}}, {{to: person.right_wrist}}]\n"
-            "  per_robot: {$replace: {}}\n")
+    text = (
+        f"extends: {BATHING}\nscripted:\n  waypoints: [{{to: person.right_elbow}}, {{to: person.right_wrist}}]\n"
+        "  per_robot: {$replace: {}}\n"
+    )
     path = write(tmp_path, text)
     rc, out, err = run_cli(capsys, "validate", str(path))
     assert (rc, err) == (0, "")
@@ -620,16 +716,24 @@ def test_segments_are_not_empty_and_each_one_a_spec_defines_is_used(tmp_path, ca
 def test_segment_waypoints_are_checked_where_the_segment_writes_them(tmp_path, capsys):
     """A mistake in a segment's waypoint is reported once, at the segment, however often it is
     spliced in; repeat_from counts the spliced waypoints."""
-    text = (f"extends: {BATHING}\nscripted:\n  segments:\n    bad: [{{to: person.right_elbw}}]\n"
-            "  per_robot:\n    panda:\n      waypoints: [{segment: bad}, {segment: bad}]\n")
+    text = (
+        f"extends: {BATHING}\nscripted:\n  segments:\n    bad: [{{to: person.right_elbw}}]\n"
+        "  per_robot:\n    panda:\n      waypoints: [{segment: bad}, {segment: bad}]\n"
+    )
     path = write(tmp_path, text)
     lines = problems(capsys, path)
-    assert len(lines) == 1 and lines[0].startswith(f"{display(path)}:{at(text, 'person.right_elbw')}: unknown link 'right_elbw' of person")
+    assert len(lines) == 1 and lines[0].startswith(
+        f"{display(path)}:{at(text, 'person.right_elbw')}: unknown link 'right_elbw' of person"
+    )
     text = f"extends: {BATHING}\nscripted:\n  per_robot:\n    panda:\n      waypoints: [{{segment: lane_40}}]\n      repeat_from: 4\n"
     path = write(tmp_path, text)
     line, column = at(text, "repeat_from: 4").split(":")
-    check(capsys, path, f"{line}:{int(column) + len('repeat_from: ')}: scripted.per_robot.panda.repeat_from: "
-                        "repeat_from 4 is not a waypoint index (0..3)")
+    check(
+        capsys,
+        path,
+        f"{line}:{int(column) + len('repeat_from: ')}: scripted.per_robot.panda.repeat_from: "
+        "repeat_from 4 is not a waypoint index (0..3)",
+    )
 
 
 def test_searched_mount_needs_furniture_present_only_when_mounted(tmp_path, capsys):
@@ -645,8 +749,12 @@ def test_searched_mount_needs_furniture_present_only_when_mounted(tmp_path, caps
 def test_carried_furniture_has_no_scene_position(tmp_path, capsys):
     text = f"extends: {BATHING}\nscene:\n  furniture:\n    nightstand: {{part: nightstand, only_when_mounted: true, position_m: [-0.9, 0.7, 0]}}\n"
     path = write(tmp_path, text)
-    check(capsys, path, f"{at(text, '[-0.9')}: furniture 'nightstand' is carried under the robot's searched base "
-                        "(robot.mount_base: search), so its position_m is not used; remove it (move the base search instead)")
+    check(
+        capsys,
+        path,
+        f"{at(text, '[-0.9')}: furniture 'nightstand' is carried under the robot's searched base "
+        "(robot.mount_base: search), so its position_m is not used; remove it (move the base search instead)",
+    )
 
 
 def test_searched_mount_needs_a_mount(tmp_path, capsys):
@@ -722,7 +830,10 @@ def test_validate_reports_every_file(tmp_path, capsys):
     assert rc == 2
     assert "Traceback" not in out + err
     assert out == f"{good}: ok (task 'feeding', robots: {ROBOTS})\n"
-    assert err == f"{display(bad)}:3:15: sim.frame_skip: must be a valid integer, unable to parse string as an integer, got 'five'\n"
+    assert (
+        err
+        == f"{display(bad)}:3:15: sim.frame_skip: must be a valid integer, unable to parse string as an integer, got 'five'\n"
+    )
 
 
 def test_references_left_dangling_by_a_child_are_reported_where_inherited_with_the_remedy(tmp_path, capsys):
@@ -731,16 +842,17 @@ def test_references_left_dangling_by_a_child_are_reported_where_inherited_with_t
     child.write_text(f"extends: {FEEDING}\nname: feeding_variant\nparticles: {{$delete: [food]}}\n")
     rc, out, err = run_cli(capsys, "validate", str(child))
     assert rc == 2 and "Traceback" not in out + err
-    assert (f"{feeding_location('relative_to: ', len('relative_to: '))}: unknown particle or marker set 'food'; expected one of none "
-            f"(success.relative_to is inherited from {display(FEEDING)}; override it in {display(child)}, "
-            "or remove it there with $delete / $replace)") in err.splitlines()
+    assert (
+        f"{feeding_location('relative_to: ', len('relative_to: '))}: unknown particle or marker set 'food'; expected one of none "
+        f"(success.relative_to is inherited from {display(FEEDING)}; override it in {display(child)}, "
+        "or remove it there with $delete / $replace)"
+    ) in err.splitlines()
 
 
 def test_a_value_used_through_an_alias_is_located_at_the_alias_and_its_insides_at_the_anchor():
     """The robot's own base_search written as ``*wide`` is in force at the alias; a key inside it
     was written at the anchor."""
-    text = ("search: &wide {attempts: 5, x_range_m: [0, 1]}\n"
-            "robot:\n  per_robot:\n    jaco:\n      base_search: *wide\n")
+    text = "search: &wide {attempts: 5, x_range_m: [0, 1]}\nrobot:\n  per_robot:\n    jaco:\n      base_search: *wide\n"
     data, smap = loads_located(text, "t.yaml")
     assert data["robot"]["per_robot"]["jaco"]["base_search"] == {"attempts": 5, "x_range_m": [0, 1]}
     assert str(smap.value(("robot", "per_robot", "jaco", "base_search"))) == "t.yaml:5:20"

@@ -20,13 +20,12 @@ import numpy as np
 import pybullet as pb
 import pytest
 import xacro
+from frames import homogeneous, origin_matrix, rot_z
 
 from assistive_compiler.bullet import connect
 from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.library import Library
 from assistive_compiler.runtime.env import AssistiveEnv
-
-from frames import homogeneous, origin_matrix, rot_z
 
 REPO = Path(__file__).resolve().parents[1]
 TEMPLATE = REPO / "templates" / "robots" / "stretch.urdf.xacro"
@@ -37,14 +36,16 @@ TUBES = ["joint_arm_l3", "joint_arm_l2", "joint_arm_l1", "joint_arm_l0"]
 # The sheet's §1.1 joint table, from base_link to link_grasp_center (original values).
 # (xyz, rpy, kind): kind None = fixed, "z" = prismatic along z (value: lift or extension), "yaw" = revolute about -z.
 CHAIN = [
-    ((-0.07, 0.135, 0.0284), (1.570796, 0, 0.00925318926571245), None),                                  # joint_mast
+    ((-0.07, 0.135, 0.0284), (1.570796, 0, 0.00925318926571245), None),  # joint_mast
     ((-0.0369217062323472, 0.165471199999996, -0.000341653286793524), (-1.570796, 1.5615431375292, 0), "lift"),
-    ((-0.25471, 0, 0), (1.5708, 0, -1.5708), None),                                                     # joint_arm_l4
-    ((0, 0, 0.013), (0, 0, 0), "ext"), ((0, 0, 0.013), (0, 0, 0), "ext"), ((0, 0, 0.013), (0, 0, 0), "ext"),
+    ((-0.25471, 0, 0), (1.5708, 0, -1.5708), None),  # joint_arm_l4
+    ((0, 0, 0.013), (0, 0, 0), "ext"),
+    ((0, 0, 0.013), (0, 0, 0), "ext"),
+    ((0, 0, 0.013), (0, 0, 0), "ext"),
     ((0, 0, -0.01375), (0, 0, 0), "ext"),
-    ((0.083, -0.03075, 0), (1.5708, 0, 0), "yaw"),                                                      # axis (0, 0, -1)
-    ((0, 0, 0), (3.14159, 0, -1.5708), None),                                                           # joint_gripper
-    ((-0.205478, 0, -0.138154), (0, 0, 3.141579), None),                                                # joint_grasp_center
+    ((0.083, -0.03075, 0), (1.5708, 0, 0), "yaw"),  # axis (0, 0, -1)
+    ((0, 0, 0), (3.14159, 0, -1.5708), None),  # joint_gripper
+    ((-0.205478, 0, -0.138154), (0, 0, 3.141579), None),  # joint_grasp_center
 ]
 
 
@@ -76,8 +77,14 @@ def robot(urdf_xml, tmp_path_factory):
     path.write_text(urdf_xml)
     c = pb.connect(pb.DIRECT)
     rid = pb.loadURDF(str(path), useFixedBase=True, physicsClientId=c)
-    joints = {pb.getJointInfo(rid, j, physicsClientId=c)[1].decode(): j for j in range(pb.getNumJoints(rid, physicsClientId=c))}
-    links = {pb.getJointInfo(rid, j, physicsClientId=c)[12].decode(): j for j in range(pb.getNumJoints(rid, physicsClientId=c))}
+    joints = {
+        pb.getJointInfo(rid, j, physicsClientId=c)[1].decode(): j
+        for j in range(pb.getNumJoints(rid, physicsClientId=c))
+    }
+    links = {
+        pb.getJointInfo(rid, j, physicsClientId=c)[12].decode(): j
+        for j in range(pb.getNumJoints(rid, physicsClientId=c))
+    }
     yield c, rid, joints, links
     pb.disconnect(c)
 
@@ -94,7 +101,9 @@ def test_grasp_centre_matches_the_joint_table_and_the_closed_form(robot):
         lift, ext, yaw = rng.uniform(0, 1.1), rng.uniform(0, 0.13), rng.uniform(-1.75, 4.0)
         for name, value in [("joint_lift", lift), *[(t, ext) for t in TUBES], ("joint_wrist_yaw", yaw)]:
             pb.resetJointState(rid, joints[name], value, physicsClientId=c)
-        got = np.array(pb.getLinkState(rid, links["link_grasp_center"], computeForwardKinematics=True, physicsClientId=c)[4])
+        got = np.array(
+            pb.getLinkState(rid, links["link_grasp_center"], computeForwardKinematics=True, physicsClientId=c)[4]
+        )
         worst_table = max(worst_table, float(np.linalg.norm(got - _table_fk(lift, ext, yaw))))
         worst_closed = max(worst_closed, float(np.linalg.norm(got - _closed_form(lift, ext, yaw))))
     assert worst_table < FK_TOLERANCE and worst_closed < FK_TOLERANCE
@@ -103,7 +112,10 @@ def test_grasp_centre_matches_the_joint_table_and_the_closed_form(robot):
 
 def test_limits_follow_the_sheet(robot):
     c, rid, joints, _ = robot
-    limits = {name: pb.getJointInfo(rid, joints[name], physicsClientId=c)[8:10] for name in ["joint_lift", *TUBES, "joint_wrist_yaw"]}
+    limits = {
+        name: pb.getJointInfo(rid, joints[name], physicsClientId=c)[8:10]
+        for name in ["joint_lift", *TUBES, "joint_wrist_yaw"]
+    }
     assert limits["joint_lift"] == pytest.approx((0.0, 1.1))
     assert all(limits[t] == pytest.approx((0.0, 0.13)) for t in TUBES)
     assert limits["joint_wrist_yaw"] == pytest.approx((-1.75, 4.0))
@@ -125,19 +137,30 @@ def test_spoon_grip_pinches_the_handle_end_with_the_bowl_raised(robot, tmp_path)
     path = tmp_path / "spoon.urdf"
     path.write_text(xacro.process_file(str(SPOON)).toprettyxml())
     centre = pb.getLinkState(rid, links["link_grasp_center"], computeForwardKinematics=True, physicsClientId=c)[4:6]
-    spoon = pb.loadURDF(str(path), *pb.multiplyTransforms(*centre, grip.position_m, pb.getQuaternionFromEuler(grip.rpy_rad)),
-                        useFixedBase=True, physicsClientId=c)
+    spoon = pb.loadURDF(
+        str(path),
+        *pb.multiplyTransforms(*centre, grip.position_m, pb.getQuaternionFromEuler(grip.rpy_rad)),
+        useFixedBase=True,
+        physicsClientId=c,
+    )
     try:
-        spoon_links = {pb.getJointInfo(spoon, j, physicsClientId=c)[12].decode(): j for j in range(pb.getNumJoints(spoon, physicsClientId=c))}
+        spoon_links = {
+            pb.getJointInfo(spoon, j, physicsClientId=c)[12].decode(): j
+            for j in range(pb.getNumJoints(spoon, physicsClientId=c))
+        }
         assert pb.getClosestPoints(spoon, rid, 0.0, physicsClientId=c) == ()
         near = {p[4] for p in pb.getClosestPoints(spoon, rid, 0.01, physicsClientId=c)}
         for side in ("left", "right"):
             assert near & {links[f"link_gripper_finger_{side}"], links[f"link_gripper_fingertip_{side}"]}, side
             # The handle's end inside the pad's disc (cylinder r 2 cm along the fingertip's z, 1.67 cm long).
-            end = pb.getLinkState(spoon, spoon_links["spoon_handle_end"], computeForwardKinematics=True, physicsClientId=c)[4]
+            end = pb.getLinkState(
+                spoon, spoon_links["spoon_handle_end"], computeForwardKinematics=True, physicsClientId=c
+            )[4]
             local = np.array(_pose_in(c, rid, links[f"link_gripper_fingertip_{side}"], end, (0, 0, 0, 1))[0])
             assert math.hypot(local[0], local[1]) < 0.02 - 0.003  # less the handle's half thickness
-        bowl = np.array(_pose_in(c, rid, links["link_grasp_center"], *pb.getBasePositionAndOrientation(spoon, physicsClientId=c))[0])
+        bowl = np.array(
+            _pose_in(c, rid, links["link_grasp_center"], *pb.getBasePositionAndOrientation(spoon, physicsClientId=c))[0]
+        )
     finally:
         pb.removeBody(spoon, physicsClientId=c)
     axes = np.array(pb.getMatrixFromQuaternion(pb.getQuaternionFromEuler(grip.rpy_rad))).reshape(3, 3)
@@ -158,15 +181,25 @@ def test_food_stays_in_the_spoon_at_the_grips_pitch(tmp_path):
         pb.setPhysicsEngineParameter(numSolverIterations=50, physicsClientId=c)
         urdf = tmp_path / "spoon.urdf"
         urdf.write_text(xacro.process_file(str(SPOON)).toprettyxml())
-        spoon = pb.loadURDF(str(urdf), (0, 0, 1), pb.getQuaternionFromEuler(grip.rpy_rad), useFixedBase=True, physicsClientId=c)
+        spoon = pb.loadURDF(
+            str(urdf), (0, 0, 1), pb.getQuaternionFromEuler(grip.rpy_rad), useFixedBase=True, physicsClientId=c
+        )
         frame = pb.getBasePositionAndOrientation(spoon, physicsClientId=c)
         shape = pb.createCollisionShape(pb.GEOM_SPHERE, radius=0.005, physicsClientId=c)
         grid = [(-0.005 + 0.01 * i, 0.01 * j, 0.01 + 0.01 * k) for i in range(2) for j in range(2) for k in range(2)]
-        food = [pb.createMultiBody(0.001, shape, -1, pb.multiplyTransforms(*frame, g, (0, 0, 0, 1))[0], physicsClientId=c) for g in grid]
+        food = [
+            pb.createMultiBody(0.001, shape, -1, pb.multiplyTransforms(*frame, g, (0, 0, 0, 1))[0], physicsClientId=c)
+            for g in grid
+        ]
         for _ in range(100):
             pb.stepSimulation(physicsClientId=c)
         inv = pb.invertTransform(*frame)
-        local = np.array([pb.multiplyTransforms(*inv, pb.getBasePositionAndOrientation(f, physicsClientId=c)[0], (0, 0, 0, 1))[0] for f in food])
+        local = np.array(
+            [
+                pb.multiplyTransforms(*inv, pb.getBasePositionAndOrientation(f, physicsClientId=c)[0], (0, 0, 0, 1))[0]
+                for f in food
+            ]
+        )
     finally:
         pb.disconnect(c)
     # The tray's interior: x ±17 mm, y −12..22 mm at its floor (z 0), walls 12 mm high, flaring out.
@@ -176,7 +209,9 @@ def test_food_stays_in_the_spoon_at_the_grips_pitch(tmp_path):
 
 @pytest.fixture(scope="module")
 def scratch_env(tmp_path_factory):
-    env = AssistiveEnv.from_spec(REPO / "specs" / "tasks" / "scratch_itch.yaml", "stretch", tmp_path_factory.mktemp("si"))
+    env = AssistiveEnv.from_spec(
+        REPO / "specs" / "tasks" / "scratch_itch.yaml", "stretch", tmp_path_factory.mktemp("si")
+    )
     yield env
     env.close()
 
@@ -250,10 +285,18 @@ def _drive_to_goal(env, ahead_m: float, steps: int) -> tuple[list[np.ndarray], f
     actions = [policy(obs)]  # the first call reads the episode's start
     track, snap = policy.tracks[0], env.snap
     w = env.world
-    heading = pb.getMatrixFromQuaternion(pb.getLinkState(w.robot.id, env.drive.base_link, physicsClientId=w.client)[1])[0::3]
+    heading = pb.getMatrixFromQuaternion(pb.getLinkState(w.robot.id, env.drive.base_link, physicsClientId=w.client)[1])[
+        0::3
+    ]
     goal = snap.position(track.move) + ahead_m * np.asarray(heading)
     # One fixed goal in the world instead of the task's waypoints, held to the end.
-    track.waypoints, track.orientations, track.face_normal, track.steps_m, track.repeat_from = [None], [None], [None], [None], None
+    track.waypoints, track.orientations, track.face_normal, track.steps_m, track.repeat_from = (
+        [None],
+        [None],
+        [None],
+        [None],
+        None,
+    )
     policy._goal = lambda _track: (goal, 0.0)
     for _ in range(steps):
         obs, *_ = env.step(actions[-1])

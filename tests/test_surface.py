@@ -34,7 +34,7 @@ def test_the_head_is_covered_over_both_spheres_and_nowhere_inside_them(male):
     for p in points:
         d_cranium, d_face = math.dist(p.offset, cranium.centre), math.dist(p.offset, face.centre)
         assert min(abs(d_cranium - cranium.radius), abs(d_face - face.radius)) < 1e-9  # on one sphere's surface
-        assert d_cranium >= cranium.radius - 1e-4 and d_face >= face.radius - 1e-4     # inside neither
+        assert d_cranium >= cranium.radius - 1e-4 and d_face >= face.radius - 1e-4  # inside neither
         sphere = cranium if abs(d_cranium - cranium.radius) < 1e-9 else face
         on["cranium" if sphere is cranium else "face"] += 1
         outward = np.subtract(p.offset, sphere.centre) / sphere.radius
@@ -116,27 +116,36 @@ def _problems(spec) -> str:
 def test_a_link_without_a_shape_cannot_carry_markers(tmp_path):
     spec = _child(tmp_path, "markers:\n  around_mouth:\n    surface_of: [person.head_x_link]\n")
     message = _problems(spec)
-    assert (f"{spec}:4:18: 'person.head_x_link' is not a person link with a collision shape; expected one of 'person.chest', "
-            "'person.head', 'person.left_ankle', ") in message
+    assert (
+        f"{spec}:4:18: 'person.head_x_link' is not a person link with a collision shape; expected one of 'person.chest', "
+        "'person.head', 'person.left_ankle', "
+    ) in message
     assert message.endswith("'person.stomach', 'person.waist' (did you mean 'person.head'?)")
 
 
 def test_a_region_near_a_point_on_another_link_is_refused(tmp_path):
     spec = _child(tmp_path, "markers:\n  around_mouth:\n    region: {near: person.right_palm}\n")
-    assert (f"{spec}:4:20: 'person.right_palm' is on person.right_wrist; a region is centred on a covered link (person.head), "
-            "in that link's frame") in _problems(spec)
+    assert (
+        f"{spec}:4:20: 'person.right_palm' is on person.right_wrist; a region is centred on a covered link (person.head), "
+        "in that link's frame"
+    ) in _problems(spec)
 
 
 def test_along_needs_a_capsule(tmp_path):
     spec = _child(tmp_path, "markers:\n  around_mouth:\n    region: {along: [0.0, 0.5]}\n")
     message = _problems(spec)
-    assert f"{spec}:4:21: 'along' is a fraction of a limb's capsule; person.head has none (capsule links: 'person.chest', " in message
+    assert (
+        f"{spec}:4:21: 'along' is a fraction of a limb's capsule; person.head has none (capsule links: 'person.chest', "
+        in message
+    )
 
 
 def test_a_region_that_keeps_nothing_says_so(tmp_path):
     spec = _child(tmp_path, "markers:\n  around_mouth:\n    region: {near: person.head, radius_m: 0.005}\n")
-    assert (f"{spec}:4:13: the region keeps none of the 557 surface points of person.head (1.5 cm apart) on male_50th; "
-            "widen it (radius_m, max_angle_deg, along)") in _problems(spec)
+    assert (
+        f"{spec}:4:13: the region keeps none of the 557 surface points of person.head (1.5 cm apart) on male_50th; "
+        "widen it (radius_m, max_angle_deg, along)"
+    ) in _problems(spec)
 
 
 def test_region_fields_are_checked_together(tmp_path):
@@ -145,12 +154,18 @@ def test_region_fields_are_checked_together(tmp_path):
     spec = _child(tmp_path, "markers:\n  around_mouth:\n    region: {$replace: {near: person.mouth}}\n")
     with pytest.raises(SpecError) as info:
         load_spec(spec)
-    assert f"{spec}:4:24: markers.around_mouth.region: give 'near' and 'radius_m' together (the surface within radius_m of the point near)" in str(info.value)
+    assert (
+        f"{spec}:4:24: markers.around_mouth.region: give 'near' and 'radius_m' together (the surface within radius_m of the point near)"
+        in str(info.value)
+    )
 
 
 def test_a_surface_target_on_the_head_is_drawn_in_its_region_anew_each_episode(tmp_path):
-    spec = _child(tmp_path, "targets:\n  spot:\n    surface_of: [person.head]\n    region: {near: person.nose, radius_m: 0.04}\n"
-                            "    show_rgba: [1, 0, 0, 1]\n")
+    spec = _child(
+        tmp_path,
+        "targets:\n  spot:\n    surface_of: [person.head]\n    region: {near: person.nose, radius_m: 0.04}\n"
+        "    show_rgba: [1, 0, 0, 1]\n",
+    )
     result = compile_task(spec, "jaco", tmp_path / "out")
     lib = Library.for_spec()
     env = AssistiveEnv(result.out_dir)
@@ -171,7 +186,9 @@ def test_a_surface_target_on_the_head_is_drawn_in_its_region_anew_each_episode(t
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("example", [HANDOVER, MOUTH_WIPING, LEG_BATHING], ids=["handover", "mouth_wiping", "leg_bathing"])
+@pytest.mark.parametrize(
+    "example", [HANDOVER, MOUTH_WIPING, LEG_BATHING], ids=["handover", "mouth_wiping", "leg_bathing"]
+)
 def test_the_examples_succeed_with_their_scripted_baselines(tmp_path, example):
     """The examples written with landmarks and surface regions each succeed on at least 0.6 of seeds
     0-19 on Jaco (handover 20 of 20, mouth wiping 17, leg bathing 20)."""

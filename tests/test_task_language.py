@@ -11,6 +11,7 @@ from types import SimpleNamespace
 import numpy as np
 import pybullet as pb
 import pytest
+from helpers import compiled_env
 
 from assistive_compiler.cli import main
 from assistive_compiler.compile.compiler import compile_task
@@ -18,7 +19,6 @@ from assistive_compiler.paths import specs_dir
 from assistive_compiler.rotation import quat_angle, quat_rotate, vec_angle
 from assistive_compiler.runtime.env import AssistiveEnv
 from assistive_compiler.terms.registry import terms
-from helpers import compiled_env
 
 TASKS = specs_dir() / "tasks"
 
@@ -58,7 +58,11 @@ def test_itch_is_drawn_on_the_arm_capsules_every_reset(scratch):
         variant = scratch.world.active_variant
         caps = {c.link: c for c in variant.surfaces["itch"]}
         slot = snap.target_slots["itch"]
-        link = next(l for l, i in scratch.world.variant_bodies[variant.name].links.items() if snap._slots.get(("person", i)) == slot)
+        link = next(
+            link
+            for link, i in scratch.world.variant_bodies[variant.name].links.items()
+            if snap._slots.get(("person", i)) == slot
+        )
         cap = caps[link]
         offset = snap.target_offsets["itch"]
         start, end = np.asarray(cap.start), np.asarray(cap.end)
@@ -84,7 +88,7 @@ def _rejected_at(tmp_path, spec: str, marker: str) -> str:
     path.write_text(spec)
     with _capture() as err:
         assert main(["validate", str(path)]) == 2
-    line = next(i for i, l in enumerate(spec.splitlines(), 1) if marker in l)
+    line = next(i for i, text in enumerate(spec.splitlines(), 1) if marker in text)
     assert f"{path}:{line}:" in err.text
     return err.text
 
@@ -92,13 +96,19 @@ def _rejected_at(tmp_path, spec: str, marker: str) -> str:
 def _first_scratch_waypoint_replaced(by: str) -> str:
     """The shipped Scratch Itch spec with its first task waypoint replaced by the line ``by``."""
     spec = (TASKS / "scratch_itch.yaml").read_text()
-    first = next(l for l in spec.splitlines() if l.strip().startswith("- {to: itch, normal_offset_m: 0.08"))
+    first = next(text for text in spec.splitlines() if text.strip().startswith("- {to: itch, normal_offset_m: 0.08"))
     return spec.replace(first, by)
 
 
 def test_surface_target_specs_are_checked(tmp_path):
-    spec = (TASKS / "scratch_itch.yaml").read_text().replace(
-        "surface_of: [person.right_shoulder, person.right_elbow]", "surface_of: [person.right_shoulder, person.head_x_link]")
+    spec = (
+        (TASKS / "scratch_itch.yaml")
+        .read_text()
+        .replace(
+            "surface_of: [person.right_shoulder, person.right_elbow]",
+            "surface_of: [person.right_shoulder, person.head_x_link]",
+        )
+    )
     err = _rejected_at(tmp_path, spec, "surface_of: [person.right_shoulder, person.head_x_link]")
     assert "'person.head_x_link' is not a person link with a collision shape; expected one of 'person.chest'" in err
 
@@ -106,7 +116,9 @@ def test_surface_target_specs_are_checked(tmp_path):
 def test_facing_a_normal_needs_a_surface_target(tmp_path):
     spec = _first_scratch_waypoint_replaced("    - {to: person.right_wrist, face_normal_within_deg: 90}")
     err = _rejected_at(tmp_path, spec, "person.right_wrist, face_normal")
-    assert "face_normal_within_deg needs a target drawn on a surface (surface_of); 'person.right_wrist' is not one" in err
+    assert (
+        "face_normal_within_deg needs a target drawn on a surface (surface_of); 'person.right_wrist' is not one" in err
+    )
 
 
 def test_level_facing_needs_an_angle(tmp_path):
@@ -120,7 +132,9 @@ def test_ik_damping_names_arm_joints_of_the_robot(tmp_path):
     shipped = "ik_damping: {l_shoulder_pan_joint: 1.0, l_shoulder_lift_joint: 1.0}"
     assert shipped in spec
     spec = spec.replace(shipped, "ik_damping: {r_shoulder_pan_joint: 1.0, l_shoulder_lift_joint: 1.0}")  # the other arm
-    assert "'r_shoulder_pan_joint' is not an acting arm joint of robot 'pr2'" in _rejected_at(tmp_path, spec, "r_shoulder_pan_joint: 1.0")
+    assert "'r_shoulder_pan_joint' is not an acting arm joint of robot 'pr2'" in _rejected_at(
+        tmp_path, spec, "r_shoulder_pan_joint: 1.0"
+    )
 
 
 def test_scripted_ik_damping_damps_the_named_joints_only(tmp_path, scratch):
@@ -147,16 +161,20 @@ def test_scripted_per_robot_replaces_the_waypoints_for_that_robot_only(tmp_path)
     from assistive_compiler.spec.load import load_spec
 
     path = tmp_path / "own.yaml"
-    path.write_text(f"extends: {TASKS / 'bed_bathing.yaml'}\nscripted:\n  per_robot:\n    sawyer:\n      waypoints:\n"
-                    "        - {to: person.right_elbow, offset_m: [0, 0, 0.1]}\n        - {to: person.right_wrist, rpy_deg: [-30, 0, 90]}\n"
-                    "      repeat_from: 0\n    panda:\n      $replace: {move: wiper.pad, waypoints: [{to: person.right_shoulder}]}\n"
-                    "    $delete: [pr2]\n")
+    path.write_text(
+        f"extends: {TASKS / 'bed_bathing.yaml'}\nscripted:\n  per_robot:\n    sawyer:\n      waypoints:\n"
+        "        - {to: person.right_elbow, offset_m: [0, 0, 0.1]}\n        - {to: person.right_wrist, rpy_deg: [-30, 0, 90]}\n"
+        "      repeat_from: 0\n    panda:\n      $replace: {move: wiper.pad, waypoints: [{to: person.right_shoulder}]}\n"
+        "    $delete: [pr2]\n"
+    )
     loaded = load_spec(path)
     task = loaded.spec.scripted
     # Every shipped robot has a script of its own; the override replaces Sawyer's and Panda's and deletes PR2's.
     sawyer, panda, pr2 = (resolve(loaded, r).scripted for r in ("sawyer", "panda", "pr2"))
     assert [w["to"]["link"] for w in sawyer["waypoints"]] == ["right_elbow", "right_wrist"]
-    assert sawyer["repeat_from"] == 0 and sawyer["waypoints"][1]["rpy_rad"] == pytest.approx([math.radians(-30), 0.0, math.radians(90)])
+    assert sawyer["repeat_from"] == 0 and sawyer["waypoints"][1]["rpy_rad"] == pytest.approx(
+        [math.radians(-30), 0.0, math.radians(90)]
+    )
     assert sawyer["move"] == pr2["move"] and panda["move"] != pr2["move"]
     assert len(panda["waypoints"]) == 1 and panda["repeat_from"] is None
     assert len(pr2["waypoints"]) == len(task.spliced(task.waypoints, ())) and pr2["repeat_from"] == task.repeat_from
@@ -196,15 +214,20 @@ def test_segments_splice_into_the_script_they_replaced(tmp_path):
     assert any(isinstance(item, SegmentUse) for item in shipped.spec.scripted.per_robot["jaco"].waypoints)
     listed = tmp_path / "listed.yaml"
     items = "".join(f"        {line}\n" for line in JACO_BATHING_WRITTEN_OUT.splitlines())
-    listed.write_text(f"extends: {TASKS / 'bed_bathing.yaml'}\nscripted:\n  per_robot:\n    jaco:\n"
-                      f"      $replace:\n        waypoints:\n{items}        repeat_from: 1\n")
+    listed.write_text(
+        f"extends: {TASKS / 'bed_bathing.yaml'}\nscripted:\n  per_robot:\n    jaco:\n"
+        f"      $replace:\n        waypoints:\n{items}        repeat_from: 1\n"
+    )
     assert resolve(shipped, "jaco").scripted == resolve(load_spec(listed), "jaco").scripted
     # The task's script on a robot without its own: the same splice, read through per_robot's absence.
     bare = tmp_path / "bare.yaml"
     bare.write_text(f"extends: {TASKS / 'bed_bathing.yaml'}\nscripted:\n  per_robot: {{$replace: {{}}}}\n")
     task = resolve(load_spec(bare), "jaco").scripted
     segments = shipped.spec.scripted.segments
-    assert len(task["waypoints"]) == len(segments["lane_40"]) + len(segments["onto_forearm"]) + 2 and task["repeat_from"] == 1
+    assert (
+        len(task["waypoints"]) == len(segments["lane_40"]) + len(segments["onto_forearm"]) + 2
+        and task["repeat_from"] == 1
+    )
     assert [w["offset_m"] for w in task["waypoints"][:4]] == [list(w.offset_m) for w in segments["lane_40"]]
 
 
@@ -215,15 +238,20 @@ def test_scripted_per_robot_step_m_replaces_the_look_ahead_of_straight_line_wayp
     from assistive_compiler.resolve import resolve
     from assistive_compiler.spec.load import load_spec
 
-    lanes = ("        - {to: person.right_shoulder, offset_m: [0, 0, 0.1]}\n"
-             "        - {to: person.right_elbow, offset_m: [0, 0, 0.02], step_m: 0.07}\n")
+    lanes = (
+        "        - {to: person.right_shoulder, offset_m: [0, 0, 0.1]}\n"
+        "        - {to: person.right_elbow, offset_m: [0, 0, 0.02], step_m: 0.07}\n"
+    )
     path = tmp_path / "ahead.yaml"
-    path.write_text(f"extends: {TASKS / 'bed_bathing.yaml'}\nscripted:\n  per_robot:\n    sawyer:\n      waypoints:\n{lanes}"
-                    f"    panda:\n      step_m: 0.12\n      waypoints:\n{lanes}")
+    path.write_text(
+        f"extends: {TASKS / 'bed_bathing.yaml'}\nscripted:\n  per_robot:\n    sawyer:\n      waypoints:\n{lanes}"
+        f"    panda:\n      step_m: 0.12\n      waypoints:\n{lanes}"
+    )
     loaded = load_spec(path)
     sawyer, panda = (resolve(loaded, r).scripted for r in ("sawyer", "panda"))
-    assert [{k: v for k, v in w.items() if k != "step_m"} for w in panda["waypoints"]] == \
-        [{k: v for k, v in w.items() if k != "step_m"} for w in sawyer["waypoints"]]
+    assert [{k: v for k, v in w.items() if k != "step_m"} for w in panda["waypoints"]] == [
+        {k: v for k, v in w.items() if k != "step_m"} for w in sawyer["waypoints"]
+    ]
     assert [w.get("step_m") for w in sawyer["waypoints"]] == [None, 0.07]
     assert [w.get("step_m") for w in panda["waypoints"]] == [None, 0.12]
 
@@ -236,8 +264,10 @@ def test_scripted_step_m_is_accepted_in_the_task_own_script_too(tmp_path):
     from assistive_compiler.spec.load import load_spec
 
     path = tmp_path / "ahead.yaml"
-    path.write_text(f"extends: {TASKS / 'feeding.yaml'}\nscripted:\n  step_m: 0.09\n  waypoints:\n"
-                    "    - {to: mouth, offset_m: [0, -0.1, 0]}\n    - {to: mouth, offset_m: [0, -0.05, 0], step_m: 0.02}\n")
+    path.write_text(
+        f"extends: {TASKS / 'feeding.yaml'}\nscripted:\n  step_m: 0.09\n  waypoints:\n"
+        "    - {to: mouth, offset_m: [0, -0.1, 0]}\n    - {to: mouth, offset_m: [0, -0.05, 0], step_m: 0.02}\n"
+    )
     loaded = load_spec(path)
     assert loaded.spec.scripted.step_m == 0.09
     own = resolve(loaded, "jaco").scripted
@@ -282,15 +312,15 @@ def test_scratch_events_need_movement_gentle_force_and_nearness():
     counter = terms("reward")["contact_events"].fn()
     p = SimpleNamespace(tool=[], onto=[], target=None, radius_m=0.025, min_move_m=0.01, max_force_n=10.0)
     steps = [
-        ([], 0.0),                          # no contact
-        ([_contact(0.030, 1.0)], 0.0),      # 3 cm from the itch: too far
-        ([_contact(0.000, 12.0)], 0.0),     # on the spot but pressing 12 N: too hard
-        ([_contact(0.000, 2.0)], 1.0),      # first gentle touch: a scratch
-        ([_contact(0.005, 2.0)], 0.0),      # moved 5 mm: not yet
-        ([_contact(0.012, 2.0)], 1.0),      # 12 mm from the last scratch: another
-        ([_contact(0.012, 2.0)], 0.0),      # resting there counts once
+        ([], 0.0),  # no contact
+        ([_contact(0.030, 1.0)], 0.0),  # 3 cm from the itch: too far
+        ([_contact(0.000, 12.0)], 0.0),  # on the spot but pressing 12 N: too hard
+        ([_contact(0.000, 2.0)], 1.0),  # first gentle touch: a scratch
+        ([_contact(0.005, 2.0)], 0.0),  # moved 5 mm: not yet
+        ([_contact(0.012, 2.0)], 1.0),  # 12 mm from the last scratch: another
+        ([_contact(0.012, 2.0)], 0.0),  # resting there counts once
         ([_contact(0.001, 4.0), _contact(0.0005, 4.0)], 1.0),  # back again (8 N in all)
-        ([_contact(0.020, 6.0), _contact(0.021, 5.0)], 0.0),   # 11 N summed: too hard
+        ([_contact(0.020, 6.0), _contact(0.021, 5.0)], 0.0),  # 11 N summed: too hard
     ]
     got = [counter(_snap_with(c), p) for c, _ in steps]
     assert got == [want for _, want in steps]
@@ -401,8 +431,12 @@ def test_marker_counts_match_the_reference(bathing):
     """Facts §2.2 (verified counts): 81 + 48 = 129 markers for the male arm, 56 + 35 = 91 female."""
     counts = {v.name: len(v.markers["wipe_spots"]) for v in bathing.manifest.person.variants}
     assert counts == {"male_50th": 129, "female_50th": 91}
-    per_link = {v.name: [sum(1 for p in v.markers["wipe_spots"] if p.link == l) for l in ("right_shoulder", "right_elbow")]
-                for v in bathing.manifest.person.variants}
+    per_link = {
+        v.name: [
+            sum(1 for p in v.markers["wipe_spots"] if p.link == link) for link in ("right_shoulder", "right_elbow")
+        ]
+        for v in bathing.manifest.person.variants
+    }
     assert per_link == {"male_50th": [81, 48], "female_50th": [56, 35]}
 
 
@@ -439,7 +473,9 @@ def test_nightstand_is_carried_under_the_searched_base(bathing):
     at every reset, whichever precomputed start is drawn, with the start arm clear of it."""
     env = bathing
     w = env.world
-    assert all("base_poses" in p for p in env.manifest.robot.placement.values())  # searched, not mounted where the scene put it
+    assert all(
+        "base_poses" in p for p in env.manifest.robot.placement.values()
+    )  # searched, not mounted where the scene put it
     stand = w.bodies["nightstand"]
     bases = set()
     for seed in range(8):
@@ -526,18 +562,21 @@ def test_scripted_cup_tips_no_faster_than_its_turn_step(tmp_path):
     from assistive_compiler.policies.scripted import ScriptedPolicy
 
     path = tmp_path / "slow.yaml"
-    path.write_text(f"extends: {TASKS / 'drinking.yaml'}\nscripted:\n  per_robot:\n    jaco:\n      waypoints:\n"
-                    "        - {to: mouth, offset_m: [0.0, -0.10, 0.03], tolerance_m: 0.03}\n"
-                    "        - {to: mouth, offset_m: [0.0, -0.06, 0.04], tolerance_m: 0.01}\n"
-                    "        - {to: mouth, offset_m: [0.0, -0.005, 0.045], rpy_deg: [-95, 0, 0], tolerance_m: 0.0, turn_step_deg: 1}\n")
+    path.write_text(
+        f"extends: {TASKS / 'drinking.yaml'}\nscripted:\n  per_robot:\n    jaco:\n      waypoints:\n"
+        "        - {to: mouth, offset_m: [0.0, -0.10, 0.03], tolerance_m: 0.03}\n"
+        "        - {to: mouth, offset_m: [0.0, -0.06, 0.04], tolerance_m: 0.01}\n"
+        "        - {to: mouth, offset_m: [0.0, -0.005, 0.045], rpy_deg: [-95, 0, 0], tolerance_m: 0.0, turn_step_deg: 1}\n"
+    )
     task = tmp_path / "task.yaml"  # Jaco on the task's own pour
     task.write_text(f"extends: {TASKS / 'drinking.yaml'}\nscripted:\n  per_robot:\n    $delete: [jaco]\n")
     tilts = {}
     for name, spec in (("slow", path), ("task", task)):
         env = AssistiveEnv(compile_task(spec, "jaco", tmp_path / name).out_dir)
         try:
-            assert [w.get("turn_step_rad") for w in env.manifest.scripted["waypoints"]] == \
-                ([None, None, pytest.approx(math.radians(1))] if name == "slow" else [None, None, None])
+            assert [w.get("turn_step_rad") for w in env.manifest.scripted["waypoints"]] == (
+                [None, None, pytest.approx(math.radians(1))] if name == "slow" else [None, None, None]
+            )
             policy = ScriptedPolicy(env)
             obs, _ = env.reset(seed=0)
             track, aimed, tilt = policy.tracks[0], [], []
@@ -601,8 +640,10 @@ def test_observing_a_static_person_group_keeps_its_joints(tmp_path):
     keeps those joints (instead of baking them into fixed joints) and the observation reads the
     posture's angles, unchanged while the robot acts."""
     spec = tmp_path / "observe_head.yaml"
-    spec.write_text(f"extends: {TASKS / 'scratch_itch.yaml'}\nname: observe_head\ntitle: Observe Head\n"
-                    "observations:\n  robot:\n    - {term: joint_angles, params: {joints: person.head}}\n")
+    spec.write_text(
+        f"extends: {TASKS / 'scratch_itch.yaml'}\nname: observe_head\ntitle: Observe Head\n"
+        "observations:\n  robot:\n    - {term: joint_angles, params: {joints: person.head}}\n"
+    )
     env = AssistiveEnv(compile_task(spec, "jaco", tmp_path / "out").out_dir)
     try:
         obs, _ = env.reset(seed=3)

@@ -15,12 +15,12 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 import pytest
-
 import xacro
 import yourdfpy
+from test_scene_templates import CHECK_URDF, PI, TEMPLATES, assert_links_physical, load_quiet
+
 from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.library import Library
-from test_scene_templates import CHECK_URDF, PI, TEMPLATES, assert_links_physical, load_quiet
 
 SCRATCHER = "tools/scratcher.urdf.xacro"
 WIPER = "tools/wiper.urdf.xacro"
@@ -49,8 +49,9 @@ CUP_RIM = 0.115
 PARTICLE_RADIUS = 0.005
 PARTICLE_MASS = 0.001
 # The 4 x 4 x 4 grid recommended in specs/tools/cup.yaml: first point (-0.015, -0.015, 0.006), pitch 0.01.
-WATER_GRID = [(-0.015 + 0.01 * i, -0.015 + 0.01 * j, 0.006 + 0.01 * k)
-              for i in range(4) for j in range(4) for k in range(4)]
+WATER_GRID = [
+    (-0.015 + 0.01 * i, -0.015 + 0.01 * j, 0.006 + 0.01 * k) for i in range(4) for j in range(4) for k in range(4)
+]
 
 MATTRESS_TOP = 0.73
 
@@ -58,10 +59,12 @@ MATTRESS_TOP = 0.73
 # --------------------------------------------------------------------------------------------
 # helpers
 
+
 @cache
 def _render_text(template: str, items: tuple) -> str:
-    return xacro.process_file(str(TEMPLATES / template),
-                              mappings={k: str(v) for k, v in items}).toprettyxml(indent="  ")
+    return xacro.process_file(str(TEMPLATES / template), mappings={k: str(v) for k, v in items}).toprettyxml(
+        indent="  "
+    )
 
 
 def render_text(template: str, **args) -> str:
@@ -85,8 +88,10 @@ def link_indices(cid: int, body: int) -> dict[str, int]:
 
 
 def joint_indices(cid: int, body: int) -> dict[str, int]:
-    return {pb.getJointInfo(body, j, physicsClientId=cid)[1].decode(): j
-            for j in range(pb.getNumJoints(body, physicsClientId=cid))}
+    return {
+        pb.getJointInfo(body, j, physicsClientId=cid)[1].decode(): j
+        for j in range(pb.getNumJoints(body, physicsClientId=cid))
+    }
 
 
 def link_frame(cid: int, body: int, link: int):
@@ -102,8 +107,9 @@ def link_frame(cid: int, body: int, link: int):
 
 def subtree(cid: int, body: int, root: int) -> set[int]:
     """Link ``root`` and every link below it."""
-    parents = {j: pb.getJointInfo(body, j, physicsClientId=cid)[16]
-               for j in range(pb.getNumJoints(body, physicsClientId=cid))}
+    parents = {
+        j: pb.getJointInfo(body, j, physicsClientId=cid)[16] for j in range(pb.getNumJoints(body, physicsClientId=cid))
+    }
     out = {root}
     grew = True
     while grew:
@@ -145,6 +151,7 @@ def library() -> Library:
 # --------------------------------------------------------------------------------------------
 # every template
 
+
 @pytest.mark.parametrize("template,args", CASES, ids=CASE_IDS)
 def test_check_urdf_passes(template, args, out_dir):
     path = render(template, out_dir, **args)
@@ -168,8 +175,7 @@ def test_pybullet_loads_without_warnings(template, args, out_dir, cid):
 
 @pytest.mark.parametrize("template,args", CASES, ids=CASE_IDS)
 def test_yourdfpy_loads(template, args, out_dir):
-    model = yourdfpy.URDF.load(str(render(template, out_dir, **args)), build_scene_graph=True,
-                               load_meshes=False)
+    model = yourdfpy.URDF.load(str(render(template, out_dir, **args)), build_scene_graph=True, load_meshes=False)
     assert model.validate()
     assert len(model.robot.links) >= 2
 
@@ -189,6 +195,7 @@ def test_conventions(template, args):
 # --------------------------------------------------------------------------------------------
 # library parts
 
+
 @pytest.mark.parametrize("tool", NEW_TOOLS)
 def test_tool_part_mass_and_frames(tool, library, out_dir):
     """The part loads (its semantic links exist in the URDF), its template's total mass matches
@@ -196,23 +203,28 @@ def test_tool_part_mass_and_frames(tool, library, out_dir):
     reports is the frame the grips refer to."""
     part = library.get("tools", tool).part
     assert part.reference_link in part.links
-    model = yourdfpy.URDF.load(str(render(part.template.path, out_dir, **part.template.params)),
-                               build_scene_graph=True, load_meshes=False)
+    model = yourdfpy.URDF.load(
+        str(render(part.template.path, out_dir, **part.template.params)), build_scene_graph=True, load_meshes=False
+    )
     assert model.base_link == part.base_link
     assert total_mass(model) == pytest.approx(part.mass_kg, rel=0.01)
     np.testing.assert_allclose(model.link_map[part.base_link].inertial.origin, np.eye(4), atol=1e-12)
 
 
-@pytest.mark.parametrize("tool,link,xyz", [
-    ("scratcher", "scratcher_tip", (0.075, 0, 0)),
-    ("wiper", "wiper_pad", (0, 0, -0.035)),
-    ("wiper", "wiper_cloth", (0, 0, -0.0425)),
-    ("cup", "cup_top", (0, 0, CUP_RIM)),
-    ("scooper", "scooper_blade", (0.135, 0, 0.003)),
-])
+@pytest.mark.parametrize(
+    "tool,link,xyz",
+    [
+        ("scratcher", "scratcher_tip", (0.075, 0, 0)),
+        ("wiper", "wiper_pad", (0, 0, -0.035)),
+        ("wiper", "wiper_cloth", (0, 0, -0.0425)),
+        ("cup", "cup_top", (0, 0, CUP_RIM)),
+        ("scooper", "scooper_blade", (0.135, 0, 0.003)),
+    ],
+)
 def test_tool_frames(tool, link, xyz, out_dir):
-    model = yourdfpy.URDF.load(str(render(f"tools/{tool}.urdf.xacro", out_dir)),
-                               build_scene_graph=True, load_meshes=False)
+    model = yourdfpy.URDF.load(
+        str(render(f"tools/{tool}.urdf.xacro", out_dir)), build_scene_graph=True, load_meshes=False
+    )
     expected = np.eye(4)
     expected[:3, 3] = xyz
     np.testing.assert_allclose(model.get_transform(link, tool), expected, atol=1e-9)
@@ -246,9 +258,15 @@ def test_robot_grips_and_finger_positions(robot, library, out_dir, cid):
 # grips: each robot holds each tool in its fingers, without its hand cutting into the tool
 
 APPROACH_AXIS = {"pr2": 0}  # the tool-mount axis pointing out of the hand; z for the others
-CLOSING_AXIS = 1            # the fingers close along the tool mount's y on every robot
-ACROSS_AXIS = {"pr2": 2}    # the third axis (the PR2 palm's up); x for the others
-WIPES_FROM_ABOVE = {"pr2", "jaco", "panda", "sawyer", "baxter"}  # these hold the cloth out along the approach (wiping from above)
+CLOSING_AXIS = 1  # the fingers close along the tool mount's y on every robot
+ACROSS_AXIS = {"pr2": 2}  # the third axis (the PR2 palm's up); x for the others
+WIPES_FROM_ABOVE = {
+    "pr2",
+    "jaco",
+    "panda",
+    "sawyer",
+    "baxter",
+}  # these hold the cloth out along the approach (wiping from above)
 
 
 @pytest.mark.parametrize("tool", NEW_TOOLS)
@@ -279,12 +297,16 @@ def test_grip_holds_tool_without_overlap(robot, tool, library, out_dir, cid):
         # gripper joint hanging from that link, with its subtree.
         hand_root = pb.getJointInfo(body, joints[gripper.joints[0]], physicsClientId=cid)[16]
         hand = subtree(cid, body, hand_root)
-        fingers = [subtree(cid, body, joints[name]) for name in gripper.joints
-                   if pb.getJointInfo(body, joints[name], physicsClientId=cid)[16] == hand_root]
+        fingers = [
+            subtree(cid, body, joints[name])
+            for name in gripper.joints
+            if pb.getJointInfo(body, joints[name], physicsClientId=cid)[16] == hand_root
+        ]
         assert len(fingers) >= 2
         overlap = [p for p in pb.getClosestPoints(tool_body, body, 0.0, physicsClientId=cid) if p[4] in hand]
-        assert overlap == [], [(robot, side, tool, pb.getJointInfo(body, p[4], physicsClientId=cid)[12], p[8])
-                               for p in overlap]
+        assert overlap == [], [
+            (robot, side, tool, pb.getJointInfo(body, p[4], physicsClientId=cid)[12], p[8]) for p in overlap
+        ]
         near = [p[4] for p in pb.getClosestPoints(tool_body, body, 0.01, physicsClientId=cid)]
         touching = [f for f in fingers if any(link in f for link in near)]
         assert len(touching) >= 2, (robot, side, tool, "not held between the fingers")
@@ -307,11 +329,12 @@ def test_grip_holds_tool_without_overlap(robot, tool, library, out_dir, cid):
 # --------------------------------------------------------------------------------------------
 # cup
 
+
 def test_cup_shape(out_dir, cid):
     cup, _ = load_quiet(cid, render(CUP, out_dir))
     # (PyBullet's AABBs carry a 1 mm margin on every side.)
     lo, hi = (np.array(v) for v in pb.getAABB(cup, -1, physicsClientId=cid))
-    assert hi[2] - lo[2] - 0.002 == pytest.approx(0.125, abs=1e-4)   # 12.5 cm tall like the reference
+    assert hi[2] - lo[2] - 0.002 == pytest.approx(0.125, abs=1e-4)  # 12.5 cm tall like the reference
     assert hi[0] - lo[0] - 0.002 == pytest.approx(0.097, abs=0.002)  # ~9.6 cm across
     assert lo[2] + 0.001 == pytest.approx(-0.01, abs=1e-4)
     # Open on top; the floor's top is at the frame origin all over the inside.
@@ -331,8 +354,12 @@ def test_cup_shape(out_dir, cid):
 def _water(cid: int, cup: int) -> list[int]:
     shape = pb.createCollisionShape(pb.GEOM_SPHERE, radius=PARTICLE_RADIUS, physicsClientId=cid)
     pos, orn = link_frame(cid, cup, -1)
-    return [pb.createMultiBody(PARTICLE_MASS, shape, -1, pb.multiplyTransforms(pos, orn, p, (0, 0, 0, 1))[0],
-                               physicsClientId=cid) for p in WATER_GRID]
+    return [
+        pb.createMultiBody(
+            PARTICLE_MASS, shape, -1, pb.multiplyTransforms(pos, orn, p, (0, 0, 0, 1))[0], physicsClientId=cid
+        )
+        for p in WATER_GRID
+    ]
 
 
 def _setup(cid: int):
@@ -368,19 +395,21 @@ def test_cup_pours_when_tilted_but_never_leaks(out_dir, cid, tilt_deg):
     particle ever passes through the wall or the floor."""
     _setup(cid)
     cup, _ = load_quiet(cid, render(CUP, out_dir), pos=(0, 0, 1.0), fixed=False)
-    hold = pb.createConstraint(cup, -1, -1, -1, pb.JOINT_FIXED, [0, 0, 0], [0, 0, 0], [0, 0, 1.0],
-                               physicsClientId=cid)
+    hold = pb.createConstraint(cup, -1, -1, -1, pb.JOINT_FIXED, [0, 0, 0], [0, 0, 0], [0, 0, 1.0], physicsClientId=cid)
     pb.changeConstraint(hold, maxForce=500, physicsClientId=cid)
     water = _water(cid, cup)
     history = []
     for step in range(250):
         if 75 <= step < 105:
             angle = math.radians(tilt_deg) * (step - 74) / 30
-            pb.changeConstraint(hold, jointChildFrameOrientation=pb.getQuaternionFromEuler([-angle, 0, 0]),
-                                maxForce=500, physicsClientId=cid)
+            pb.changeConstraint(
+                hold,
+                jointChildFrameOrientation=pb.getQuaternionFromEuler([-angle, 0, 0]),
+                maxForce=500,
+                physicsClientId=cid,
+            )
         pb.stepSimulation(physicsClientId=cid)
-        history.append(in_frame(cid, cup, [pb.getBasePositionAndOrientation(b, physicsClientId=cid)[0]
-                                            for b in water]))
+        history.append(in_frame(cid, cup, [pb.getBasePositionAndOrientation(b, physicsClientId=cid)[0] for b in water]))
     roll = pb.getEulerFromQuaternion(pb.getBasePositionAndOrientation(cup, physicsClientId=cid)[1])[0]
     assert abs(roll) == pytest.approx(math.radians(tilt_deg), abs=0.02)
     h = np.array(history)
@@ -397,6 +426,7 @@ def test_cup_pours_when_tilted_but_never_leaks(out_dir, cid, tilt_deg):
 
 # --------------------------------------------------------------------------------------------
 # bed
+
 
 def test_bed_size_and_mattress(out_dir, cid):
     path = render(BED, out_dir)

@@ -75,7 +75,11 @@ def press_spoon_into_face(env, snap: Snapshot, depth: float = 0.01, steps: int =
     centre, and run physics: the spoon, held by the arm, pushes on the face. Then refresh."""
     w = env.world
     person = env.snap.handle("person")
-    head, mouth, spoon = env.snap.point({"body": "person", "link": "head"}), env.snap.point({"target": "mouth"}), env.snap.point({"body": "spoon", "link": "spoon"})
+    head, mouth, spoon = (
+        env.snap.point({"body": "person", "link": "head"}),
+        env.snap.point({"target": "mouth"}),
+        env.snap.point({"body": "spoon", "link": "spoon"}),
+    )
     hp, mp, sp = (np.array(env.snap.position(h), dtype=float) for h in (head, mouth, spoon))
     inward = (hp - mp) / np.linalg.norm(hp - mp)
     base_pos, base_orn = w.base_frame(person)
@@ -108,7 +112,9 @@ def test_position_in_world_robot_base_and_person_base_frames(snap):
     # robot_base: p − t = (0, 2, 3); frame x = world y, frame y = world −x → (2, 0, 3)
     np.testing.assert_allclose(call("observation", "position", snap, of=p, frame="robot_base"), (2, 0, 3), atol=1e-12)
     # person_base: p − t = (0.5, 3, 1); frame x = world −y, frame y = world x → (−3, 0.5, 1)
-    np.testing.assert_allclose(call("observation", "position", snap, of=p, frame="person_base"), (-3, 0.5, 1), atol=1e-12)
+    np.testing.assert_allclose(
+        call("observation", "position", snap, of=p, frame="person_base"), (-3, 0.5, 1), atol=1e-12
+    )
     # the default frame is the robot's base
     np.testing.assert_allclose(call("observation", "position", snap, of=p), (2, 0, 3), atol=1e-12)
 
@@ -130,13 +136,17 @@ def test_displacement_is_a_vector(snap):
     of, to = point(snap, "spoon", "spoon"), point(snap, "person", "head")
     snap.pos[of.slot] = (1.0, 2.0, 3.0)
     snap.pos[to.slot] = (4.0, 6.0, 3.0)
-    np.testing.assert_allclose(call("observation", "displacement", snap, of=of, to=to, frame="world"), (-3, -4, 0), atol=1e-12)
+    np.testing.assert_allclose(
+        call("observation", "displacement", snap, of=of, to=to, frame="world"), (-3, -4, 0), atol=1e-12
+    )
     snap.set_frame("robot_base", (0.0, 0.0, 0.0), ROT_Z90)
     at_origin = call("observation", "displacement", snap, of=of, to=to, frame="robot_base")
     # (−3, −4, 0) in a frame whose x is world y and whose y is world −x → (−4, 3, 0)
     np.testing.assert_allclose(at_origin, (-4, 3, 0), atol=1e-12)
     snap.set_frame("robot_base", (100.0, -50.0, 7.0), ROT_Z90)  # translation must not matter
-    np.testing.assert_allclose(call("observation", "displacement", snap, of=of, to=to, frame="robot_base"), (-4, 3, 0), atol=1e-12)
+    np.testing.assert_allclose(
+        call("observation", "displacement", snap, of=of, to=to, frame="robot_base"), (-4, 3, 0), atol=1e-12
+    )
 
 
 def test_joint_angles_with_and_without_wrap(env, snap):
@@ -150,7 +160,9 @@ def test_joint_angles_with_and_without_wrap(env, snap):
     np.testing.assert_allclose(call("observation", "joint_angles", snap, joints=arm, wrap=False), raw, atol=1e-12)
     wrapped = [-math.pi / 2, 4.0 - 2 * math.pi, math.pi / 2, 1.0, 5.0 - 2 * math.pi, 2.0, 0.25]
     np.testing.assert_allclose(call("observation", "joint_angles", snap, joints=arm, wrap=True), wrapped, atol=1e-12)
-    np.testing.assert_allclose(call("observation", "joint_angles", snap, joints=arm), wrapped, atol=1e-12)  # wrap by default
+    np.testing.assert_allclose(
+        call("observation", "joint_angles", snap, joints=arm), wrapped, atol=1e-12
+    )  # wrap by default
 
 
 def test_contact_force_observation_and_reward(env, snap):
@@ -221,7 +233,9 @@ def test_force_nontarget_without_and_with_a_target(env, snap):
     spoon_cps = contacts(env, "spoon", "person")
     total = sum(cp[9] for cp in spoon_cps) + sum(cp[9] for cp in contacts(env, "robot", "person"))
     assert total > 0
-    assert call("preference", "force_nontarget", snap, onto=["person"], by=["robot", "spoon"]) == pytest.approx(-total, rel=1e-12)
+    assert call("preference", "force_nontarget", snap, onto=["person"], by=["robot", "spoon"]) == pytest.approx(
+        -total, rel=1e-12
+    )
 
     # Target: the point on the spoon of its strongest contact; only contacts within the radius count.
     strongest = max(spoon_cps, key=lambda cp: cp[9])
@@ -229,10 +243,28 @@ def test_force_nontarget_without_and_with_a_target(env, snap):
     radius = 1e-4
     at_target = sum(cp[9] for cp in spoon_cps if np.linalg.norm(np.subtract(cp[5], strongest[5])) <= radius)
     assert 0 < at_target <= total
-    value = call("preference", "force_nontarget", snap, onto=["person"], by=["robot", "spoon"], target_tool=["spoon"], target=centre, target_radius_m=radius)
+    value = call(
+        "preference",
+        "force_nontarget",
+        snap,
+        onto=["person"],
+        by=["robot", "spoon"],
+        target_tool=["spoon"],
+        target=centre,
+        target_radius_m=radius,
+    )
     assert value == pytest.approx(-(total - at_target), abs=1e-12)
     # a radius that takes every contact leaves only the arm's force (none here)
-    value = call("preference", "force_nontarget", snap, onto=["person"], by=["robot", "spoon"], target_tool=["spoon"], target=centre, target_radius_m=10.0)
+    value = call(
+        "preference",
+        "force_nontarget",
+        snap,
+        onto=["person"],
+        by=["robot", "spoon"],
+        target_tool=["spoon"],
+        target=centre,
+        target_radius_m=10.0,
+    )
     assert value == pytest.approx(-(total - sum(cp[9] for cp in spoon_cps)), abs=1e-12)
 
 
@@ -241,8 +273,12 @@ def test_high_force_below_and_above_threshold(env, snap):
     force = sum(spoon_face_forces(env))
     assert force > 0
     assert call("preference", "high_force", snap, tool=["spoon"], onto=["person"], threshold_n=2 * force) == 0.0
-    assert call("preference", "high_force", snap, tool=["spoon"], onto=["person"], threshold_n=force / 2) == pytest.approx(-force, rel=1e-12)
-    assert call("preference", "high_force", snap, tool=["spoon"], onto=["person"], threshold_n=10.0) == 0.0  # the default 10 N
+    assert call(
+        "preference", "high_force", snap, tool=["spoon"], onto=["person"], threshold_n=force / 2
+    ) == pytest.approx(-force, rel=1e-12)
+    assert (
+        call("preference", "high_force", snap, tool=["spoon"], onto=["person"], threshold_n=10.0) == 0.0
+    )  # the default 10 N
 
 
 def test_food_hit_and_food_velocity(snap):
@@ -258,7 +294,9 @@ def test_dressing_force(env, snap):
     press_spoon_into_face(env, snap)
     force = sum(spoon_face_forces(env))
     assert force > 0
-    assert call("preference", "dressing_force", snap, cloth=["spoon"], onto=["person"]) == pytest.approx(-force, rel=1e-12)
+    assert call("preference", "dressing_force", snap, cloth=["spoon"], onto=["person"]) == pytest.approx(
+        -force, rel=1e-12
+    )
     assert call("preference", "dressing_force", snap, cloth=["spoon"], onto=["table"]) == 0.0
 
 
@@ -292,7 +330,9 @@ def test_target_offset_on_a_rotated_link(snap):
     snap.orn[head.slot] = ROT_Z90
     # R_z(90°)·(0, −0.11, 0.03) = (0.11, 0, 0.03)
     np.testing.assert_allclose(snap.position(mouth), (1.11, 2.0, 3.03), atol=1e-12)
-    np.testing.assert_allclose(call("observation", "position", snap, of=mouth, frame="world"), (1.11, 2.0, 3.03), atol=1e-12)
+    np.testing.assert_allclose(
+        call("observation", "position", snap, of=mouth, frame="world"), (1.11, 2.0, 3.03), atol=1e-12
+    )
     snap.orn[head.slot] = IDENTITY
     np.testing.assert_allclose(snap.position(mouth), (1.0, 1.89, 3.03), atol=1e-12)
 
@@ -308,9 +348,13 @@ def test_target_offset_follows_the_person_variant(env):
         variant = info["person_variant"]
         seen.add(variant)
         person = env.snap.handle("person")
-        state = pb.getLinkState(person.id, person.links["head"], computeForwardKinematics=True, physicsClientId=env.world.client)
+        state = pb.getLinkState(
+            person.id, person.links["head"], computeForwardKinematics=True, physicsClientId=env.world.client
+        )
         rot = np.array(pb.getMatrixFromQuaternion(state[5])).reshape(3, 3)
-        np.testing.assert_allclose(env.snap.position(mouth), np.array(state[4]) + rot @ np.array(expected[variant]), atol=1e-9)
+        np.testing.assert_allclose(
+            env.snap.position(mouth), np.array(state[4]) + rot @ np.array(expected[variant]), atol=1e-9
+        )
         if len(seen) == 2:
             break
     assert seen == {"male_50th", "female_50th"}
@@ -321,15 +365,25 @@ def test_target_offset_follows_the_person_variant(env):
 
 
 def test_bind_term_replaces_references_with_handles(snap):
-    use = TermUse(name="d", term="distance", category="reward", weight=-1.0,
-                  params={"a": {"body": "spoon", "link": "spoon"}, "b": {"body": "person", "link": "head"}})
+    use = TermUse(
+        name="d",
+        term="distance",
+        category="reward",
+        weight=-1.0,
+        params={"a": {"body": "spoon", "link": "spoon"}, "b": {"body": "person", "link": "head"}},
+    )
     fn = bind_term(use, snap)
     a, b = point(snap, "spoon", "spoon"), point(snap, "person", "head")  # the same slots
     snap.pos[a.slot] = (0.0, 0.0, 0.0)
     snap.pos[b.slot] = (0.0, 3.0, 4.0)
     assert fn(snap) == pytest.approx(5.0, abs=1e-12)
-    use = TermUse(name="v", term="velocity", category="preference", weight=0.25,
-                  params={"of": [{"body": "spoon", "link": "spoon"}, {"body": "person", "link": "head"}]})
+    use = TermUse(
+        name="v",
+        term="velocity",
+        category="preference",
+        weight=0.25,
+        params={"of": [{"body": "spoon", "link": "spoon"}, {"body": "person", "link": "head"}]},
+    )
     fn = bind_term(use, snap)
     snap.vel[a.slot] = (0.0, 3.0, 0.0)
     snap.vel[b.slot] = (4.0, 0.0, 0.0)
@@ -369,10 +423,19 @@ def test_reward_is_the_weighted_sum_on_a_constructed_state(env):
     assert values == pytest.approx(expected_values, abs=1e-12)
     weights = {name: weight for name, weight, _ in env.reward_fns}
     assert weights == {t.name: t.weight for t in env.manifest.reward}
-    assert weights == pytest.approx({"distance_to_mouth": -1.0, "action": -0.01, "food_eaten": 20.0, "food_spilled": -5.0,
-                                     "preference_velocity": 0.25, "preference_force_nontarget": 0.01,
-                                     "preference_high_force": 0.05, "preference_food_hit": 1.0,
-                                     "preference_food_velocity": 1.0})
+    assert weights == pytest.approx(
+        {
+            "distance_to_mouth": -1.0,
+            "action": -0.01,
+            "food_eaten": 20.0,
+            "food_spilled": -5.0,
+            "preference_velocity": 0.25,
+            "preference_force_nontarget": 0.01,
+            "preference_high_force": 0.05,
+            "preference_food_hit": 1.0,
+            "preference_food_velocity": 1.0,
+        }
+    )
     # −0.5 − 0.013 + 40 − 5 − 0.25 − 0 + 0 − 1 − 0.5
     reward = sum(weight * fn(snap) for _, weight, fn in env.reward_fns)
     assert reward == pytest.approx(32.737, abs=1e-12)

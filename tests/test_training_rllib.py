@@ -13,13 +13,14 @@ import pytest
 from PIL import Image
 
 pytest.importorskip("ray", reason='needs the "train" extra (README: Training); CI installs it')
-# Ray clusters run one at a time: under pytest-xdist every Ray test goes to the same worker.
+# Meant to run Ray clusters one at a time on one xdist worker; --dist loadgroup is a no-op under
+# pytest 9.2 with xdist 3.8 (the group never reaches the scheduler), so the clusters do overlap.
 pytestmark = pytest.mark.xdist_group("ray")
 
-from assistive_compiler.cli import main
-from assistive_compiler.training.evaluate import evaluate
-from assistive_compiler.training.run_dir import RunDir
-from assistive_compiler.training.train import train
+from assistive_compiler.cli import main  # noqa: E402 (after the importorskip)
+from assistive_compiler.training.evaluate import evaluate  # noqa: E402 (after the importorskip)
+from assistive_compiler.training.run_dir import RunDir  # noqa: E402 (after the importorskip)
+from assistive_compiler.training.train import train  # noqa: E402 (after the importorskip)
 
 REPO = Path(__file__).resolve().parents[1]
 FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
@@ -65,7 +66,9 @@ def test_multi_agent_ppo_iteration_checkpoint_resume_evaluate(local_ray, tmp_pat
     with (out / "curve.csv").open("a") as f:
         f.write("400,12.5,")
     assert run.latest_checkpoint()[0] == 200
-    resumed = train(str(FEEDING), robot="jaco", config_path=str(config), coop=True, out=str(out), resume=True, steps=400, quiet=True)
+    resumed = train(
+        str(FEEDING), robot="jaco", config_path=str(config), coop=True, out=str(out), resume=True, steps=400, quiet=True
+    )
     assert not partial.exists()
     assert resumed["steps"] == 400 and run.latest_checkpoint()[0] == 400
     rows = (out / "curve.csv").read_text().splitlines()
@@ -82,10 +85,10 @@ def test_multi_agent_ppo_iteration_checkpoint_resume_evaluate(local_ray, tmp_pat
 
     # Deterministic actions are the Gaussian's means clipped to the action bounds (the env clips them
     # for the motion, but the action penalty sees them raw), and the NumPy export gives the same.
+    import torch
+
     from assistive_compiler.training.export import export_run
     from assistive_compiler.training.rllib import RLlibPolicy
-
-    import torch
 
     pair = RLlibPolicy(checkpoint.parent / f"step_{400:010d}", coop=True, algorithm="ppo")
     with torch.no_grad():  # a head whose means leave the bounds
@@ -101,7 +104,9 @@ def test_multi_agent_ppo_iteration_checkpoint_resume_evaluate(local_ray, tmp_pat
 def test_unreachable_ray_address_fails_fast_with_a_message(tmp_path, capsys):
     out = tmp_path / "run"
     t0 = time.perf_counter()
-    code = main(["train", str(REACH), "--config", "ppo_quick", "--address", "127.0.0.1:1", "--out", str(out), "--quiet"])
+    code = main(
+        ["train", str(REACH), "--config", "ppo_quick", "--address", "127.0.0.1:1", "--out", str(out), "--quiet"]
+    )
     elapsed = time.perf_counter() - t0
     err = capsys.readouterr().err
     assert code == 2 and elapsed < 20
@@ -135,16 +140,54 @@ def test_multi_agent_sac_trains_and_exports_a_pair_that_plays_under_coop(local_r
     assert record["coop"] and record["export_max_action_difference"] < 1e-4
     assert {p.name for p in (tmp_path / "pair").iterdir()} >= {"policy.json", "robot", "human"}
     checkpoint_return = evaluate(out, episodes=1, seed=7)["mean_return"]
-    assert record["evaluation"]["mean_return"] == pytest.approx(checkpoint_return, abs=0.05)  # float64 NumPy vs float32 torch
+    assert record["evaluation"]["mean_return"] == pytest.approx(
+        checkpoint_return, abs=0.05
+    )  # float64 NumPy vs float32 torch
     capsys.readouterr()
-    assert main(["run", str(FEEDING), "--robot", "jaco", "--coop", "--policy", str(tmp_path / "pair"), "--episodes", "1",
-                 "--seed", "7", "--json", "--quiet"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                str(FEEDING),
+                "--robot",
+                "jaco",
+                "--coop",
+                "--policy",
+                str(tmp_path / "pair"),
+                "--episodes",
+                "1",
+                "--seed",
+                "7",
+                "--json",
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     report = json.loads(capsys.readouterr().out)
     assert report["human_policy"] == str(tmp_path / "pair")  # the pair plays the person too
     assert report["episodes"][0]["return"] == pytest.approx(record["evaluation"]["returns"][0], abs=1e-3)
     strip = tmp_path / "pair.png"
-    assert main(["render", str(FEEDING), "--robot", "jaco", "--policy", str(tmp_path / "pair"), "--seed", "7", "--out", str(strip)]) == 0
-    assert f"return {record['evaluation']['returns'][0]:.1f}" in capsys.readouterr().out  # both agents acted, as in run --coop
+    assert (
+        main(
+            [
+                "render",
+                str(FEEDING),
+                "--robot",
+                "jaco",
+                "--policy",
+                str(tmp_path / "pair"),
+                "--seed",
+                "7",
+                "--out",
+                str(strip),
+            ]
+        )
+        == 0
+    )
+    assert (
+        f"return {record['evaluation']['returns'][0]:.1f}" in capsys.readouterr().out
+    )  # both agents acted, as in run --coop
 
 
 def _free_port() -> int:
@@ -173,9 +216,23 @@ def test_a_refused_authentication_token_says_so_and_names_rays_remedy(tmp_path):
         (homes[who] / ".ray").mkdir(parents=True)
         (homes[who] / ".ray" / "auth_token").write_text(token)
     base = {k: v for k, v in os.environ.items() if not k.startswith("RAY_")}
-    head = subprocess.Popen([sys.executable, "-m", "ray.scripts.scripts", "start", "--head", f"--port={port}", "--num-cpus=0",
-                             "--include-dashboard=false", "--block"], env={**base, "HOME": str(homes["head"]), "RAY_AUTH_MODE": "token"},
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    head = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "ray.scripts.scripts",
+            "start",
+            "--head",
+            f"--port={port}",
+            "--num-cpus=0",
+            "--include-dashboard=false",
+            "--block",
+        ],
+        env={**base, "HOME": str(homes["head"]), "RAY_AUTH_MODE": "token"},
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     try:
         deadline = time.time() + 60
         while time.time() < deadline:
@@ -184,9 +241,26 @@ def test_a_refused_authentication_token_says_so_and_names_rays_remedy(tmp_path):
                 break
             except OSError:
                 time.sleep(0.5)
-        proc = subprocess.run([sys.executable, "-m", "assistive_compiler.cli", "train", str(REACH), "--config", "ppo_quick",
-                               "--address", f"127.0.0.1:{port}", "--out", str(tmp_path / "run"), "--quiet"],
-                              env={**base, "HOME": str(homes["driver"])}, capture_output=True, text=True, timeout=120)
+        proc = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "assistive_compiler.cli",
+                "train",
+                str(REACH),
+                "--config",
+                "ppo_quick",
+                "--address",
+                f"127.0.0.1:{port}",
+                "--out",
+                str(tmp_path / "run"),
+                "--quiet",
+            ],
+            env={**base, "HOME": str(homes["driver"])},
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
     finally:
         os.killpg(head.pid, signal.SIGTERM)
         head.wait(timeout=60)
@@ -194,7 +268,8 @@ def test_a_refused_authentication_token_says_so_and_names_rays_remedy(tmp_path):
 
         forget_cluster(port)
     assert proc.returncode == 2
-    assert (f"error: --address: the Ray cluster at 127.0.0.1:{port} refused this machine's authentication token "
-            "(~/.ray/auth_token, $RAY_AUTH_TOKEN or $RAY_AUTH_TOKEN_PATH). Ray's remedy: every machine uses the cluster's token") \
-        in proc.stderr
+    assert (
+        f"error: --address: the Ray cluster at 127.0.0.1:{port} refused this machine's authentication token "
+        "(~/.ray/auth_token, $RAY_AUTH_TOKEN or $RAY_AUTH_TOKEN_PATH). Ray's remedy: every machine uses the cluster's token"
+    ) in proc.stderr
     assert not (tmp_path / "run" / "run.json").exists()  # nothing written for a run that never started

@@ -20,6 +20,8 @@ from PIL import Image
 
 pytest.importorskip("stable_baselines3", reason='needs the "train" extra (README: Training); CI installs it')
 
+from conftest import built_once
+
 from assistive_compiler.artifact import Manifest
 from assistive_compiler.cli import main
 from assistive_compiler.cli.run import rollout
@@ -28,7 +30,6 @@ from assistive_compiler.policies import make_policy
 from assistive_compiler.runtime.env import AssistiveEnv
 from assistive_compiler.training.evaluate import evaluate
 from assistive_compiler.training.run_dir import RunDir, check_resumable
-from conftest import built_once
 
 pytestmark = pytest.mark.slow
 
@@ -41,8 +42,11 @@ EVAL_SEED, EVAL_EPISODES = 100, 20
 def reach_run(tmp_path_factory, worker_id) -> Path:
     """PPO (ppo_quick: 2 env processes, 30k steps) trained on reach for Jaco, once per test session
     (the module's tests may run on both xdist workers; each gets a copy)."""
+
     def train(out: Path) -> None:
-        assert main(["train", str(REACH), "--robot", "jaco", "--config", "ppo_quick", "--out", str(out), "--quiet"]) == 0
+        assert (
+            main(["train", str(REACH), "--robot", "jaco", "--config", "ppo_quick", "--out", str(out), "--quiet"]) == 0
+        )
 
     return built_once(tmp_path_factory, worker_id, "reach-jaco", train)
 
@@ -123,7 +127,9 @@ def test_table_from_a_real_run(reach_run, tmp_path, capsys):
     evaluation = json.loads((reach_run / "evaluation.json").read_text())
     text = out.read_text()
     assert "| Task | PR2 | Jaco | Baxter | Sawyer | Success |" in text
-    assert "| Feeding | — (100.5) | — (83.8) | — (108.5) | — (95.6) | — (88%) |" in text  # the paper's Table I beside ours
+    assert (
+        "| Feeding | — (100.5) | — (83.8) | — (108.5) | — (95.6) | — (88%) |" in text
+    )  # the paper's Table I beside ours
     assert f"| reach | — (—) | {evaluation['mean_return']:.1f} (—) |" in text
     rows = list(csv.DictReader((tmp_path / "results.csv").open()))
     mine = [r for r in rows if r["task"] == "reach" and r["robot"] == "jaco"][0]
@@ -135,8 +141,25 @@ def test_resume_continues_from_the_newest_checkpoint(reach_run, tmp_path):
     copy = tmp_path / "resumed"
     shutil.copytree(reach_run, copy)
     before = RunDir(copy).latest_checkpoint()[0]
-    assert main(["train", str(REACH), "--robot", "jaco", "--config", "ppo_quick", "--out", str(copy), "--resume",
-                 "--steps", str(before + 800), "--quiet"]) == 0
+    assert (
+        main(
+            [
+                "train",
+                str(REACH),
+                "--robot",
+                "jaco",
+                "--config",
+                "ppo_quick",
+                "--out",
+                str(copy),
+                "--resume",
+                "--steps",
+                str(before + 800),
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     after = RunDir(copy).latest_checkpoint()[0]
     assert after == before + 800
     rows = list(csv.DictReader((copy / "curve.csv").open()))
@@ -148,7 +171,9 @@ def test_resume_refuses_a_run_of_another_spec(reach_run, tmp_path, capsys):
     other.write_text(REACH.read_text().replace("episode_steps: 40", "episode_steps: 30"))
     copy = tmp_path / "run"
     shutil.copytree(reach_run, copy)
-    code = main(["train", str(other), "--robot", "jaco", "--config", "ppo_quick", "--out", str(copy), "--resume", "--quiet"])
+    code = main(
+        ["train", str(other), "--robot", "jaco", "--config", "ppo_quick", "--out", str(copy), "--resume", "--quiet"]
+    )
     err = capsys.readouterr().err
     assert code == 2
     assert f"{copy / 'run.json'}:1:1: --resume: this run trained a different compiled task" in err
@@ -177,11 +202,31 @@ def test_resume_accepts_the_same_task_compiled_by_another_compiler_version(reach
 @pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
 def test_ctrl_c_or_sigterm_leaves_a_resumable_checkpoint(tmp_path, stop):
     out = tmp_path / "interrupted"
-    proc = subprocess.Popen([sys.executable, "-m", "assistive_compiler.cli", "train", str(REACH), "--config", "ppo_quick",
-                             "--envs", "1", "--steps", "1000000", "--out", str(out), "--quiet"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "assistive_compiler.cli",
+            "train",
+            str(REACH),
+            "--config",
+            "ppo_quick",
+            "--envs",
+            "1",
+            "--steps",
+            "1000000",
+            "--out",
+            str(out),
+            "--quiet",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     deadline = time.time() + 120
-    while time.time() < deadline and not ((out / "curve.csv").is_file() and len((out / "curve.csv").read_text().splitlines()) > 1):
+    while time.time() < deadline and not (
+        (out / "curve.csv").is_file() and len((out / "curve.csv").read_text().splitlines()) > 1
+    ):
         time.sleep(0.5)
     proc.send_signal(stop)
     _, err = proc.communicate(timeout=60)
@@ -228,8 +273,25 @@ def test_sac_run_checkpoints_with_its_replay_buffer_and_resumes(sac_run, tmp_pat
     assert run.info().training_config.algorithm == "sac" and "ppo" not in (sac_run / "config.yaml").read_text()
     copy = tmp_path / "resumed"
     shutil.copytree(sac_run, copy)
-    assert main(["train", str(REACH), "--robot", "jaco", "--config", str(sac_run / "config.yaml"), "--out", str(copy), "--resume",
-                 "--steps", "800", "--quiet"]) == 0
+    assert (
+        main(
+            [
+                "train",
+                str(REACH),
+                "--robot",
+                "jaco",
+                "--config",
+                str(sac_run / "config.yaml"),
+                "--out",
+                str(copy),
+                "--resume",
+                "--steps",
+                "800",
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     from stable_baselines3 import SAC
 
     model = SAC.load(str(RunDir(copy).latest_checkpoint()[1] / "model.zip"))
@@ -243,10 +305,27 @@ def test_sac_resume_without_the_replay_buffer_is_refused(sac_run, tmp_path, caps
     shutil.copytree(sac_run, copy)
     buffer = RunDir(copy).latest_checkpoint()[1] / "replay_buffer.pkl"
     buffer.unlink()
-    code = main(["train", str(REACH), "--robot", "jaco", "--config", str(sac_run / "config.yaml"), "--out", str(copy), "--resume",
-                 "--steps", "800", "--quiet"])
+    code = main(
+        [
+            "train",
+            str(REACH),
+            "--robot",
+            "jaco",
+            "--config",
+            str(sac_run / "config.yaml"),
+            "--out",
+            str(copy),
+            "--resume",
+            "--steps",
+            "800",
+            "--quiet",
+        ]
+    )
     assert code == 2
-    assert f"{buffer}: --resume of a SAC run needs the newest checkpoint's replay buffer, which is missing" in capsys.readouterr().err
+    assert (
+        f"{buffer}: --resume of a SAC run needs the newest checkpoint's replay buffer, which is missing"
+        in capsys.readouterr().err
+    )
 
 
 @pytest.mark.parametrize("which", ["ppo", "sac"])
@@ -265,8 +344,12 @@ def test_export_gives_the_checkpoints_actions_in_numpy(which, reach_run, sac_run
     rng = np.random.default_rng(1)
     for obs in rng.normal(0, 2, (50, exported.obs_dim)).astype(np.float32):
         assert np.allclose(exported(obs), original(obs), atol=1e-5)
-    assert (exported.head, record["algorithm"], record["trained_steps"], record["label"]) == \
-        ("clip" if which == "ppo" else "tanh", which, steps, f"{which} tiny")
+    assert (exported.head, record["algorithm"], record["trained_steps"], record["label"]) == (
+        "clip" if which == "ppo" else "tanh",
+        which,
+        steps,
+        f"{which} tiny",
+    )
     assert (exported.obs_mean is not None) == (which == "ppo")  # ppo_quick normalises observations
     ours = evaluate(run_dir, episodes=3, seed=100)
     assert [round(e["return"], 3) for e in ours["per_episode"]] == record["evaluation"]["returns"]
@@ -280,35 +363,90 @@ def test_run_render_and_evaluate_take_a_run_directory_or_an_exported_policy(reac
     export_run(reach_run, tmp_path / "exported", episodes=2, seed=5)
     returns = {}
     for source in (str(reach_run), str(tmp_path / "exported")):
-        assert main(["run", str(REACH), "--robot", "jaco", "--policy", source, "--episodes", "2", "--seed", "5", "--json",
-                     "--out", str(tmp_path / "artifact"), "--quiet"]) == 0
+        assert (
+            main(
+                [
+                    "run",
+                    str(REACH),
+                    "--robot",
+                    "jaco",
+                    "--policy",
+                    source,
+                    "--episodes",
+                    "2",
+                    "--seed",
+                    "5",
+                    "--json",
+                    "--out",
+                    str(tmp_path / "artifact"),
+                    "--quiet",
+                ]
+            )
+            == 0
+        )
         report = json.loads(capsys.readouterr().out)
         returns[source] = [round(e["return"], 4) for e in report["episodes"]]
         assert report["policy"] == source
     assert returns[str(reach_run)] == returns[str(tmp_path / "exported")]
     gif = tmp_path / "exported.gif"
-    assert main(["render", str(REACH), "--robot", "jaco", "--policy", str(tmp_path / "exported"), "--seed", "5", "--out", str(gif),
-                 "--out-dir", str(tmp_path / "artifact")]) == 0
+    assert (
+        main(
+            [
+                "render",
+                str(REACH),
+                "--robot",
+                "jaco",
+                "--policy",
+                str(tmp_path / "exported"),
+                "--seed",
+                "5",
+                "--out",
+                str(gif),
+                "--out-dir",
+                str(tmp_path / "artifact"),
+            ]
+        )
+        == 0
+    )
     assert Image.open(gif).n_frames > 10
     capsys.readouterr()
     assert main(["evaluate", "--policy", str(tmp_path / "exported"), "--episodes", "2", "--seed", "5", "--json"]) == 0
-    assert [round(e["return"], 4) for e in json.loads(capsys.readouterr().out)["per_episode"]] == returns[str(reach_run)]
+    assert [round(e["return"], 4) for e in json.loads(capsys.readouterr().out)["per_episode"]] == returns[
+        str(reach_run)
+    ]
 
 
 def test_a_trained_policy_of_another_task_is_refused(reach_run, capsys):
-    code = main(["run", str(REPO / "specs" / "tasks" / "feeding.yaml"), "--robot", "jaco", "--policy", str(reach_run), "--episodes", "1"])
+    code = main(
+        [
+            "run",
+            str(REPO / "specs" / "tasks" / "feeding.yaml"),
+            "--robot",
+            "jaco",
+            "--policy",
+            str(reach_run),
+            "--episodes",
+            "1",
+        ]
+    )
     assert code == 2
-    assert capsys.readouterr().err.strip().endswith(f"error: --policy {reach_run}: trained for reach with jaco, but the env is feeding with jaco")
+    assert (
+        capsys.readouterr()
+        .err.strip()
+        .endswith(f"error: --policy {reach_run}: trained for reach with jaco, but the env is feeding with jaco")
+    )
 
 
 def test_training_needs_only_the_declared_train_extra(tmp_path):
     """The training path imports nothing the train extra does not declare (tqdm was one): a run
     with tqdm made unimportable still trains and writes its curve."""
     out = tmp_path / "no-tqdm"
-    code = ("import sys; sys.modules['tqdm'] = None\n"
-            "from assistive_compiler.cli import main\n"
-            f"sys.exit(main(['train', {str(REACH)!r}, '--robot', 'jaco', '--config', 'ppo_quick', '--envs', '1', '--steps', '800', "
-            f"'--out', {str(out)!r}]))")
+    code = (
+        "import sys; sys.modules['tqdm'] = None\n"
+        "from assistive_compiler.cli import main\n"
+        f"sys.exit(main(['train', {str(REACH)!r}, '--robot', 'jaco', '--config', 'ppo_quick', '--envs', '1', '--steps', '800', "
+        f"'--out', {str(out)!r}]))"
+    )
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     assert RunDir(out).latest_checkpoint()[0] == 800 and (out / "curve.csv").is_file()
@@ -332,8 +470,22 @@ def test_a_driver_killed_outright_leaves_a_resumable_run(tmp_path):
     out = tmp_path / "killed"
     config = tmp_path / "ppo_often.yaml"  # checkpoints every 400 steps (ppo_quick's 10,000 took ~50 s each here)
     config.write_text(PPO_OFTEN)
-    cmd = [sys.executable, "-m", "assistive_compiler.cli", "train", str(REACH), "--config", str(config), "--envs", "1",
-           "--steps", "1000000", "--out", str(out), "--quiet"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "assistive_compiler.cli",
+        "train",
+        str(REACH),
+        "--config",
+        str(config),
+        "--envs",
+        "1",
+        "--steps",
+        "1000000",
+        "--out",
+        str(out),
+        "--quiet",
+    ]
     proc = subprocess.Popen(cmd + [], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.time() + 180
     run = RunDir(out)
@@ -346,8 +498,15 @@ def test_a_driver_killed_outright_leaves_a_resumable_run(tmp_path):
     assert all(p.name.startswith(("step_", ".partial-")) for p in run.checkpoints.iterdir())
     json.loads((out / "run.json").read_text())  # readable
     target = latest[0] + 800
-    assert subprocess.run(cmd[:-5] + ["--steps", str(target), "--out", str(out), "--resume", "--quiet"],
-                          capture_output=True, text=True, timeout=300).returncode == 0
+    assert (
+        subprocess.run(
+            cmd[:-5] + ["--steps", str(target), "--out", str(out), "--resume", "--quiet"],
+            capture_output=True,
+            text=True,
+            timeout=300,
+        ).returncode
+        == 0
+    )
     assert run.latest_checkpoint()[0] == target and not list(run.checkpoints.glob(".partial-*"))
     rows = list(csv.DictReader((out / "curve.csv").open()))
     steps = [int(r["steps"]) for r in rows]

@@ -9,13 +9,12 @@ import shutil
 from pathlib import Path
 
 import pytest
+from helpers import cli
 
 from assistive_compiler.errors import SpecError
 from assistive_compiler.library import LIBRARY_ENV, Library
 from assistive_compiler.paths import specs_dir
 from assistive_compiler.spec.load import load_spec
-
-from helpers import cli
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 
@@ -50,9 +49,11 @@ def test_readme_walkthrough_runs_through_the_cli_outside_the_package(tmp_path):
         outputs.append(out)
     assert "ok (task 'long_scratch', robots: jaco, panda)" in outputs[0]
     assert "long_scratch for jaco" in outputs[1]
-    assert "long_scratch for jaco  policy=scripted" in outputs[2]  # a user's spec has no id of its own (it is made as Task-v1)
+    assert (
+        "long_scratch for jaco  policy=scripted" in outputs[2]
+    )  # a user's spec has no id of its own (it is made as Task-v1)
     assert (tmp_path / "long_scratch.png").stat().st_size > 10_000
-    tool = (tmp_path / "build" / "long_scratch" / "urdf")
+    tool = tmp_path / "build" / "long_scratch" / "urdf"
     urdf = next(p for p in tool.glob("*.urdf") if "long_scratcher" in p.read_text())
     assert '<joint name="tip_joint"' in urdf.read_text()  # the user's template, not the shipped scratcher
 
@@ -71,11 +72,18 @@ def test_a_library_outside_the_spec_folder_is_found_with_library_and_the_environ
     # One folder too high: the message names the folders it looked in and the one that has tools/.
     status, _, err = cli("validate", spec, "--library", str(parts.parent), cwd=tmp_path)
     assert status == 2 and "unknown tool 'long_scratcher'" in err
-    assert "(looked in elsewhere/tools/ (no such folder), " in err and "; elsewhere/parts/ holds tools/: use it as the library)" in err, err
+    assert (
+        "(looked in elsewhere/tools/ (no such folder), " in err
+        and "; elsewhere/parts/ holds tools/: use it as the library)" in err
+    ), err
     status, out, err = cli("validate", spec, cwd=tmp_path, env={LIBRARY_ENV: str(parts)})
     assert status == 0, err
     status, _, err = cli("validate", spec, "--library", str(tmp_path / "nope"), cwd=tmp_path)
-    assert status == 2 and err.strip() == f"{tmp_path / 'nope'}:1:1: --library: folder not found (expected a folder holding robots/, tools/, furniture/ or people/)"
+    assert (
+        status == 2
+        and err.strip()
+        == f"{tmp_path / 'nope'}:1:1: --library: folder not found (expected a folder holding robots/, tools/, furniture/ or people/)"
+    )
 
 
 def test_python_make_finds_the_same_parts(tmp_path, monkeypatch):
@@ -85,7 +93,10 @@ def test_python_make_finds_the_same_parts(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     env = assistive_compiler.make(project / "specs" / "tasks" / "long_scratch.yaml", "jaco", out_dir=tmp_path / "out")
     assert env.manifest.gym_id == "assistive_compiler/Task-v1" and env.manifest.label == "long_scratch for jaco"
-    assert any(b.name == "scratcher" and "long_scratcher" in (tmp_path / "out" / b.urdf).read_text() for b in env.manifest.bodies)
+    assert any(
+        b.name == "scratcher" and "long_scratcher" in (tmp_path / "out" / b.urdf).read_text()
+        for b in env.manifest.bodies
+    )
     env.close()
 
 
@@ -98,8 +109,10 @@ def test_a_part_name_in_two_libraries_is_an_error_naming_both_files(tmp_path):
     status, _, err = cli("validate", str(spec), cwd=tmp_path)
     assert status == 2
     mine = "myproject/specs/tools/scratcher.yaml"  # shown relative to the working directory
-    assert f"{mine}:1:1: tool 'scratcher' is defined in more than one library: {mine} and {specs_dir() / 'tools' / 'scratcher.yaml'}; " \
-           "part names must be unique, rename one" in err
+    assert (
+        f"{mine}:1:1: tool 'scratcher' is defined in more than one library: {mine} and {specs_dir() / 'tools' / 'scratcher.yaml'}; "
+        "part names must be unique, rename one" in err
+    )
 
 
 def test_library_roots_are_explicit_then_environment_then_the_spec_own_then_shipped(tmp_path, monkeypatch):

@@ -13,7 +13,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from browser import Browser, chromium_path
 from conftest import FEEDING
 
@@ -28,10 +27,17 @@ def free_port() -> int:
 
 
 def start_view(args: list[str]) -> tuple[subprocess.Popen, str]:
-    proc = subprocess.Popen([sys.executable, "-m", "assistive_compiler.cli", "view", *args], cwd=REPO, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "assistive_compiler.cli", "view", *args],
+        cwd=REPO,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     line = ""
-    while "viewing" not in line:  # "viewing SPEC at URL  (Ctrl-C to stop)" once the page can be loaded (after viser's banner)
+    while (
+        "viewing" not in line
+    ):  # "viewing SPEC at URL  (Ctrl-C to stop)" once the page can be loaded (after viser's banner)
         line = proc.stdout.readline()
         if not line:
             break
@@ -51,7 +57,9 @@ def stop_with_sigint(proc: subprocess.Popen) -> tuple[int, str, str]:
 @pytest.mark.skipif(chromium_path() is None, reason="needs Debian's chromium (.ci/run installs it)")
 def test_view_page_in_headless_chromium(artifact, tmp_path):
     port = free_port()
-    proc, url = start_view([str(FEEDING), "--robot", "jaco", "--policy", "scripted", "--port", str(port), "--out", str(artifact)])
+    proc, url = start_view(
+        [str(FEEDING), "--robot", "jaco", "--policy", "scripted", "--port", str(port), "--out", str(artifact)]
+    )
     assert url == f"http://127.0.0.1:{port}"
     browser = Browser()
     try:
@@ -67,7 +75,9 @@ def test_view_page_in_headless_chromium(artifact, tmp_path):
         code, out, err = stop_with_sigint(proc)
     for body in ("robot", "person_female_50th", "person_male_50th", "spoon", "bowl", "table", "wheelchair"):
         assert body in text
-    assert "seed 0 · person" in text and "success yes" in text and "Reward terms" in text and "distance_to_mouth" in text
+    assert (
+        "seed 0 · person" in text and "success yes" in text and "Reward terms" in text and "distance_to_mouth" in text
+    )
     from PIL import Image
 
     image = np.asarray(Image.open(shot).convert("RGB"), dtype=float)
@@ -82,10 +92,8 @@ def test_view_page_in_headless_chromium(artifact, tmp_path):
 
 @pytest.mark.slow
 def test_view_replay_of_another_artifact_is_refused(artifact, tmp_path):
-    from assistive_compiler.record import load_recording
-
     from assistive_compiler.policies import make_policy
-    from assistive_compiler.record import record_episode
+    from assistive_compiler.record import load_recording, record_episode
     from assistive_compiler.runtime.env import AssistiveEnv
 
     env = AssistiveEnv(artifact)
@@ -95,11 +103,32 @@ def test_view_replay_of_another_artifact_is_refused(artifact, tmp_path):
     rec = load_recording(path)
     rec.header["content_hash"] = "0" * 64
     rec.save(path)
-    result = subprocess.run([sys.executable, "-m", "assistive_compiler.cli", "view", str(FEEDING), "--robot", "jaco", "--replay", str(path),
-                             "--out", str(artifact), "--port", str(free_port())], cwd=REPO, capture_output=True, text=True, timeout=120)
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "assistive_compiler.cli",
+            "view",
+            str(FEEDING),
+            "--robot",
+            "jaco",
+            "--replay",
+            str(path),
+            "--out",
+            str(artifact),
+            "--port",
+            str(free_port()),
+        ],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert result.returncode == 2
-    assert result.stderr.strip().splitlines()[-1] == (f"{path}:1:1: recorded from artifact 000000000000 (feeding, jaco), but {FEEDING} for jaco compiles to "
-                                     f"{env.manifest.content_hash[:12]}; view it with the spec and robot it was recorded from")
+    assert result.stderr.strip().splitlines()[-1] == (
+        f"{path}:1:1: recorded from artifact 000000000000 (feeding, jaco), but {FEEDING} for jaco compiles to "
+        f"{env.manifest.content_hash[:12]}; view it with the spec and robot it was recorded from"
+    )
 
 
 def test_gui_without_display_is_a_clear_message(artifact, tmp_path):
@@ -111,8 +140,26 @@ def test_gui_without_display_is_a_clear_message(artifact, tmp_path):
     env = AssistiveEnv(artifact)
     record_episode(env, make_policy("zero", env), 0, tmp_path)
     env.close()
-    result = subprocess.run([sys.executable, "-m", "assistive_compiler.cli", "view", str(FEEDING), "--robot", "jaco", "--gui", "--replay",
-                             str(tmp_path / "episode-0000.npz"), "--out", str(artifact)], cwd=REPO, capture_output=True, text=True,
-                            env=env_vars, timeout=120)
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "assistive_compiler.cli",
+            "view",
+            str(FEEDING),
+            "--robot",
+            "jaco",
+            "--gui",
+            "--replay",
+            str(tmp_path / "episode-0000.npz"),
+            "--out",
+            str(artifact),
+        ],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        env=env_vars,
+        timeout=120,
+    )
     assert result.returncode == 1 and "Traceback" not in result.stderr
     assert "view --gui: no display ($DISPLAY is not set), so pybullet's GUI cannot open here" in result.stderr

@@ -55,8 +55,13 @@ VALUES = {"hinge": 1.1, "slide": -0.23, "spin": 2.9}
 
 def _frames(cid, path: Path, reset: dict[str, float]) -> dict[str, tuple]:
     """World frame (position, orientation) of every link, after resetting the named joints."""
-    body = pb.loadURDF(str(path), [0.2, -0.1, 0.5], pb.getQuaternionFromEuler([0.1, 0.2, -0.3]), useFixedBase=True, physicsClientId=cid)
-    names = {pb.getJointInfo(body, j, physicsClientId=cid)[1].decode(): j for j in range(pb.getNumJoints(body, physicsClientId=cid))}
+    body = pb.loadURDF(
+        str(path), [0.2, -0.1, 0.5], pb.getQuaternionFromEuler([0.1, 0.2, -0.3]), useFixedBase=True, physicsClientId=cid
+    )
+    names = {
+        pb.getJointInfo(body, j, physicsClientId=cid)[1].decode(): j
+        for j in range(pb.getNumJoints(body, physicsClientId=cid))
+    }
     for name, q in reset.items():
         pb.resetJointState(body, names[name], q, physicsClientId=cid)
     out = {}
@@ -79,24 +84,39 @@ def test_welded_links_sit_where_the_joints_held_them(cid, tmp_path):
         assert np.allclose(pb.getMatrixFromQuaternion(fixed[link][1]), pb.getMatrixFromQuaternion(orn), atol=1e-7), link
         assert fixed[link][2] == pb.JOINT_FIXED
     for joint in ET.fromstring(welded.read_text()).findall("joint"):  # no motion elements left on a welded joint
-        assert joint.get("type") == "fixed" and sorted(e.tag for e in joint) == ["child", "origin", "parent"], joint.get("name")
+        assert joint.get("type") == "fixed" and sorted(e.tag for e in joint) == ["child", "origin", "parent"], (
+            joint.get("name")
+        )
 
 
 def test_welding_only_some_joints_keeps_the_others_moving(cid, tmp_path):
     path = tmp_path / "some.urdf"
     path.write_text(weld_joints(CHAIN, {"slide": 0.1}))
     body = pb.loadURDF(str(path), useFixedBase=True, physicsClientId=cid)
-    kinds = {pb.getJointInfo(body, j, physicsClientId=cid)[1].decode(): pb.getJointInfo(body, j, physicsClientId=cid)[2]
-             for j in range(pb.getNumJoints(body, physicsClientId=cid))}
-    assert kinds == {"hinge": pb.JOINT_REVOLUTE, "slide": pb.JOINT_FIXED, "spin": pb.JOINT_REVOLUTE, "tip_mount": pb.JOINT_FIXED}
+    kinds = {
+        pb.getJointInfo(body, j, physicsClientId=cid)[1].decode(): pb.getJointInfo(body, j, physicsClientId=cid)[2]
+        for j in range(pb.getNumJoints(body, physicsClientId=cid))
+    }
+    assert kinds == {
+        "hinge": pb.JOINT_REVOLUTE,
+        "slide": pb.JOINT_FIXED,
+        "spin": pb.JOINT_REVOLUTE,
+        "tip_mount": pb.JOINT_FIXED,
+    }
     assert weld_joints(CHAIN, {"slide": 0.1}) == weld_joints(CHAIN, {"slide": 0.1})  # deterministic bytes
 
 
-@pytest.mark.parametrize("values, message", [
-    ({"hing": 0.1}, "no joint named 'hing' in the document"),
-    ({"tip_mount": 0.0}, "joint 'tip_mount' is 'fixed'; only revolute, continuous and prismatic joints can be welded"),
-    ({"hinge": math.nan}, "joint 'hinge': value nan is not a finite number"),
-])
+@pytest.mark.parametrize(
+    "values, message",
+    [
+        ({"hing": 0.1}, "no joint named 'hing' in the document"),
+        (
+            {"tip_mount": 0.0},
+            "joint 'tip_mount' is 'fixed'; only revolute, continuous and prismatic joints can be welded",
+        ),
+        ({"hinge": math.nan}, "joint 'hinge': value nan is not a finite number"),
+    ],
+)
 def test_weld_refusals(values, message):
     with pytest.raises(ValueError) as err:
         weld_joints(CHAIN, values)
@@ -111,14 +131,21 @@ def test_the_compiler_welds_the_joints_a_task_never_drives(tmp_path):
 
     robot = json.loads((out / "manifest.json").read_text())["robot"]
     assert robot["welded_joints"] == {
-        "j2s7s300_joint_finger_1": 0.9, "j2s7s300_joint_finger_2": 0.9, "j2s7s300_joint_finger_3": 0.9,
-        "j2s7s300_joint_finger_tip_1": 0.0, "j2s7s300_joint_finger_tip_2": 0.0, "j2s7s300_joint_finger_tip_3": 0.0,
+        "j2s7s300_joint_finger_1": 0.9,
+        "j2s7s300_joint_finger_2": 0.9,
+        "j2s7s300_joint_finger_3": 0.9,
+        "j2s7s300_joint_finger_tip_1": 0.0,
+        "j2s7s300_joint_finger_tip_2": 0.0,
+        "j2s7s300_joint_finger_tip_3": 0.0,
     }
     cid = pb.connect(pb.DIRECT)
     try:
         body = pb.loadURDF(str(out / "urdf" / "robot.urdf"), useFixedBase=True, physicsClientId=cid)
-        moving = [pb.getJointInfo(body, j, physicsClientId=cid)[1].decode() for j in range(pb.getNumJoints(body, physicsClientId=cid))
-                  if pb.getJointInfo(body, j, physicsClientId=cid)[2] != pb.JOINT_FIXED]
+        moving = [
+            pb.getJointInfo(body, j, physicsClientId=cid)[1].decode()
+            for j in range(pb.getNumJoints(body, physicsClientId=cid))
+            if pb.getJointInfo(body, j, physicsClientId=cid)[2] != pb.JOINT_FIXED
+        ]
     finally:
         pb.disconnect(cid)
     assert moving == robot["arm_joints"] == [f"j2s7s300_joint_{i}" for i in range(1, 8)]

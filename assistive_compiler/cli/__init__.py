@@ -28,7 +28,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from typing import Callable, Sequence
+from collections.abc import Callable, Sequence
 
 from ..errors import SpecError, UsageError
 from . import bench, collect, compare, describe, evaluate, render, results, run, spec_commands, table, train, view

@@ -39,20 +39,31 @@ print(json.dumps({"import_s": import_s, "heavy_modules_on_import": heavy,
 """
 
 
-SIDE_BY_SIDE = ("measured side by side on 2026-11-27: quiet 2-core machine, one core each, interleaved fresh processes, "
-                "the reference at its own solver settings on stock pybullet with its fork-only gravity emulation's time removed "
-                "(the reference harness); random actions")
-LOADED_ONCE = ("measured once, not side by side, on a shared 2-core machine under load (stock pybullet, random actions, "
-               "200-step episodes): lower than the reference does on a quiet machine, so the ratio overstates ours there")
+SIDE_BY_SIDE = (
+    "measured side by side on 2026-11-27: quiet 2-core machine, one core each, interleaved fresh processes, "
+    "the reference at its own solver settings on stock pybullet with its fork-only gravity emulation's time removed "
+    "(the reference harness); random actions"
+)
+LOADED_ONCE = (
+    "measured once, not side by side, on a shared 2-core machine under load (stock pybullet, random actions, "
+    "200-step episodes): lower than the reference does on a quiet machine, so the ratio overstates ours there"
+)
 
 #: Env steps/s of the reference implementation (Assistive Gym v1.0) per (task, robot), with how each
 #: figure was taken (the ratio is only as good as that). Dressing does not run on stock pybullet.
 #: ``--reference-json`` replaces them with figures measured beside ours.
 REFERENCE_STEPS_PER_S: dict[tuple[str, str], tuple[float, str]] = {
-    ("feeding", "jaco"): (348, SIDE_BY_SIDE), ("scratch_itch", "jaco"): (620, SIDE_BY_SIDE), ("drinking", "jaco"): (44, SIDE_BY_SIDE),
-    ("bed_bathing", "jaco"): (170, SIDE_BY_SIDE), ("arm_manipulation", "jaco"): (338, SIDE_BY_SIDE),
-    ("scratch_itch", "pr2"): (188, LOADED_ONCE), ("scratch_itch", "sawyer"): (428, LOADED_ONCE), ("scratch_itch", "baxter"): (312, LOADED_ONCE),
-    ("feeding", "pr2"): (135, LOADED_ONCE), ("feeding", "sawyer"): (237, LOADED_ONCE), ("feeding", "baxter"): (199, LOADED_ONCE),
+    ("feeding", "jaco"): (348, SIDE_BY_SIDE),
+    ("scratch_itch", "jaco"): (620, SIDE_BY_SIDE),
+    ("drinking", "jaco"): (44, SIDE_BY_SIDE),
+    ("bed_bathing", "jaco"): (170, SIDE_BY_SIDE),
+    ("arm_manipulation", "jaco"): (338, SIDE_BY_SIDE),
+    ("scratch_itch", "pr2"): (188, LOADED_ONCE),
+    ("scratch_itch", "sawyer"): (428, LOADED_ONCE),
+    ("scratch_itch", "baxter"): (312, LOADED_ONCE),
+    ("feeding", "pr2"): (135, LOADED_ONCE),
+    ("feeding", "sawyer"): (237, LOADED_ONCE),
+    ("feeding", "baxter"): (199, LOADED_ONCE),
 }
 
 
@@ -63,18 +74,28 @@ def load_reference_json(path: str) -> dict[str, float]:
     the lines of that env. Located errors for a file that is not such lines."""
     text = Path(path).read_text() if Path(path).is_file() else None
     if text is None:
-        raise SpecError.at(path, "--reference-json: file not found (lines printed by the reference harness's measure.py ag ENV)")
+        raise SpecError.at(
+            path, "--reference-json: file not found (lines printed by the reference harness's measure.py ag ENV)"
+        )
     try:
-        rows = json.loads(text) if text.lstrip().startswith("[") else [json.loads(line) for line in text.splitlines() if line.strip()]
+        rows = (
+            json.loads(text)
+            if text.lstrip().startswith("[")
+            else [json.loads(line) for line in text.splitlines() if line.strip()]
+        )
     except json.JSONDecodeError as exc:
         raise SpecError.at(path, f"--reference-json: not JSON ({exc.msg})", exc.lineno, exc.colno) from None
     figures: dict[str, list[float]] = {}
     for k, row in enumerate(rows):
         if not isinstance(row, dict) or not {"env", "steps_per_s"} <= set(row):
-            raise SpecError.at(path, "--reference-json: each entry needs 'env' and 'steps_per_s' (measure.py's output)", k + 1)
+            raise SpecError.at(
+                path, "--reference-json: each entry needs 'env' and 'steps_per_s' (measure.py's output)", k + 1
+            )
         if row.get("side", "ag") != "ag":
             continue  # our own side's lines, if the file holds both
-        figures.setdefault(str(row["env"]), []).append(float(row["steps_per_s"]) / (1.0 - float(row.get("gravity_shim_share", 0.0))))
+        figures.setdefault(str(row["env"]), []).append(
+            float(row["steps_per_s"]) / (1.0 - float(row.get("gravity_shim_share", 0.0)))
+        )
     return {env: statistics.median(v) for env, v in figures.items()}
 
 
@@ -130,7 +151,7 @@ def measure_resets(env, resets: int) -> tuple[list[float], list[float]]:
     """Reset times (ms) after a step: unseeded (restore the saved state: the training path) and
     seeded (rebuild for a bit-exact replay; at most 20)."""
     reset_ms, seeded_ms = [], []
-    for k in range(resets):
+    for _ in range(resets):
         env.step(env.action_space.sample())
         t0 = time.perf_counter()
         env.reset()
@@ -146,12 +167,19 @@ def measure_resets(env, resets: int) -> tuple[list[float], list[float]]:
 def measure_process(artifact_dir: Path) -> dict:
     """In a fresh interpreter: ``import assistive_compiler`` time (s), heavy modules it imported, and
     peak RSS (MB) of one env stepped 200 times."""
-    child = subprocess.run([sys.executable, "-c", _CHILD, str(artifact_dir)], capture_output=True, text=True, check=True,
-                           env=os.environ | {"PYTHONWARNINGS": "ignore"})
+    child = subprocess.run(
+        [sys.executable, "-c", _CHILD, str(artifact_dir)],
+        capture_output=True,
+        text=True,
+        check=True,
+        env=os.environ | {"PYTHONWARNINGS": "ignore"},
+    )
     return json.loads(child.stdout.strip().splitlines()[-1])
 
 
-def measure_steps_paired(envs: dict, steps: int, repeats: int, seed: int) -> dict[str, tuple[list[float], list[float], list[float]]]:
+def measure_steps_paired(
+    envs: dict, steps: int, repeats: int, seed: int
+) -> dict[str, tuple[list[float], list[float], list[float]]]:
     """:func:`measure_steps` of several envs, their repeats interleaved (repeat r of every env, then
     r + 1) so that a change of the machine's load falls on all of them alike; each repeat r is the
     same seeded episode with the same random actions in every env."""
@@ -163,8 +191,16 @@ def measure_steps_paired(envs: dict, steps: int, repeats: int, seed: int) -> dic
     return out
 
 
-def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, seed: int = 0,
-          reference_json: dict[str, float] | None = None, reference_file: str | None = None) -> dict:
+def bench(
+    spec: str,
+    robot: str | None,
+    steps: int,
+    resets: int,
+    repeats: int,
+    seed: int = 0,
+    reference_json: dict[str, float] | None = None,
+    reference_file: str | None = None,
+) -> dict:
     """Speed figures of one (task, robot), all taken in this one run (medians over repeats).
 
     Env steps/s is measured at the spec's solver settings and, where they differ, at the reference
@@ -184,7 +220,9 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
         envs = {"shipped": AssistiveEnv.from_compiled(cold)}
         variant = write_reference_variant(spec, loaded, Path(tmp) / "specs")
         if variant is not None:
-            envs["reference_solver"] = AssistiveEnv.from_compiled(compile_task(variant, robot, Path(tmp) / "reference_solver"))
+            envs["reference_solver"] = AssistiveEnv.from_compiled(
+                compile_task(variant, robot, Path(tmp) / "reference_solver")
+            )
         rates = measure_steps_paired(envs, steps, repeats, seed)
         for extra in list(envs)[1:]:
             envs.pop(extra).close()
@@ -201,17 +239,26 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
     env_name = m.gym_id.rpartition("/")[2].removesuffix("-v1")
     if reference_json is not None:
         reference = reference_json.get(env_name)
-        reference_figure = f"{reference_file}: measured beside ours with the reference harness" if reference is not None else None
+        reference_figure = (
+            f"{reference_file}: measured beside ours with the reference harness" if reference is not None else None
+        )
         reference = round(reference, 1) if reference is not None else None
     else:
         reference, reference_figure = REFERENCE_STEPS_PER_S.get((m.task, m.robot_name), (None, None))
     ref_solver = reference_solver(m.task)
     # At the reference's solver settings: measured on the variant's artifact, or the same figure when
     # the spec already uses them (None: the reference has no such task).
-    at_ref = statistics.median(rates["reference_solver"][0]) if "reference_solver" in rates else (env_med if ref_solver is not None else None)
+    at_ref = (
+        statistics.median(rates["reference_solver"][0])
+        if "reference_solver" in rates
+        else (env_med if ref_solver is not None else None)
+    )
     return {
-        "task": m.task, "robot": m.robot_name, "gym_id": m.gym_id,
-        "obs_size": sum(t.size for t in m.observations["robot"]), "action_size": m.robot.action_size,
+        "task": m.task,
+        "robot": m.robot_name,
+        "gym_id": m.gym_id,
+        "obs_size": sum(t.size for t in m.observations["robot"]),
+        "action_size": m.robot.action_size,
         "env_steps_per_s": round(env_med, 1),
         "reference_env_steps_per_s": reference,
         "reference_figure": reference_figure,
@@ -220,26 +267,43 @@ def bench(spec: str, robot: str | None, steps: int, resets: int, repeats: int, s
         "reference_solver": ref_solver,
         "reference_solver_is_shipped": ref_solver is not None and variant is None,
         "env_steps_per_s_reference_solver": round(at_ref, 1) if at_ref is not None else None,
-        "vs_reference_at_reference_solver": round(at_ref / reference, 2) if at_ref is not None and reference is not None else None,
+        "vs_reference_at_reference_solver": round(at_ref / reference, 2)
+        if at_ref is not None and reference is not None
+        else None,
         "raw_physics_steps_per_s": round(raw_med, 1),
         "env_over_raw": round(env_med / raw_med, 3),
         "env_overhead_us_per_step": round(statistics.median(overhead), 1),
         "raw_loop_steps_per_s_at_rest": round(raw_loop, 1),
-        "reset_ms_median": round(reset_med, 3), "reset_ms_p95": round(reset_p95, 3), "resets": resets,
+        "reset_ms_median": round(reset_med, 3),
+        "reset_ms_p95": round(reset_p95, 3),
+        "resets": resets,
         "seeded_reset_ms_median": round(statistics.median(seeded_ms), 2),
-        "compile_s_cold": round(cold.seconds, 3), "compile_s_cached": round(cached.seconds, 3),
-        "import_s": round(proc["import_s"], 4), "heavy_modules_on_import": proc["heavy_modules_on_import"],
+        "compile_s_cold": round(cold.seconds, 3),
+        "compile_s_cached": round(cached.seconds, 3),
+        "import_s": round(proc["import_s"], 4),
+        "heavy_modules_on_import": proc["heavy_modules_on_import"],
         "peak_rss_mb_one_env": round(proc["peak_rss_mb"], 1),
-        "steps_per_repeat": steps, "repeats": repeats,
+        "steps_per_repeat": steps,
+        "repeats": repeats,
         "notes": "env/raw: the same episodes, physics timed inside env.step (stepSimulation + gravity compensation) vs the whole step; "
-                 "reference_solver: the same episodes and actions on an artifact compiled with the reference's sim.solver, repeats "
-                 "interleaved with the shipped ones (when reference_solver_is_shipped, the same figure as env_steps_per_s); random actions; "
-                 "medians over repeats; both agents acting: bench --coop",
+        "reference_solver: the same episodes and actions on an artifact compiled with the reference's sim.solver, repeats "
+        "interleaved with the shipped ones (when reference_solver_is_shipped, the same figure as env_steps_per_s); random actions; "
+        "medians over repeats; both agents acting: bench --coop",
     }
 
 
-BENCH_TABLE = ("task", "robot", "env_steps_per_s", "env_steps_per_s_reference_solver", "raw_physics_steps_per_s", "env_over_raw", "reset_ms_median",
-               "reference_env_steps_per_s", "vs_reference", "vs_reference_at_reference_solver")
+BENCH_TABLE = (
+    "task",
+    "robot",
+    "env_steps_per_s",
+    "env_steps_per_s_reference_solver",
+    "raw_physics_steps_per_s",
+    "env_over_raw",
+    "reset_ms_median",
+    "reference_env_steps_per_s",
+    "vs_reference",
+    "vs_reference_at_reference_solver",
+)
 """The columns of ``bench``'s table for several specs or robots."""
 
 BENCH_COOP_TABLE = ("task", "robot", "single_agent_env_steps_per_s", "multi_agent_env_steps_per_s", "multi_over_single")
@@ -255,7 +319,9 @@ def bench_coop_spec(spec: str, robot: str | None, steps: int, repeats: int, seed
 
     check_coop_spec(load_spec(spec))
     with tempfile.TemporaryDirectory() as tmp:
-        return bench_coop(compile_task(spec, robot, Path(tmp) / "coop").out_dir, steps=steps, repeats=repeats, seed=seed)
+        return bench_coop(
+            compile_task(spec, robot, Path(tmp) / "coop").out_dir, steps=steps, repeats=repeats, seed=seed
+        )
 
 
 def bench_robots(args: argparse.Namespace) -> list[str | None]:
@@ -275,10 +341,14 @@ def cmd_bench(args: argparse.Namespace) -> int:
         for spec, robot in pairs:
             if args.coop:
                 r = bench_coop_spec(spec, robot, args.steps, args.repeats, args.seed)
-                tracker.done(f"{r['name']}: {r['multi_agent_env_steps_per_s']} multi-agent env steps/s, "
-                             f"{r['multi_over_single']} x single-agent ({spec})")
+                tracker.done(
+                    f"{r['name']}: {r['multi_agent_env_steps_per_s']} multi-agent env steps/s, "
+                    f"{r['multi_over_single']} x single-agent ({spec})"
+                )
             else:
-                r = bench(spec, robot, args.steps, args.resets, args.repeats, args.seed, reference_json, args.reference_json)
+                r = bench(
+                    spec, robot, args.steps, args.resets, args.repeats, args.seed, reference_json, args.reference_json
+                )
                 tracker.done(f"{r['gym_id']}: {r['env_steps_per_s']} env steps/s ({spec})")
             results.append(r)
     if args.json:
@@ -286,8 +356,12 @@ def cmd_bench(args: argparse.Namespace) -> int:
         return EXIT_OK
     if len(results) == 1:
         figures = {k: v for k, v in results[0].items() if k != "notes"}
-        print_table(["figure", "value"], [[key, cell(value)] for key, value in figures.items()], left=["figure", "value"],
-                    caption=f"notes: {results[0]['notes']}")
+        print_table(
+            ["figure", "value"],
+            [[key, cell(value)] for key, value in figures.items()],
+            left=["figure", "value"],
+            caption=f"notes: {results[0]['notes']}",
+        )
         return EXIT_OK
     # Several tasks or robots: one row per spec x robot (taken one after the other in this run; medians over repeats).
     columns = BENCH_COOP_TABLE if args.coop else BENCH_TABLE
@@ -300,18 +374,36 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 
 def add_commands(sub) -> None:
-    p = sub.add_parser("bench", help="speed figures taken in one run: steps/s vs raw physics and the reference, resets, compile, import, RSS")
+    p = sub.add_parser(
+        "bench",
+        help="speed figures taken in one run: steps/s vs raw physics and the reference, resets, compile, import, RSS",
+    )
     add_library_argument(p)
     p.add_argument("specs", nargs="+", metavar="spec", help="task spec file(s); several print one row each")
-    p.add_argument("--robot", action="append", help="robot (default: each spec's default); may be given several times: one row per spec x robot")
-    p.add_argument("--robots", help="comma-separated robot names, e.g. jaco,stretch (as compare takes them); with --robot, both count")
+    p.add_argument(
+        "--robot",
+        action="append",
+        help="robot (default: each spec's default); may be given several times: one row per spec x robot",
+    )
+    p.add_argument(
+        "--robots",
+        help="comma-separated robot names, e.g. jaco,stretch (as compare takes them); with --robot, both count",
+    )
     p.add_argument("--seed", type=int, default=0, help="seed of the first repeat's episode and of the random actions")
     p.add_argument("--steps", type=int, default=400, help="env steps per repeat")
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--resets", type=int, default=100)
-    p.add_argument("--coop", action="store_true", help="multi-agent (PettingZoo, both agents acting) vs single-agent env steps/s, in one run")
+    p.add_argument(
+        "--coop",
+        action="store_true",
+        help="multi-agent (PettingZoo, both agents acting) vs single-agent env steps/s, in one run",
+    )
     p.add_argument("--json", action="store_true")
-    p.add_argument("--reference-json", dest="reference_json", metavar="FILE",
-                   help="reference figures measured beside ours: the lines the reference harness's 'measure.py ag ENV' printed "
-                        "(default: the stored figures, each reported with the date and conditions it was measured under)")
+    p.add_argument(
+        "--reference-json",
+        dest="reference_json",
+        metavar="FILE",
+        help="reference figures measured beside ours: the lines the reference harness's 'measure.py ag ENV' printed "
+        "(default: the stored figures, each reported with the date and conditions it was measured under)",
+    )
     p.set_defaults(func=cmd_bench)

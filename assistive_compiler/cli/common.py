@@ -16,8 +16,10 @@ from ..errors import SpecError
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 EXIT_INTERRUPTED = 130
 
-TRAIN_EXTRA_HINT = ("the learning commands need the 'train' extra: install torch's CPU build first "
-                    "(pip install torch --index-url https://download.pytorch.org/whl/cpu), then pip install -e '.[train]'")
+TRAIN_EXTRA_HINT = (
+    "the learning commands need the 'train' extra: install torch's CPU build first "
+    "(pip install torch --index-url https://download.pytorch.org/whl/cpu), then pip install -e '.[train]'"
+)
 
 
 def print_problems(error: SpecError) -> None:
@@ -27,9 +29,14 @@ def print_problems(error: SpecError) -> None:
 
 def add_library_argument(p: argparse.ArgumentParser) -> None:
     """``--library DIR`` (repeatable): a folder of the user's own parts, laid out like ``specs/``."""
-    p.add_argument("--library", action="append", default=[], metavar="DIR",
-                   help="a folder of your own parts (robots/ tools/ furniture/ people/, templates in ../templates); "
-                        "repeatable; searched before $ASSISTIVE_COMPILER_LIBRARY, the spec's own library and the shipped parts")
+    p.add_argument(
+        "--library",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="a folder of your own parts (robots/ tools/ furniture/ people/, templates in ../templates); "
+        "repeatable; searched before $ASSISTIVE_COMPILER_LIBRARY, the spec's own library and the shipped parts",
+    )
 
 
 def use_library_dirs(dirs: list[str]) -> None:
@@ -39,7 +46,9 @@ def use_library_dirs(dirs: list[str]) -> None:
 
     for d in dirs:
         if not Path(d).is_dir():
-            raise SpecError.at(d, "--library: folder not found (expected a folder holding robots/, tools/, furniture/ or people/)")
+            raise SpecError.at(
+                d, "--library: folder not found (expected a folder holding robots/, tools/, furniture/ or people/)"
+            )
     if dirs:
         current = [p for p in os.environ.get(LIBRARY_ENV, "").split(os.pathsep) if p]
         os.environ[LIBRARY_ENV] = os.pathsep.join([str(Path(d).resolve()) for d in dirs] + current)

@@ -10,20 +10,22 @@ from __future__ import annotations
 
 import argparse
 import json
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
-from .common import EXIT_OK, add_library_argument
 from ..episode import rollout
+from .common import EXIT_OK, add_library_argument
 
 COLUMNS = ("robot", "placement", "goals_reached", "jlwki", "compile_s", "success", "return")
 #: ``--policy pretrained``: each robot plays its own shipped policy, ``pretrained:<task>-<robot>``.
 EACH_PRETRAINED = "pretrained"
-JLWKI_NOTE = ("jlwki: joint-limit-weighted kinematic isotropy (0 to 1 per goal; higher: farther from singularities "
-              "and joint limits) summed over the goals the arm reaches from the searched base pose, mean over person "
-              "variants; '-' for a robot mounted on furniture (no base search).")
+JLWKI_NOTE = (
+    "jlwki: joint-limit-weighted kinematic isotropy (0 to 1 per goal; higher: farther from singularities "
+    "and joint limits) summed over the goals the arm reaches from the searched base pose, mean over person "
+    "variants; '-' for a robot mounted on furniture (no base search)."
+)
 
 
 def compare_robot(spec: str, robot: str, episodes: int, seed: int, out: Path | None, policy: str = "scripted") -> dict:
@@ -68,16 +70,25 @@ def compare_robot(spec: str, robot: str, episodes: int, seed: int, out: Path | N
     return row
 
 
-def compare(spec: str, robots: list[str], episodes: int, seed: int, out_root: str | None,
-            on_row: Callable[[dict], None] | None = None, policy: str = "scripted") -> list[dict]:
+def compare(
+    spec: str,
+    robots: list[str],
+    episodes: int,
+    seed: int,
+    out_root: str | None,
+    on_row: Callable[[dict], None] | None = None,
+    policy: str = "scripted",
+) -> list[dict]:
     """Per robot: placement quality, compile time and ``policy``'s results (each row also handed
     to ``on_row`` as soon as it is measured)."""
     from ..errors import UsageError
     from ..policies import POLICIES
 
     if policy not in POLICIES + (EACH_PRETRAINED,) and len(robots) > 1:
-        raise UsageError(f"compare --policy {policy}: a trained policy plays one robot; compare it with --robots <its robot>, "
-                         f"or use --policy {EACH_PRETRAINED} (each robot's shipped policy)")
+        raise UsageError(
+            f"compare --policy {policy}: a trained policy plays one robot; compare it with --robots <its robot>, "
+            f"or use --policy {EACH_PRETRAINED} (each robot's shipped policy)"
+        )
     rows = []
     for robot in robots:
         rows.append(compare_robot(spec, robot, episodes, seed, Path(out_root) / robot if out_root else None, policy))
@@ -99,8 +110,12 @@ def print_comparison(rows: list[dict]) -> None:
     from .output import cell, print_table
 
     digits = {"success": 2}
-    table = [[cell(row.get(c), digits.get(c)) for c in COLUMNS] if "error" not in row
-             else [row["robot"], "failed to compile"] + ["-"] * (len(COLUMNS) - 2) for row in rows]
+    table = [
+        [cell(row.get(c), digits.get(c)) for c in COLUMNS]
+        if "error" not in row
+        else [row["robot"], "failed to compile"] + ["-"] * (len(COLUMNS) - 2)
+        for row in rows
+    ]
     print_table(COLUMNS, table, left=("robot", "placement"), caption=JLWKI_NOTE)
     for row in rows:
         if "error" in row:
@@ -112,8 +127,15 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
     robots = [r.strip() for r in args.robots.split(",") if r.strip()]
     with progress(f"compare {Path(args.spec).name}", len(robots)) as tracker:
-        rows = compare(args.spec, robots, args.episodes, args.seed, args.out, on_row=lambda row: tracker.done(_finished(row)),
-                       policy=args.policy)
+        rows = compare(
+            args.spec,
+            robots,
+            args.episodes,
+            args.seed,
+            args.out,
+            on_row=lambda row: tracker.done(_finished(row)),
+            policy=args.policy,
+        )
     if args.json:
         print(json.dumps(rows, indent=1))
         return EXIT_OK
@@ -128,9 +150,12 @@ def add_commands(sub) -> None:
     p.add_argument("spec", help="task spec file")
     p.add_argument("--robots", required=True, help="comma-separated robot names, e.g. pr2,jaco,baxter,sawyer,panda")
     p.add_argument("--episodes", type=int, default=10, help="episodes per robot")
-    p.add_argument("--policy", default="scripted",
-                   help="scripted (default), random, zero, pretrained (each robot's shipped policy), or for one robot "
-                        "pretrained:<task>-<robot> or a training run directory")
+    p.add_argument(
+        "--policy",
+        default="scripted",
+        help="scripted (default), random, zero, pretrained (each robot's shipped policy), or for one robot "
+        "pretrained:<task>-<robot> or a training run directory",
+    )
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", help="artifact root (default generated/<task>-<robot>)")
     p.add_argument("--json", action="store_true")

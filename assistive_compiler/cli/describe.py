@@ -22,8 +22,11 @@ def cmd_describe(args: argparse.Namespace) -> int:
 
 
 def add_commands(sub) -> None:
-    p = sub.add_parser("describe", help="every body and link of a task's scene after a reset: world positions, frame axes, "
-                                        "targets, tools, markers")
+    p = sub.add_parser(
+        "describe",
+        help="every body and link of a task's scene after a reset: world positions, frame axes, "
+        "targets, tools, markers",
+    )
     add_spec_arguments(p, policy=False)
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--out-dir", dest="out_dir", help="artifact directory")

@@ -10,8 +10,9 @@ in every case one line per finished item saying what finished. Only the CLI impo
 from __future__ import annotations
 
 import sys
+from collections.abc import Collection, Iterator, Sequence
 from contextlib import contextmanager
-from typing import Any, Collection, Iterator, Sequence
+from typing import Any
 
 from rich import box
 from rich.console import Console
@@ -46,13 +47,28 @@ def _print(renderable: Any) -> None:
     print("\n".join(line.rstrip() for line in captured.get().splitlines()))
 
 
-def print_table(columns: Sequence[str], rows: Sequence[Sequence[str]], *, left: Sequence[str] = (),
-                title: str | None = None, caption: str | None = None, section_after: Collection[int] = ()) -> None:
+def print_table(
+    columns: Sequence[str],
+    rows: Sequence[Sequence[str]],
+    *,
+    left: Sequence[str] = (),
+    title: str | None = None,
+    caption: str | None = None,
+    section_after: Collection[int] = (),
+) -> None:
     """Print ``rows`` (cells as strings, see :func:`cell`) under ``columns``; the ``left`` columns
     are left-aligned (text), the others right-aligned (numbers). ``caption`` explains the table
     below it; a rule follows the rows whose indices are in ``section_after``."""
-    table = Table(box=box.SIMPLE_HEAD, show_edge=False, pad_edge=False, header_style="bold",
-                  title=title, title_justify="left", caption=caption, caption_justify="left")
+    table = Table(
+        box=box.SIMPLE_HEAD,
+        show_edge=False,
+        pad_edge=False,
+        header_style="bold",
+        title=title,
+        title_justify="left",
+        caption=caption,
+        caption_justify="left",
+    )
     for name in columns:
         table.add_column(name, justify="left" if name in left else "right")
     for i, row in enumerate(rows):
@@ -87,6 +103,12 @@ def progress(description: str, total: int, *, enabled: bool = True) -> Iterator[
         yield Tracker(total, None, None, enabled)
         return
     console = Console(file=sys.stderr, highlight=False)
-    columns = (SpinnerColumn(), TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
+    columns = (
+        SpinnerColumn(),
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+    )
     with Progress(*columns, console=console, transient=True) as bar:
         yield Tracker(total, bar, bar.add_task(description, total=total), enabled)

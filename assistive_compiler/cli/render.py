@@ -35,8 +35,11 @@ def parse_camera(text: str | None) -> dict | None:
             numbers = []
         want = 1 if names.get(key) == "fov_deg" else 3
         if key not in names or len(numbers) != want:
-            raise SpecError.at("--camera", f"'{item}': expected eye=X,Y,Z, target=X,Y,Z or fov=DEG (metres in the world frame, degrees), "
-                                           "e.g. --camera 'eye=-0.9,-1.4,1.5 target=-0.1,-0.15,0.85 fov=50'")
+            raise SpecError.at(
+                "--camera",
+                f"'{item}': expected eye=X,Y,Z, target=X,Y,Z or fov=DEG (metres in the world frame, degrees), "
+                "e.g. --camera 'eye=-0.9,-1.4,1.5 target=-0.1,-0.15,0.85 fov=50'",
+            )
         view[names[key]] = numbers[0] if want == 1 else tuple(numbers)
     return view
 
@@ -47,14 +50,18 @@ def cmd_render(args: argparse.Namespace) -> int:
     out = Path(args.out)
     check_picture_path(out)
     view = parse_camera(args.camera)
-    env = make_env(args.spec, args.robot, args.out_dir, render_mode="rgb_array", render_size=(args.width, args.height), camera=view)
+    env = make_env(
+        args.spec, args.robot, args.out_dir, render_mode="rgb_array", render_size=(args.width, args.height), camera=view
+    )
     env.show_frames = args.frames
     target, act = make_player(args.policy, env, seed=args.seed)  # a co-optimised pair: the person acts too
     frames, summary = episode_frames(target, act, args.seed, args.every)
     fps = args.fps or control_hz(env.manifest) / args.every
     env.close()
     write_picture(frames, out, fps=fps)
-    print(f"wrote {args.out} ({len(frames)} frames at {fps:g} fps; return {summary['return']:.1f}, success {'yes' if summary['success'] else 'no'})")
+    print(
+        f"wrote {args.out} ({len(frames)} frames at {fps:g} fps; return {summary['return']:.1f}, success {'yes' if summary['success'] else 'no'})"
+    )
     return EXIT_OK
 
 
@@ -90,7 +97,9 @@ def render_people(artifact_dir: Path, width: int = 360, height: int = 480) -> np
         eye = target + rotation @ [0.0, -2.6, 0.35]
         view = pb.computeViewMatrix(eye.tolist(), target.tolist(), (rotation @ [0, 0, 1]).tolist(), physicsClientId=c)
         proj = pb.computeProjectionMatrixFOV(40, width / height, 0.05, 10, physicsClientId=c)
-        rgba = pb.getCameraImage(width, height, view, proj, renderer=pb.ER_TINY_RENDERER, lightDirection=[1, -2, 2], physicsClientId=c)[2]
+        rgba = pb.getCameraImage(
+            width, height, view, proj, renderer=pb.ER_TINY_RENDERER, lightDirection=[1, -2, 2], physicsClientId=c
+        )[2]
         image = Image.fromarray(np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3])
         label = f"{variant.name}\n{variant.sex}, {variant.mass_kg:.1f} kg, {variant.standing_height_m:.3f} m"
         ImageDraw.Draw(image).multiline_text((8, 8), label, fill=(0, 0, 0))
@@ -118,14 +127,23 @@ def add_commands(sub) -> None:
     add_spec_arguments(p)
     p.add_argument("--out", required=True, help="output .gif or .mp4 (every recorded frame) or .png (a strip of four)")
     p.add_argument("--every", type=int, default=4, help="record every N steps (default 4)")
-    p.add_argument("--fps", type=float, help="frames per second of a GIF or MP4 (default: simulated speed, "
-                                              "the control rate / --every: 2.5 at 10 Hz and --every 4)")
-    p.add_argument("--camera", help="camera instead of the task's: 'eye=X,Y,Z target=X,Y,Z fov=DEG' (world frame, m; any subset)")
+    p.add_argument(
+        "--fps",
+        type=float,
+        help="frames per second of a GIF or MP4 (default: simulated speed, "
+        "the control rate / --every: 2.5 at 10 Hz and --every 4)",
+    )
+    p.add_argument(
+        "--camera", help="camera instead of the task's: 'eye=X,Y,Z target=X,Y,Z fov=DEG' (world frame, m; any subset)"
+    )
     p.add_argument("--width", type=int, default=480)
     p.add_argument("--height", type=int, default=360)
     p.add_argument("--out-dir", dest="out_dir", help="artifact directory")
-    p.add_argument("--frames", action="store_true", help="draw the end effector's, tools' and targets' frames "
-                                                         "(x red, y green, z blue, 6 cm) with their names")
+    p.add_argument(
+        "--frames",
+        action="store_true",
+        help="draw the end effector's, tools' and targets' frames (x red, y green, z blue, 6 cm) with their names",
+    )
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("render-person", help="draw the person variants a spec declares, side by side (PNG)")

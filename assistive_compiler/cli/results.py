@@ -19,14 +19,22 @@ def cmd_export(args: argparse.Namespace) -> int:
     from ..paths import display
     from ..training.export import export_run
 
-    record = export_run(args.run_dir, args.out, episodes=args.episodes, seed=args.seed, label=args.label or "",
-                        progress=lambda line: print(line, file=sys.stderr))
+    record = export_run(
+        args.run_dir,
+        args.out,
+        episodes=args.episodes,
+        seed=args.seed,
+        label=args.label or "",
+        progress=lambda line: print(line, file=sys.stderr),
+    )
     e = record["evaluation"]
     where = display(Path(args.out)) if args.out else f"pretrained/{record['name']}"
     play = where if args.out else f"pretrained:{record['name']}"
-    print(f"exported {record['gym_id']} ({record['trained_steps']:,} steps) -> {where}: success {e['success_rate']:.2f}, "
-          f"return {e['mean_return']:.1f} ± {e['std_return']:.1f} over {e['episodes']} episodes from seed {e['seed']:,}; "
-          f"play it with --policy {play}")
+    print(
+        f"exported {record['gym_id']} ({record['trained_steps']:,} steps) -> {where}: success {e['success_rate']:.2f}, "
+        f"return {e['mean_return']:.1f} ± {e['std_return']:.1f} over {e['episodes']} episodes from seed {e['seed']:,}; "
+        f"play it with --policy {play}"
+    )
     return EXIT_OK
 
 
@@ -49,16 +57,30 @@ def cmd_results(args: argparse.Namespace) -> int:
 def add_commands(sub) -> None:
     from ..training.export import EVAL_SEED
 
-    p = sub.add_parser("export", help="a run's newest checkpoint as a shipped policy (NumPy only), evaluated on unseen seeds")
+    p = sub.add_parser(
+        "export", help="a run's newest checkpoint as a shipped policy (NumPy only), evaluated on unseen seeds"
+    )
     p.add_argument("run_dir", help="a run directory written by train (SB3 or RLlib; static or co-optimised)")
-    p.add_argument("--out", help="policy folder (default pretrained/<task>-<robot>, co-optimised pretrained/<task>-<robot>-coop: "
-                   "shipped as pretrained:<that name>)")
+    p.add_argument(
+        "--out",
+        help="policy folder (default pretrained/<task>-<robot>, co-optimised pretrained/<task>-<robot>-coop: "
+        "shipped as pretrained:<that name>)",
+    )
     p.add_argument("--episodes", type=int, default=100, help="evaluation episodes (default 100, as the paper)")
-    p.add_argument("--seed", type=int, default=EVAL_SEED, help=f"first evaluation seed (default {EVAL_SEED:,}: never used in training)")
+    p.add_argument(
+        "--seed",
+        type=int,
+        default=EVAL_SEED,
+        help=f"first evaluation seed (default {EVAL_SEED:,}: never used in training)",
+    )
     p.add_argument("--label", help="the table row's name (default: the algorithm and its config's description)")
     p.set_defaults(func=cmd_export)
 
-    p = sub.add_parser("results", help="regenerate docs/results.md's tables, curves and pictures from the shipped policies")
+    p = sub.add_parser(
+        "results", help="regenerate docs/results.md's tables, curves and pictures from the shipped policies"
+    )
     p.add_argument("--out", default="docs/results.md", help="the results document (its generated block is replaced)")
-    p.add_argument("--no-pictures", action="store_true", help="tables only; keep the curve and rollout pictures as they are")
+    p.add_argument(
+        "--no-pictures", action="store_true", help="tables only; keep the curve and rollout pictures as they are"
+    )
     p.set_defaults(func=cmd_results)

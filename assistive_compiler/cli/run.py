@@ -72,21 +72,35 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         def play(seed: int) -> dict:
             return rollout(player, policy, seed)
+
     weights = {t.name: t.weight for t in env.manifest.reward}
     episodes = []
     with progress(f"{env.manifest.label} {label}", args.episodes, enabled=not args.quiet) as tracker:
         for k in range(args.episodes):
             e = play(args.seed + k)
             episodes.append(e)
-            tracker.done(f"episode {k} (seed {e['seed']}): return {e['return']:.1f}, success {_yes_no(e['success'])}; "
-                         f"{sum(x['success'] for x in episodes)}/{len(episodes)} successful so far")
+            tracker.done(
+                f"episode {k} (seed {e['seed']}): return {e['return']:.1f}, success {_yes_no(e['success'])}; "
+                f"{sum(x['success'] for x in episodes)}/{len(episodes)} successful so far"
+            )
     env.close()
     rate = sum(e["success"] for e in episodes) / len(episodes)
     if args.json:
-        print(json.dumps({"task": env.manifest.task, "robot": env.manifest.robot_name, "policy": args.policy,
-                          **({"human_policy": args.human_policy} if args.coop else {}),
-                          "term_weights": weights, "episodes": episodes, "success_rate": rate,
-                          "mean_return": float(np.mean([e["return"] for e in episodes]))}, indent=1))
+        print(
+            json.dumps(
+                {
+                    "task": env.manifest.task,
+                    "robot": env.manifest.robot_name,
+                    "policy": args.policy,
+                    **({"human_policy": args.human_policy} if args.coop else {}),
+                    "term_weights": weights,
+                    "episodes": episodes,
+                    "success_rate": rate,
+                    "mean_return": float(np.mean([e["return"] for e in episodes])),
+                },
+                indent=1,
+            )
+        )
         return EXIT_OK
     human = f"  human-policy={args.human_policy}" if args.coop else ""
     print(f"{env.manifest.label}  policy={args.policy}{human}  episodes={len(episodes)}  seed={args.seed}")
@@ -103,14 +117,16 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def cmd_demo(args: argparse.Namespace) -> int:
     from ..compile.compiler import compile_task
+    from ..pictures import episode_frames, write_picture
     from ..policies import make_policy
     from ..runtime.env import AssistiveEnv
-    from ..pictures import episode_frames, write_picture
 
     spec = str(Path(args.spec))
     result = compile_task(spec, args.robot)
     m = result.manifest
-    print(f"{'cache hit' if result.cache_hit else 'compiled'}: {m.task} for {m.robot_name} -> {result.out_dir}/ ({result.seconds:.2f} s)")
+    print(
+        f"{'cache hit' if result.cache_hit else 'compiled'}: {m.task} for {m.robot_name} -> {result.out_dir}/ ({result.seconds:.2f} s)"
+    )
     env = AssistiveEnv(result.out_dir, render_mode="rgb_array")
     policy = make_policy("scripted", env)
     outcomes = []
@@ -122,8 +138,10 @@ def cmd_demo(args: argparse.Namespace) -> int:
         e = rollout(env, policy, args.seed + k)
         outcomes.append(e)
         eaten = e["success_metric"]
-        print(f"episode {k}: return {e['return']:7.1f}  success {'yes' if e['success'] else 'no '}  "
-              f"{m.success.term} {eaten:g} (need {m.success.threshold:g})  mean force on person {e['mean_force_on_human_n']:.2f} N")
+        print(
+            f"episode {k}: return {e['return']:7.1f}  success {'yes' if e['success'] else 'no '}  "
+            f"{m.success.term} {eaten:g} (need {m.success.threshold:g})  mean force on person {e['mean_force_on_human_n']:.2f} N"
+        )
         if frames is not None:
             write_picture(frames, Path(args.picture), fps=1)
     env.close()
@@ -147,13 +165,23 @@ def add_commands(sub) -> None:
     p.add_argument("--out", help="artifact directory (default generated/<task>-<robot>)")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
-    p.add_argument("--coop", action="store_true", help="co-optimisation: the person acts too (by --human-policy), shared reward")
-    p.add_argument("--human-policy", dest="human_policy", default=None,
-                   help=f"with --coop: {', '.join(HUMAN_POLICIES)} (zero: keep still by acting; hold: no human action, the static "
-                        "person), or a co-optimised pair (pretrained:<task>-<robot>-coop, a --coop run directory); default: the "
-                        "pair's own person when --policy is one, else random")
-    p.add_argument("--record", metavar="DIR", help="also write each episode to DIR/episode-NNNN.npz (poses, actions, per-term "
-                   "rewards, success; see assistive_compiler.record.format); view one with: view SPEC --replay FILE")
+    p.add_argument(
+        "--coop", action="store_true", help="co-optimisation: the person acts too (by --human-policy), shared reward"
+    )
+    p.add_argument(
+        "--human-policy",
+        dest="human_policy",
+        default=None,
+        help=f"with --coop: {', '.join(HUMAN_POLICIES)} (zero: keep still by acting; hold: no human action, the static "
+        "person), or a co-optimised pair (pretrained:<task>-<robot>-coop, a --coop run directory); default: the "
+        "pair's own person when --policy is one, else random",
+    )
+    p.add_argument(
+        "--record",
+        metavar="DIR",
+        help="also write each episode to DIR/episode-NNNN.npz (poses, actions, per-term "
+        "rewards, success; see assistive_compiler.record.format); view one with: view SPEC --replay FILE",
+    )
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("demo", help="the main job: compile Feeding for Jaco, run the scripted policy, write a picture")

@@ -91,8 +91,16 @@ def cmd_schema(args: argparse.Namespace) -> int:
         from .output import print_table
 
         for category in ("observation", "reward", "preference"):
-            rows = [[name, ", ".join(tdef.params.model_fields) or "-", tdef.summary()] for name, tdef in sorted(terms(category).items())]
-            print_table(["term", "parameters", "what it is"], rows, left=["term", "parameters", "what it is"], title=f"{category} terms")
+            rows = [
+                [name, ", ".join(tdef.params.model_fields) or "-", tdef.summary()]
+                for name, tdef in sorted(terms(category).items())
+            ]
+            print_table(
+                ["term", "parameters", "what it is"],
+                rows,
+                left=["term", "parameters", "what it is"],
+                title=f"{category} terms",
+            )
         return EXIT_OK
     print(json.dumps(task_schema(), indent=2, sort_keys=True))
     return EXIT_OK
@@ -104,12 +112,22 @@ def cmd_list(args: argparse.Namespace) -> int:
 
     tasks = shipped_tasks()
     if args.json:
-        print(json.dumps([{"task": t.name, "title": t.title, "spec": display(t.spec), "robots": t.robots, "ids": t.ids} for t in tasks], indent=2))
+        print(
+            json.dumps(
+                [
+                    {"task": t.name, "title": t.title, "spec": display(t.spec), "robots": t.robots, "ids": t.ids}
+                    for t in tasks
+                ],
+                indent=2,
+            )
+        )
         return EXIT_OK
     from .output import print_table
 
     robots = sorted({r for t in tasks for r in t.robots})
-    print(f"{len(tasks)} tasks x {len(robots)} robots ({', '.join(robots)}); Gymnasium ids (gymnasium.make after import assistive_compiler):")
+    print(
+        f"{len(tasks)} tasks x {len(robots)} robots ({', '.join(robots)}); Gymnasium ids (gymnasium.make after import assistive_compiler):"
+    )
     rows, ends = [], []
     for t in tasks:
         for k, (robot, env_id) in enumerate(zip(t.robots, t.ids)):
@@ -141,11 +159,19 @@ def add_commands(sub) -> None:
 
     p = sub.add_parser("schema", help="print the JSON Schema of a task spec (or --terms: the term library)")
     p.add_argument("--terms", action="store_true", help="list registered terms and their parameters instead")
-    p.add_argument("--training", action="store_true", help="print the JSON Schema of a training config (specs/training/*.yaml) instead")
+    p.add_argument(
+        "--training",
+        action="store_true",
+        help="print the JSON Schema of a training config (specs/training/*.yaml) instead",
+    )
     p.set_defaults(func=cmd_schema)
 
-    p = sub.add_parser("person-reference", help="write the person model's reference page (links, frames, joints and limits)")
-    p.add_argument("--out", default="docs/person.md", help="output Markdown file (default docs/person.md); '-' prints it")
+    p = sub.add_parser(
+        "person-reference", help="write the person model's reference page (links, frames, joints and limits)"
+    )
+    p.add_argument(
+        "--out", default="docs/person.md", help="output Markdown file (default docs/person.md); '-' prints it"
+    )
     p.set_defaults(func=cmd_person_reference)
 
 

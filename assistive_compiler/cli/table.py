@@ -22,6 +22,8 @@ def add_commands(sub) -> None:
     p = sub.add_parser("table", help="the paper's Tables I/II from run directories, ours beside the paper's")
     p.add_argument("run_dirs", nargs="+", help="run directories (static runs fill Table I, --coop runs Table II)")
     p.add_argument("--out", help="write OUT (.md) with OUT's .csv and .png (learning curves) beside it")
-    p.add_argument("--episodes", type=int, help="episodes for runs not yet evaluated (default: each run's eval_episodes)")
+    p.add_argument(
+        "--episodes", type=int, help="episodes for runs not yet evaluated (default: each run's eval_episodes)"
+    )
     p.add_argument("--seed", type=int, default=0, help="seed for runs not yet evaluated")
     p.set_defaults(func=cmd_table)

@@ -27,10 +27,12 @@ def training_config_path(name: str) -> str:
 
 def _summary_line(summary: dict) -> str:
     ret, rate = summary["final_mean_return"], summary["final_success_rate"]
-    return (f"{summary['gym_id']}: {summary['steps']:,} steps in {summary['wall_s']:.0f} s "
-            f"({summary['steps_per_s_including_learning']:.0f} steps/s including learning); "
-            f"last mean return {'-' if ret is None else f'{ret:.1f}'}, success {'-' if rate is None else f'{rate:.2f}'}; "
-            f"checkpoint {summary['checkpoint']}")
+    return (
+        f"{summary['gym_id']}: {summary['steps']:,} steps in {summary['wall_s']:.0f} s "
+        f"({summary['steps_per_s_including_learning']:.0f} steps/s including learning); "
+        f"last mean return {'-' if ret is None else f'{ret:.1f}'}, success {'-' if rate is None else f'{rate:.2f}'}; "
+        f"checkpoint {summary['checkpoint']}"
+    )
 
 
 def cmd_train(args: argparse.Namespace) -> int:
@@ -49,13 +51,28 @@ def cmd_train(args: argparse.Namespace) -> int:
     # With --json, stdout holds the summary alone: whatever training prints (and Ray's forwarded
     # cluster messages, e.g. "node ... marked dead") goes to stderr meanwhile.
     with contextlib.redirect_stdout(sys.stderr) if args.json else contextlib.nullcontext():
-        summary = train(args.spec, robot=args.robot, config_path=training_config_path(args.config), coop=args.coop, engine=engine,
-                        steps=args.steps, seed=args.seed, envs=args.envs, out=args.out, resume=args.resume,
-                        address=args.address, quiet=args.quiet)
+        summary = train(
+            args.spec,
+            robot=args.robot,
+            config_path=training_config_path(args.config),
+            coop=args.coop,
+            engine=engine,
+            steps=args.steps,
+            seed=args.seed,
+            envs=args.envs,
+            out=args.out,
+            resume=args.resume,
+            address=args.address,
+            quiet=args.quiet,
+        )
     print(json.dumps(summary, indent=1) if args.json else _summary_line(summary))
     if summary["interrupted"]:
-        print(f"stopped: {summary['stopped_because']}" if summary.get("stopped_because") else
-              "interrupted: checkpoint written; continue with the same command and --resume", file=sys.stderr)
+        print(
+            f"stopped: {summary['stopped_because']}"
+            if summary.get("stopped_because")
+            else "interrupted: checkpoint written; continue with the same command and --resume",
+            file=sys.stderr,
+        )
         return EXIT_INTERRUPTED
     return EXIT_OK
 
@@ -65,9 +82,15 @@ def add_commands(sub) -> None:
     add_library_argument(p)
     p.add_argument("spec", help="task spec file")
     p.add_argument("--robot", help="robot name (default: the spec's default robot)")
-    p.add_argument("--config", required=True, help=f"training config: a file, or a shipped one by name ({SHIPPED_CONFIGS})")
-    p.add_argument("--coop", action="store_true", help="co-optimisation: train the robot and the person (policies robot and human)")
-    p.add_argument("--engine", default="auto", help="sb3 | rllib | auto (default: rllib for --coop or --address, else sb3)")
+    p.add_argument(
+        "--config", required=True, help=f"training config: a file, or a shipped one by name ({SHIPPED_CONFIGS})"
+    )
+    p.add_argument(
+        "--coop", action="store_true", help="co-optimisation: train the robot and the person (policies robot and human)"
+    )
+    p.add_argument(
+        "--engine", default="auto", help="sb3 | rllib | auto (default: rllib for --coop or --address, else sb3)"
+    )
     p.add_argument("--address", help="attach to a running Ray cluster at HOST:PORT (or ray://HOST:PORT, or auto)")
     p.add_argument("--steps", type=int, help="total env steps (overrides the config's total_steps)")
     p.add_argument("--seed", type=int, help="seed (overrides the config's)")

@@ -16,31 +16,50 @@ def cmd_view(args: argparse.Namespace) -> int:
     try:
         import viser  # noqa: F401
     except ImportError:
-        print('view: the browser viewer needs the "view" extra: pip install "assistive-compiler[view]"', file=sys.stderr)
+        print(
+            'view: the browser viewer needs the "view" extra: pip install "assistive-compiler[view]"', file=sys.stderr
+        )
         return EXIT_FAILED
     from ..viewer import view
 
     def ready(url: str) -> None:
         print(f"viewing {args.spec} at {url}  (Ctrl-C to stop)", flush=True)
 
-    status = view(args.spec, args.robot, policy=args.policy, replay=args.replay, seed=args.seed, out=args.out, host=args.host,
-                  port=args.port, gui=args.gui, speed=args.speed, on_ready=ready)
+    status = view(
+        args.spec,
+        args.robot,
+        policy=args.policy,
+        replay=args.replay,
+        seed=args.seed,
+        out=args.out,
+        host=args.host,
+        port=args.port,
+        gui=args.gui,
+        speed=args.speed,
+        on_ready=ready,
+    )
     if status == 0:
         print("viewer stopped", flush=True)
     return status
 
 
 def add_commands(sub) -> None:
-    p = sub.add_parser("view", help="view an episode in the browser (3D scene, timeline, per-term reward plots), or --gui")
+    p = sub.add_parser(
+        "view", help="view an episode in the browser (3D scene, timeline, per-term reward plots), or --gui"
+    )
     add_spec_arguments(p, policy=False)
     source = p.add_mutually_exclusive_group()
     from ..policies import POLICY_HELP
 
-    source.add_argument("--policy", help=f"play this policy headless first: {POLICY_HELP} (default scripted); the page can play more")
+    source.add_argument(
+        "--policy", help=f"play this policy headless first: {POLICY_HELP} (default scripted); the page can play more"
+    )
     source.add_argument("--replay", metavar="FILE", help="show a recording (run --record DIR) of this spec and robot")
     p.add_argument("--host", default="127.0.0.1", help="address to serve on (default 127.0.0.1: this machine only)")
     p.add_argument("--port", type=int, default=8080, help="port (default 8080)")
     p.add_argument("--speed", type=float, default=1.0, help="playback speed, × real time (default 1)")
-    p.add_argument("--gui", action="store_true", help="pybullet's own GUI window instead of the browser (needs a display)")
+    p.add_argument(
+        "--gui", action="store_true", help="pybullet's own GUI window instead of the browser (needs a display)"
+    )
     p.add_argument("--out", help="artifact directory (default generated/<task>-<robot>)")
     p.set_defaults(func=cmd_view)

@@ -20,10 +20,10 @@ from ..library import PERSON_TEMPLATE_RELPATH, Library
 from ..paths import display, templates_dir
 from ..person.body import format_fixed_joints
 from ..resolve import ResolvedTask
-from .lint import lint_urdf
-from .weld import robot_welds, weld_joints
 from ..templates import expand_template
+from .lint import lint_urdf
 from .task import impairment_joints, mounted_on, observed_person_joints, policy_joints, present_furniture
+from .weld import robot_welds, weld_joints
 
 
 @dataclass
@@ -72,11 +72,19 @@ def emit_props(rt: ResolvedTask, urdf_dir: Path, lib: Library) -> EmittedScene:
         part = rt.furniture[name].part
         params = dict(part.template.params) | (dict(part.mount_params) if name == mount else {})
         params |= dict(use.params)  # the task's explicit parameters win (e.g. a mount on the person's left)
-        emit_body(scene, name, lib.template_path(rt.furniture[name]), params, rt.furniture[name].smap.value(("template", "path")))
+        emit_body(
+            scene,
+            name,
+            lib.template_path(rt.furniture[name]),
+            params,
+            rt.furniture[name].smap.value(("template", "path")),
+        )
     for name, use in rt.tool_uses.items():
         part = rt.tools[name].part
         params = dict(part.template.params) | ({"mass_kg": use.mass_kg} if use.mass_kg else {})
-        emit_body(scene, name, lib.template_path(rt.tools[name]), params, rt.tools[name].smap.value(("template", "path")))
+        emit_body(
+            scene, name, lib.template_path(rt.tools[name]), params, rt.tools[name].smap.value(("template", "path"))
+        )
     scene.movable = _movable_person_joints(rt)
     scene.measurements = {variant: rt.people[variant].part.measurements() for variant in spec.person.variants}
     return scene
@@ -94,7 +102,13 @@ def _emit_robot(rt: ResolvedTask, scene: EmittedScene, lib: Library) -> str:
         scene.written["robot"] = scene.urdf_dir / "robot.urdf"
         scene.written["robot"].write_text(xml)
     else:
-        emit_body(scene, "robot", lib.template_path(rt.robot), robot_part.template.params, rt.robot.smap.value(("template", "path")))
+        emit_body(
+            scene,
+            "robot",
+            lib.template_path(rt.robot),
+            robot_part.template.params,
+            rt.robot.smap.value(("template", "path")),
+        )
     return scene.written["robot"].read_text()
 
 
@@ -127,12 +141,21 @@ def emit_people(rt: ResolvedTask, scene: EmittedScene, settled: dict[str, tuple]
         scene.postures[variant] = posture
         baked = {j: posture[j] for j in person_joints if j not in scene.movable}
         args = person_xacro_args(scene.measurements[variant], part, format_fixed_joints(baked))
-        emit_body(scene, f"person_{variant}", templates_dir() / PERSON_TEMPLATE_RELPATH, args, rt.loaded.smap.value(("person", "variants", i)))
+        emit_body(
+            scene,
+            f"person_{variant}",
+            templates_dir() / PERSON_TEMPLATE_RELPATH,
+            args,
+            rt.loaded.smap.value(("person", "variants", i)),
+        )
 
 
 def person_xacro_args(measurements, part, fixed_joints: str) -> dict[str, Any]:
     """The person template's arguments: body measurements, the fixed joints' spec, the skin colour."""
-    return measurements.xacro_args() | {"fixed_joints": fixed_joints, "skin_rgba": " ".join(repr(float(c)) for c in part.skin_rgba)}
+    return measurements.xacro_args() | {
+        "fixed_joints": fixed_joints,
+        "skin_rgba": " ".join(repr(float(c)) for c in part.skin_rgba),
+    }
 
 
 def absolute_mesh_paths(urdf_xml: str, base: Path) -> str:

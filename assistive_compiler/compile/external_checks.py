@@ -22,8 +22,8 @@ import shutil
 import subprocess
 import sys
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Iterator
 
 from ..bullet import connect
 
@@ -212,9 +212,7 @@ def _warning_lines(text: str) -> list[str]:
     return lines
 
 
-def pybullet_load_warnings(
-    path: str | os.PathLike[str], *, use_fixed_base: bool = True
-) -> list[str]:
+def pybullet_load_warnings(path: str | os.PathLike[str], *, use_fixed_base: bool = True) -> list[str]:
     """Load ``path`` into a fresh DIRECT pybullet client and return the warning/error lines
     the C library printed to stdout/stderr meanwhile (empty = loaded silently).
 

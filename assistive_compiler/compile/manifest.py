@@ -14,9 +14,23 @@ import math
 from pathlib import Path
 from typing import Any
 
-
-from ..artifact import (Camera, Capsule, Drive, Manifest, MarkerPoint, MarkerSet, Person, PersonVariant, Robot, Sim, StartState, Success,
-                        SurfacePoint, Target, TermUse)
+from ..artifact import (
+    Camera,
+    Capsule,
+    Drive,
+    Manifest,
+    MarkerPoint,
+    MarkerSet,
+    Person,
+    PersonVariant,
+    Robot,
+    Sim,
+    StartState,
+    Success,
+    SurfacePoint,
+    Target,
+    TermUse,
+)
 from ..paths import display
 from ..person.surface import SURFACE_TARGET_SPACING_M, link_surface
 from ..resolve import ResolvedTask
@@ -24,8 +38,8 @@ from ..resolve.bodies import surface_region
 from ..spec.models import scalar_bounds
 from ..terms.registry import SizeContext, terms
 from ..urdf import urdf_info
-from .weld import gripper
 from .task import impairment_joints, policy_joints, rounded
+from .weld import gripper
 
 
 def gym_id(rt: ResolvedTask) -> str:
@@ -36,29 +50,56 @@ def gym_id(rt: ResolvedTask) -> str:
     return shipped_gym_id(rt.loaded.path, rt.spec.name, rt.robot_name) or TASK_ID
 
 
-def build_manifest(rt: ResolvedTask, *, bodies, variants, tools, particles, garments, arm_joints, lower, upper,
-                   placements, welded) -> Manifest:
+def build_manifest(
+    rt: ResolvedTask, *, bodies, variants, tools, particles, garments, arm_joints, lower, upper, placements, welded
+) -> Manifest:
     """The artifact's manifest (``input_hash`` and ``content_hash`` left empty)."""
     spec = rt.spec
-    robot_part = rt.robot.part
     return Manifest(
-        task=spec.name, title=spec.title, robot_name=rt.robot_name, gym_id=gym_id(rt), input_hash="",
+        task=spec.name,
+        title=spec.title,
+        robot_name=rt.robot_name,
+        gym_id=gym_id(rt),
+        input_hash="",
         sources=[display(f) for f in rt.loaded.files],
-        sim=Sim(time_step=spec.sim.time_step_s, frame_skip=spec.sim.frame_skip, episode_steps=spec.sim.episode_steps,
-                gravity=spec.sim.gravity_mps2, sub_steps=spec.sim.solver.sub_steps, solver_iterations=spec.sim.solver.iterations,
-                contact_breaking_threshold=spec.sim.solver.contact_breaking_threshold_m,
-                ground_friction=scalar_bounds(spec.sim.ground.friction)),
+        sim=Sim(
+            time_step=spec.sim.time_step_s,
+            frame_skip=spec.sim.frame_skip,
+            episode_steps=spec.sim.episode_steps,
+            gravity=spec.sim.gravity_mps2,
+            sub_steps=spec.sim.solver.sub_steps,
+            solver_iterations=spec.sim.solver.iterations,
+            contact_breaking_threshold=spec.sim.solver.contact_breaking_threshold_m,
+            ground_friction=scalar_bounds(spec.sim.ground.friction),
+        ),
         bodies=bodies,
         person=_person(rt, variants),
         robot=_robot(rt, arm_joints, lower, upper, placements, welded),
-        tools=tools, targets=_targets(rt), particles=particles,
-        markers=[MarkerSet(name=name, tool=ms["tool"]["body"], tool_link=ms["tool"]["link"], radius=ms["radius_m"],
-                           show_rgba=ms["show_rgba"]) for name, ms in rt.markers.items()],
-        joint_groups=rt.joint_groups | {"person.policy": {"body": "person", "group": "policy", "joints": policy_joints(rt)}},
+        tools=tools,
+        targets=_targets(rt),
+        particles=particles,
+        markers=[
+            MarkerSet(
+                name=name,
+                tool=ms["tool"]["body"],
+                tool_link=ms["tool"]["link"],
+                radius=ms["radius_m"],
+                show_rgba=ms["show_rgba"],
+            )
+            for name, ms in rt.markers.items()
+        ],
+        joint_groups=rt.joint_groups
+        | {"person.policy": {"body": "person", "group": "policy", "joints": policy_joints(rt)}},
         observations={agent: [_observation_use(rt, t) for t in ts] for agent, ts in rt.observations.items()},
-        reward=[TermUse(name=t.name, term=t.term, category=t.category, weight=t.weight, params=t.params) for t in rt.reward],
-        success=Success(term=spec.success.term, aggregate=spec.success.aggregate, threshold=rt.success_threshold,
-                        fraction_of=spec.success.relative_to if spec.success.relative_to in rt.markers else None),
+        reward=[
+            TermUse(name=t.name, term=t.term, category=t.category, weight=t.weight, params=t.params) for t in rt.reward
+        ],
+        success=Success(
+            term=spec.success.term,
+            aggregate=spec.success.aggregate,
+            threshold=rt.success_threshold,
+            fraction_of=spec.success.relative_to if spec.success.relative_to in rt.markers else None,
+        ),
         garments=list(garments),
         scripted=rt.scripted,
         camera=camera(rt),
@@ -71,7 +112,11 @@ def camera(rt: ResolvedTask) -> Camera:
     fields = {}
     for view in (cam, cam.per_robot.get(rt.robot_name)):
         if view is not None:
-            fields |= {k: v for k, v in (("eye", view.eye_m), ("target", view.target_m), ("fov_deg", view.fov_deg)) if v is not None}
+            fields |= {
+                k: v
+                for k, v in (("eye", view.eye_m), ("target", view.target_m), ("fov_deg", view.fov_deg))
+                if v is not None
+            }
     return Camera(**fields)
 
 
@@ -82,11 +127,20 @@ def _person(rt: ResolvedTask, variants: list[PersonVariant]) -> Person:
     if compliant:
         for ref in compliant.joints:
             compliant_joints += rt.joint_groups[ref]["joints"]
-    return Person(variants=variants, policy_joints=policy_joints(rt), position_gain=gains.position_gain, max_force=gains.max_force_nm,
-                  hold_gain=0.1, hold_force=1000.0, compliant_joints=compliant_joints,
-                  compliant_gain=compliant.position_gain if compliant else 0.0, compliant_force=compliant.max_force_nm if compliant else 0.0,
-                  impairments=[impairment_json(rt, ch) for ch in rt.spec.person.impairments.choices],
-                  action_scale=gains.action_scale_rad, arm_limits=gains.arm_limits)
+    return Person(
+        variants=variants,
+        policy_joints=policy_joints(rt),
+        position_gain=gains.position_gain,
+        max_force=gains.max_force_nm,
+        hold_gain=0.1,
+        hold_force=1000.0,
+        compliant_joints=compliant_joints,
+        compliant_gain=compliant.position_gain if compliant else 0.0,
+        compliant_force=compliant.max_force_nm if compliant else 0.0,
+        impairments=[impairment_json(rt, ch) for ch in rt.spec.person.impairments.choices],
+        action_scale=gains.action_scale_rad,
+        arm_limits=gains.arm_limits,
+    )
 
 
 def _robot(rt: ResolvedTask, arm_joints, lower, upper, placements, welded) -> Robot:
@@ -102,23 +156,50 @@ def _robot(rt: ResolvedTask, arm_joints, lower, upper, placements, welded) -> Ro
     multipliers = [m for arm in arms for m in (arm.action_multipliers or [1.0] * len(arm.joints))]
     followers = {f: leader for arm in arms for f, leader in arm.follow.items()}
     d = robot_part.base_drive
-    drive = None if d is None else Drive(joints=d.joints, base_link=d.base_link, wheel_radius=d.wheel_radius_m,
-                                         wheel_separation=d.wheel_separation_m, action_scale=control.action_scale_rad * d.action_multiplier,
-                                         position_gain=d.position_gain, max_force=(d.max_force_n, d.max_force_n, d.max_torque_nm))
-    return Robot(name=rt.robot_name, title=robot_part.title, arm_joints=arm_joints, joint_lower=rounded(lower), joint_upper=rounded(upper),
-                 links=rt.robot_links, action_scale=control.action_scale_rad, position_gain=chosen["position_gain"],
-                 max_force=chosen["max_force_nm"], gripper_joints=finger_joints, gripper_position=grip_pos,
-                 welded_joints=welded, placement=placements,
-                 action_multipliers=multipliers if any(m != 1.0 for m in multipliers) else None,
-                 followers=followers or None, drive=drive)
+    drive = (
+        None
+        if d is None
+        else Drive(
+            joints=d.joints,
+            base_link=d.base_link,
+            wheel_radius=d.wheel_radius_m,
+            wheel_separation=d.wheel_separation_m,
+            action_scale=control.action_scale_rad * d.action_multiplier,
+            position_gain=d.position_gain,
+            max_force=(d.max_force_n, d.max_force_n, d.max_torque_nm),
+        )
+    )
+    return Robot(
+        name=rt.robot_name,
+        title=robot_part.title,
+        arm_joints=arm_joints,
+        joint_lower=rounded(lower),
+        joint_upper=rounded(upper),
+        links=rt.robot_links,
+        action_scale=control.action_scale_rad,
+        position_gain=chosen["position_gain"],
+        max_force=chosen["max_force_nm"],
+        gripper_joints=finger_joints,
+        gripper_position=grip_pos,
+        welded_joints=welded,
+        placement=placements,
+        action_multipliers=multipliers if any(m != 1.0 for m in multipliers) else None,
+        followers=followers or None,
+        drive=drive,
+    )
 
 
 def _targets(rt: ResolvedTask) -> dict[str, Target]:
     targets = {}
     for name, t in rt.spec.targets.items():
         ref = rt.points[name]
-        targets[name] = Target(body=ref["body"], link=ref["link"], offset=rounded(tuple(t.offset_m)), show_rgba=t.show_rgba,
-                               surface="surface_links" in ref)
+        targets[name] = Target(
+            body=ref["body"],
+            link=ref["link"],
+            offset=rounded(tuple(t.offset_m)),
+            show_rgba=t.show_rgba,
+            surface="surface_links" in ref,
+        )
     return targets
 
 
@@ -126,13 +207,38 @@ def _observation_use(rt: ResolvedTask, t) -> TermUse:
     """An observation term with its size (a joint group's size from the task's joint groups)."""
     sizes = {name: len(g["joints"]) for name, g in rt.joint_groups.items()} | {"person.policy": len(policy_joints(rt))}
     tdef = terms("observation")[t.term]
-    raw = {k: (v["group"] if isinstance(v, dict) and "group" in v and "joints" in v else v) for k, v in t.params.items()}
-    size_params = tdef.params.model_construct(**{k: (f"{t.params[k]['body']}.{t.params[k]['group']}" if isinstance(t.params[k], dict) and "joints" in t.params[k] else v) for k, v in raw.items()})
-    return TermUse(name=t.name, term=t.term, category="observation", weight=1.0, params=t.params, size=tdef.size(size_params, SizeContext(sizes)))
+    raw = {
+        k: (v["group"] if isinstance(v, dict) and "group" in v and "joints" in v else v) for k, v in t.params.items()
+    }
+    size_params = tdef.params.model_construct(
+        **{
+            k: (
+                f"{t.params[k]['body']}.{t.params[k]['group']}"
+                if isinstance(t.params[k], dict) and "joints" in t.params[k]
+                else v
+            )
+            for k, v in raw.items()
+        }
+    )
+    return TermUse(
+        name=t.name,
+        term=t.term,
+        category="observation",
+        weight=1.0,
+        params=t.params,
+        size=tdef.size(size_params, SizeContext(sizes)),
+    )
 
 
-def person_variant(rt: ResolvedTask, variant: str, urdf: Path, measurements, posture: dict[str, float], movable: list[str],
-                   starts: list[StartState]) -> PersonVariant:
+def person_variant(
+    rt: ResolvedTask,
+    variant: str,
+    urdf: Path,
+    measurements,
+    posture: dict[str, float],
+    movable: list[str],
+    starts: list[StartState],
+) -> PersonVariant:
     """One person variant's entry: body, movable joints at ``posture`` (rad), randomisation, target
     offsets, limb surfaces and marker points (from the variant's ``urdf`` capsules) and the robot's starts."""
     person_spec = rt.spec.person
@@ -142,16 +248,37 @@ def person_variant(rt: ResolvedTask, variant: str, urdf: Path, measurements, pos
             offsets[tname] = rounded(tuple(target.offset_by_variant.get(variant, target.offset_m)))
     info = urdf_info(urdf.read_text())
     drawn = {t: ref for t, ref in rt.points.items() if "surface_links" in ref}
-    surfaces = {t: [_capsule(info.capsules, link) for link in ref["surface_links"]] for t, ref in drawn.items() if _drawn_on_capsules(rt, ref)}
-    surface_points = {t: _surface_points(rt, info, variant, ref) for t, ref in drawn.items() if not _drawn_on_capsules(rt, ref)}
+    surfaces = {
+        t: [_capsule(info.capsules, link) for link in ref["surface_links"]]
+        for t, ref in drawn.items()
+        if _drawn_on_capsules(rt, ref)
+    }
+    surface_points = {
+        t: _surface_points(rt, info, variant, ref) for t, ref in drawn.items() if not _drawn_on_capsules(rt, ref)
+    }
     marker_points = {name: _marker_points(rt, info, variant, ms) for name, ms in rt.markers.items()}
     initial = {j: rounded(posture[j]) for j in movable}
-    randomize = {j: rounded(tuple(math.radians(a) for a in person_spec.randomize_deg[j].uniform)) for j in movable if j in person_spec.randomize_deg}
+    randomize = {
+        j: rounded(tuple(math.radians(a) for a in person_spec.randomize_deg[j].uniform))
+        for j in movable
+        if j in person_spec.randomize_deg
+    }
     m = measurements
-    return PersonVariant(name=variant, body=f"person_{variant}", sex=m.sex, mass_kg=rounded(m.mass_kg),
-                         standing_height_m=rounded(m.standing_height_m), movable_joints=movable,
-                         initial_angles=initial, randomize=randomize, target_offsets=offsets, starts=starts,
-                         surfaces=surfaces, surface_points=surface_points, markers=marker_points)
+    return PersonVariant(
+        name=variant,
+        body=f"person_{variant}",
+        sex=m.sex,
+        mass_kg=rounded(m.mass_kg),
+        standing_height_m=rounded(m.standing_height_m),
+        movable_joints=movable,
+        initial_angles=initial,
+        randomize=randomize,
+        target_offsets=offsets,
+        starts=starts,
+        surfaces=surfaces,
+        surface_points=surface_points,
+        markers=marker_points,
+    )
 
 
 def _capsule(limbs: dict, link: str) -> Capsule:
@@ -163,19 +290,27 @@ def _marker_points(rt: ResolvedTask, info, variant: str, ms: dict) -> list[Marke
     """The markers of one set on one variant: each link's surface points ``spacing_m`` apart
     (:func:`~assistive_compiler.person.surface.link_surface`), in its region."""
     region = surface_region(rt.spec, ms["region"], variant)
-    return [MarkerPoint(link=p.link, offset=rounded(p.offset)) for link in ms["links"]
-            for p in link_surface(info, link, ms["spacing_m"], region)]
+    return [
+        MarkerPoint(link=p.link, offset=rounded(p.offset))
+        for link in ms["links"]
+        for p in link_surface(info, link, ms["spacing_m"], region)
+    ]
 
 
 def _surface_points(rt: ResolvedTask, info, variant: str, ref: dict) -> list[SurfacePoint]:
     region = surface_region(rt.spec, ref.get("region"), variant)
-    return [SurfacePoint(link=p.link, offset=rounded(p.offset), normal=rounded(p.normal), axis=rounded(p.axis))
-            for link in ref["surface_links"] for p in link_surface(info, link, SURFACE_TARGET_SPACING_M, region)]
+    return [
+        SurfacePoint(link=p.link, offset=rounded(p.offset), normal=rounded(p.normal), axis=rounded(p.axis))
+        for link in ref["surface_links"]
+        for p in link_surface(info, link, SURFACE_TARGET_SPACING_M, region)
+    ]
 
 
 def _drawn_on_capsules(rt: ResolvedTask, ref: dict) -> bool:
     """A surface target drawn as the reference draws an itch: plain capsules, no region."""
-    return "region" not in ref and all(l in rt.person_urdf.capsules and l not in rt.person_urdf.spheres for l in ref["surface_links"])
+    return "region" not in ref and all(
+        link in rt.person_urdf.capsules and link not in rt.person_urdf.spheres for link in ref["surface_links"]
+    )
 
 
 def impairment_json(rt: ResolvedTask, choice) -> dict[str, Any]:

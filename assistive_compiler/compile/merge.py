@@ -245,9 +245,7 @@ class _Tree:
         return joint is not None and joint.get("type") == "fixed" and name not in self.keep
 
 
-def merge_fixed_links(
-    urdf_xml: str, *, keep: Iterable[str] = ()
-) -> tuple[str, dict[str, MergedFrame]]:
+def merge_fixed_links(urdf_xml: str, *, keep: Iterable[str] = ()) -> tuple[str, dict[str, MergedFrame]]:
     """Merge every link whose parent joint is ``fixed`` into its parent (transitively).
 
     Returns the merged URDF document and, for every merged link, its `MergedFrame` on the link

@@ -37,7 +37,12 @@ def merge_people(rt: ResolvedTask, scene: EmittedScene) -> list[tuple[str, str]]
         merged, _frames = merge_fixed_links(path.read_text(), keep=keep)
         problems = lint_urdf(merged, template=f"merged person '{variant}'")
         if problems:  # pragma: no cover - the merge preserves validity; lint guards it
-            raise SpecError([Problem(rt.loaded.smap.value(("person", "variants")), f"merged person URDF refused: {pr}") for pr in problems])
+            raise SpecError(
+                [
+                    Problem(rt.loaded.smap.value(("person", "variants")), f"merged person URDF refused: {pr}")
+                    for pr in problems
+                ]
+            )
         path.write_text(merged)
     return collision_pairs
 
@@ -58,7 +63,9 @@ def finish_person(rt: ResolvedTask, manifest: Manifest, out_tmp: Path, pairs: li
     return manifest.model_copy(update={"person": manifest.person.model_copy(update=update)})
 
 
-def _pairs_apart_at_rest(rt: ResolvedTask, manifest: Manifest, out_tmp: Path, pairs: list[tuple[str, str]]) -> list[tuple[str, str]]:
+def _pairs_apart_at_rest(
+    rt: ResolvedTask, manifest: Manifest, out_tmp: Path, pairs: list[tuple[str, str]]
+) -> list[tuple[str, str]]:
     """``pairs`` less those within 1 mm at any variant's initial pose (merged bodies, fixed base)."""
     import pybullet
 
@@ -68,7 +75,9 @@ def _pairs_apart_at_rest(rt: ResolvedTask, manifest: Manifest, out_tmp: Path, pa
         touching: set[tuple[str, str]] = set()
         for variant in manifest.person.variants:
             body = manifest.body(variant.body)
-            bid = p.loadURDF(str(out_tmp / body.urdf), useFixedBase=True, flags=pybullet.URDF_USE_SELF_COLLISION, physicsClientId=c)
+            bid = p.loadURDF(
+                str(out_tmp / body.urdf), useFixedBase=True, flags=pybullet.URDF_USE_SELF_COLLISION, physicsClientId=c
+            )
             joints = pc.joint_index(bid)
             for name, q in variant.initial_angles.items():
                 p.resetJointState(bid, joints[name], q, physicsClientId=c)

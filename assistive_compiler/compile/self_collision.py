@@ -71,7 +71,7 @@ def person_self_collision(urdf_xml: str, keep: set[str]) -> tuple[set[str], list
     while changed:
         changed = False
         for i, a in enumerate(geometry):
-            for b in geometry[i + 1:]:
+            for b in geometry[i + 1 :]:
                 sa, sb = survivor(a), survivor(b)
                 if sa == sb or rigid(sa, sb):
                     continue
@@ -81,6 +81,10 @@ def person_self_collision(urdf_xml: str, keep: set[str]) -> tuple[set[str], list
                     extra.add(pick)
                     changed = True
     survivors = sorted({survivor(link) for link in geometry})
-    pairs = [(a, b) for i, a in enumerate(survivors) for b in survivors[i + 1:]
-             if (a, b) in enabled and not rigid(a, b) and parent.get(a, ("",))[0] != b and parent.get(b, ("",))[0] != a]
+    pairs = [
+        (a, b)
+        for i, a in enumerate(survivors)
+        for b in survivors[i + 1 :]
+        if (a, b) in enabled and not rigid(a, b) and parent.get(a, ("",))[0] != b and parent.get(b, ("",))[0] != a
+    ]
     return extra, pairs

@@ -28,7 +28,11 @@ def fail(rt: ResolvedTask, path: tuple, message: str) -> SpecError:
 def rounded(values: Any, digits: int = 6) -> Any:
     """Round floats so the manifest's bytes do not depend on the last bits of a solver."""
     if isinstance(values, (list, tuple)):
-        return type(values)(rounded(v, digits) for v in values) if isinstance(values, list) else tuple(rounded(v, digits) for v in values)
+        return (
+            type(values)(rounded(v, digits) for v in values)
+            if isinstance(values, list)
+            else tuple(rounded(v, digits) for v in values)
+        )
     if isinstance(values, (float, np.floating)):
         r = round(float(values), digits)
         return 0.0 if r == 0 else r
@@ -46,8 +50,11 @@ def present_furniture(rt: ResolvedTask, placed_only: bool = False) -> dict[str, 
     spec = rt.spec
     mount = mounted_on(rt)
     carried = mount if spec.robot.mount_base == "search" else None
-    return {name: use for name, use in spec.scene.furniture.items()
-            if (not use.only_when_mounted or name == mount) and not (placed_only and name == carried)}
+    return {
+        name: use
+        for name, use in spec.scene.furniture.items()
+        if (not use.only_when_mounted or name == mount) and not (placed_only and name == carried)
+    }
 
 
 def group_joints(rt: ResolvedTask, refs) -> list[str]:
@@ -126,7 +133,11 @@ def start_for(rt: ResolvedTask, side: str):
     role = rt.spec.robot
     if side == "left" and len(rt.sides) > 1:
         if role.start_left is None:
-            raise fail(rt, ("robot", "arm"), f"robot '{rt.robot_name}' acts with both arms here; give robot.start_left, the left arm's start pose")
+            raise fail(
+                rt,
+                ("robot", "arm"),
+                f"robot '{rt.robot_name}' acts with both arms here; give robot.start_left, the left arm's start pose",
+            )
         return role.start_left
     own = role.per_robot.get(rt.robot_name)
     return own.start if own is not None and own.start is not None else role.start

@@ -17,8 +17,8 @@ import numpy as np
 
 from ..resolve import ResolvedTask
 from ..rotation import axis_rotation
-from .merge import Pose, origin_pose, parse_vector, reindent, write_origin
 from ..urdf import urdf_info
+from .merge import Pose, origin_pose, parse_vector, reindent, write_origin
 from .task import fail
 
 _MOTION_TAGS = ("axis", "limit", "dynamics", "calibration", "safety_controller", "mimic")
@@ -44,11 +44,17 @@ def weld_joints(urdf_xml: str, values: Mapping[str, float]) -> str:
         joint = joints[name]
         kind = joint.get("type")
         if kind not in ("revolute", "continuous", "prismatic"):
-            raise ValueError(f"joint {name!r} is {kind!r}; only revolute, continuous and prismatic joints can be welded")
+            raise ValueError(
+                f"joint {name!r} is {kind!r}; only revolute, continuous and prismatic joints can be welded"
+            )
         if not math.isfinite(value):
             raise ValueError(f"joint {name!r}: value {value!r} is not a finite number")
         axis_elem = joint.find("axis")
-        axis = parse_vector(axis_elem.get("xyz"), f"joint {name!r} <axis xyz>") if axis_elem is not None else np.array([1.0, 0.0, 0.0])
+        axis = (
+            parse_vector(axis_elem.get("xyz"), f"joint {name!r} <axis xyz>")
+            if axis_elem is not None
+            else np.array([1.0, 0.0, 0.0])
+        )
         norm = float(np.linalg.norm(axis))
         if norm == 0.0:
             raise ValueError(f"joint {name!r} has a zero axis")
@@ -111,7 +117,11 @@ def gripper(rt: ResolvedTask) -> tuple[list[str], list[float]]:
         n_fingers = len(hand.joints) if hand else 0
         grip_pos = [float(v) for v in grip_pos] if isinstance(grip_pos, list) else [float(grip_pos)] * n_fingers
         if len(grip_pos) != n_fingers:
-            raise fail(rt, ("tools",), f"robot '{rt.robot_name}' gives {len(grip_pos)} finger positions for '{tool_part}' but has {n_fingers} finger joints")
+            raise fail(
+                rt,
+                ("tools",),
+                f"robot '{rt.robot_name}' gives {len(grip_pos)} finger positions for '{tool_part}' but has {n_fingers} finger joints",
+            )
         joints += list(hand.joints) if hand else []
         positions += grip_pos
     return joints, positions

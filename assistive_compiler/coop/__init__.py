@@ -12,5 +12,19 @@ from .policies import HUMAN_POLICIES, ROBOT_POLICIES, agent_policy
 from .registry import ids, make, spec_of
 from .rollout import bench_coop, rollout_coop
 
-__all__ = ["AGENTS", "AssistiveParallelEnv", "parallel_env", "check_coop_spec", "coop_name", "make", "ids", "spec_of",
-           "FixedPartner", "agent_policy", "ROBOT_POLICIES", "HUMAN_POLICIES", "rollout_coop", "bench_coop"]
+__all__ = [
+    "AGENTS",
+    "AssistiveParallelEnv",
+    "parallel_env",
+    "check_coop_spec",
+    "coop_name",
+    "make",
+    "ids",
+    "spec_of",
+    "FixedPartner",
+    "agent_policy",
+    "ROBOT_POLICIES",
+    "HUMAN_POLICIES",
+    "rollout_coop",
+    "bench_coop",
+]

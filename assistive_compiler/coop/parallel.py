@@ -48,20 +48,32 @@ def coop_name(gym_id: str) -> str:
 class AssistiveParallelEnv(ParallelEnv):
     """A compiled task with the robot and the person as agents (PettingZoo parallel API)."""
 
-    metadata = {"name": "assistive_compiler_coop", "render_modes": ["rgb_array"], "render_fps": 10, "is_parallelizable": True}
+    metadata = {
+        "name": "assistive_compiler_coop",
+        "render_modes": ["rgb_array"],
+        "render_fps": 10,
+        "is_parallelizable": True,
+    }
 
-    def __init__(self, artifact_dir: str | Path, render_mode: str | None = None, render_size: tuple[int, int] = (480, 360)):
+    def __init__(
+        self, artifact_dir: str | Path, render_mode: str | None = None, render_size: tuple[int, int] = (480, 360)
+    ):
         env = AssistiveEnv(artifact_dir, render_mode=render_mode, render_size=render_size)
         if env.human_action_space is None:
             env.close()
-            raise ValueError(f"{artifact_dir}: the person has no policy joints (person.control.policy_joints is empty), "
-                             "so it cannot act as an agent; list the joint groups a human policy moves in the spec")
+            raise ValueError(
+                f"{artifact_dir}: the person has no policy joints (person.control.policy_joints is empty), "
+                "so it cannot act as an agent; list the joint groups a human policy moves in the spec"
+            )
         #: The single-agent env underneath (the same world; its ``step`` is the static person's task).
         self.env = env
         m = env.manifest
         from ..registration import TASK_ID
 
-        self.metadata = {**type(self).metadata, "name": coop_name(m.gym_id) if m.gym_id != TASK_ID else f"{m.task}_{m.robot_name}_human"}
+        self.metadata = {
+            **type(self).metadata,
+            "name": coop_name(m.gym_id) if m.gym_id != TASK_ID else f"{m.task}_{m.robot_name}_human",
+        }
         self.render_mode = render_mode
         self.possible_agents: list[str] = list(AGENTS)
         self.agents: list[str] = []
@@ -72,7 +84,9 @@ class AssistiveParallelEnv(ParallelEnv):
         self._obs: dict[str, np.ndarray] = {}
 
     @classmethod
-    def from_spec(cls, spec: str | Path, robot: str | None = None, out_dir: str | Path | None = None, **kwargs) -> "AssistiveParallelEnv":
+    def from_spec(
+        cls, spec: str | Path, robot: str | None = None, out_dir: str | Path | None = None, **kwargs
+    ) -> AssistiveParallelEnv:
         """Check that ``spec`` gives the person something to control (a located :class:`SpecError`
         if not), compile it for ``robot`` (a cache hit when unchanged) and build the env."""
         from ..compile.compiler import compile_task
@@ -98,23 +112,36 @@ class AssistiveParallelEnv(ParallelEnv):
         """One env step of both agents: ``actions`` maps 'robot' and 'human' to their actions
         (``actions['human']`` may be None: the person holds still this step)."""
         if not self.agents:
-            raise RuntimeError("step() called with no live agents: the episode ended (or never began); call reset() first")
+            raise RuntimeError(
+                "step() called with no live agents: the episode ended (or never began); call reset() first"
+            )
         unknown = [a for a in actions if a not in self.possible_agents]
         if unknown:
-            raise ValueError(f"unknown agent '{unknown[0]}' in actions; expected 'robot' and 'human'{did_you_mean(str(unknown[0]), self.possible_agents)}")
+            raise ValueError(
+                f"unknown agent '{unknown[0]}' in actions; expected 'robot' and 'human'{did_you_mean(str(unknown[0]), self.possible_agents)}"
+            )
         missing = [a for a in self.possible_agents if a not in actions]
         if missing:
-            raise ValueError(f"actions has no entry for '{missing[0]}': give both 'robot' and 'human' an action "
-                             "(actions['human'] = None holds the person still)")
-        robot_obs, human_obs, reward, terminated, truncated, info = self.env.step_agents(actions["robot"], actions["human"])
+            raise ValueError(
+                f"actions has no entry for '{missing[0]}': give both 'robot' and 'human' an action "
+                "(actions['human'] = None holds the person still)"
+            )
+        robot_obs, human_obs, reward, terminated, truncated, info = self.env.step_agents(
+            actions["robot"], actions["human"]
+        )
         self._obs = {"robot": robot_obs, "human": human_obs}
         done = terminated or truncated
         if done:
             self.agents = []
         agents = self.possible_agents
         infos = {"robot": info, "human": {**info, "arm_limit_reverts": self.env.human.reverts}}
-        return (dict(self._obs), dict.fromkeys(agents, reward), dict.fromkeys(agents, terminated),
-                dict.fromkeys(agents, truncated), infos)
+        return (
+            dict(self._obs),
+            dict.fromkeys(agents, reward),
+            dict.fromkeys(agents, terminated),
+            dict.fromkeys(agents, truncated),
+            infos,
+        )
 
     def state(self) -> np.ndarray:
         """The robot's and the human's current observations, concatenated (float32)."""
@@ -136,19 +163,32 @@ def check_coop_spec(loaded) -> None:
     problems = []
     if not spec.person.control.policy_joints:
         where = ("person", "control", "policy_joints")
-        problems.append(Problem(smap.value(where if where in smap.values else where[:2]),
-                                "person.control.policy_joints: the person controls no joints, so it cannot be a co-optimisation "
-                                "agent; list the joint groups a human policy moves, e.g. [person.head] or [person.right_arm]"))
+        problems.append(
+            Problem(
+                smap.value(where if where in smap.values else where[:2]),
+                "person.control.policy_joints: the person controls no joints, so it cannot be a co-optimisation "
+                "agent; list the joint groups a human policy moves, e.g. [person.head] or [person.right_arm]",
+            )
+        )
     if not spec.observations.human:
-        problems.append(Problem(smap.value(("observations", "human")),
-                                "observations.human: the person observes nothing, so it cannot be a co-optimisation agent; "
-                                "list its observation terms (see `assistive-compiler schema --terms`)"))
+        problems.append(
+            Problem(
+                smap.value(("observations", "human")),
+                "observations.human: the person observes nothing, so it cannot be a co-optimisation agent; "
+                "list its observation terms (see `assistive-compiler schema --terms`)",
+            )
+        )
     if problems:
         raise SpecError(problems)
 
 
-def parallel_env(spec: str | Path, robot: str | None = None, render_mode: str | None = None,
-                 out_dir: str | Path | None = None, **kwargs) -> AssistiveParallelEnv:
+def parallel_env(
+    spec: str | Path,
+    robot: str | None = None,
+    render_mode: str | None = None,
+    out_dir: str | Path | None = None,
+    **kwargs,
+) -> AssistiveParallelEnv:
     """The co-optimisation env of the task spec at ``spec`` for ``robot`` (compiled first; a cache
     hit when unchanged): ``assistive_compiler.parallel_env("specs/tasks/feeding.yaml", robot="jaco")``."""
     return AssistiveParallelEnv.from_spec(spec, robot=robot, out_dir=out_dir, render_mode=render_mode, **kwargs)

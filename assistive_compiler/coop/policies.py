@@ -12,7 +12,8 @@ A callable ``obs -> action`` or an object with Stable-Baselines3's ``predict(obs
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -52,7 +53,9 @@ def agent_policy(env, agent: str, policy: Any, seed: int = 0) -> Policy:
         return lambda obs: policy.predict(obs, deterministic=True)[0]
     if callable(policy):
         return policy
-    raise TypeError(f"a {agent} policy must be a name, a callable obs -> action or a model with predict(), got {type(policy).__name__}")
+    raise TypeError(
+        f"a {agent} policy must be a name, a callable obs -> action or a model with predict(), got {type(policy).__name__}"
+    )
 
 
 def _is_trained(source: str) -> bool:
@@ -73,6 +76,8 @@ def trained_agent_policy(env, agent: str, source: str) -> Policy:
     if info.get("coop"):
         return policy.agent(agent)
     if agent == "human":
-        raise UsageError(f"--human-policy {source}: trained for the robot alone; a person's policy comes from a "
-                         "co-optimised pair (pretrained:<task>-<robot>-coop or a --coop run)")
+        raise UsageError(
+            f"--human-policy {source}: trained for the robot alone; a person's policy comes from a "
+            "co-optimised pair (pretrained:<task>-<robot>-coop or a --coop run)"
+        )
     return policy

@@ -32,8 +32,10 @@ def spec_of(name: str) -> tuple[Path, str]:
     names = _names()
     key = name.removeprefix(f"{NAMESPACE}/")
     if key not in names:
-        raise ValueError(f"unknown co-optimisation env '{name}'{did_you_mean(key, names)}; "
-                         f"expected <Task><Robot>Human-v1, one of assistive_compiler.coop.ids() ({len(names)} in all)")
+        raise ValueError(
+            f"unknown co-optimisation env '{name}'{did_you_mean(key, names)}; "
+            f"expected <Task><Robot>Human-v1, one of assistive_compiler.coop.ids() ({len(names)} in all)"
+        )
     return names[key]
 
 

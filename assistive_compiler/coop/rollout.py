@@ -22,7 +22,10 @@ def rollout_coop(env: AssistiveParallelEnv, robot_policy: Any, human_policy: Any
     Returns the shared return, success, each term's unweighted values summed over the episode,
     the mean force on the person (N) and the arm-limit reverts of the episode."""
     obs, _ = env.reset(seed=seed)
-    act = {"robot": agent_policy(env, "robot", robot_policy, seed), "human": agent_policy(env, "human", human_policy, seed)}
+    act = {
+        "robot": agent_policy(env, "robot", robot_policy, seed),
+        "human": agent_policy(env, "human", human_policy, seed),
+    }
     tally = EpisodeTally()
     while env.agents:
         obs, rewards, _, _, infos = env.step({agent: act[agent](obs[agent]) for agent in env.possible_agents})
@@ -84,15 +87,20 @@ def bench_coop(artifact_dir: str | Path, steps: int = 200, repeats: int = 5, see
     s, mu = statistics.median(rates["single"]), statistics.median(rates["multi"])
     m = single.manifest
     return {
-        "task": m.task, "robot": m.robot_name, "name": multi.metadata["name"],
-        "human_action_size": int(shapes["human"][0]), "human_obs_size": int(multi.observation_space("human").shape[0]),
+        "task": m.task,
+        "robot": m.robot_name,
+        "name": multi.metadata["name"],
+        "human_action_size": int(shapes["human"][0]),
+        "human_obs_size": int(multi.observation_space("human").shape[0]),
         "single_agent_env_steps_per_s": round(s, 1),
         "multi_agent_env_steps_per_s": round(mu, 1),
         "multi_over_single": round(mu / s, 3),
         "arm_limit_reverts_last_episode": reverts,
-        "steps_per_repeat": steps, "repeats": repeats, "chunk": chunk,
+        "steps_per_repeat": steps,
+        "repeats": repeats,
+        "chunk": chunk,
         "notes": "one artifact, two envs side by side; single: env.step (robot acts, person static); multi: the "
-                 "PettingZoo step, both agents random; stepped in alternating chunks; medians over episodes",
+        "PettingZoo step, both agents random; stepped in alternating chunks; medians over episodes",
     }
 
 

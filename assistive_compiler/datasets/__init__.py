@@ -45,13 +45,29 @@ def _play(env, act, seed: int):
         infos["success_metric"].append(float(info["success_metric"]))
         infos["force_on_human"].append(float(info["total_force_on_human"]))
         done = terminated or truncated
-    buffer = EpisodeBuffer(seed=seed, observations=np.asarray(observations), actions=np.asarray(actions), rewards=rewards,
-                           terminations=terminations, truncations=truncations, infos={k: np.asarray(v) for k, v in infos.items()})
+    buffer = EpisodeBuffer(
+        seed=seed,
+        observations=np.asarray(observations),
+        actions=np.asarray(actions),
+        rewards=rewards,
+        terminations=terminations,
+        truncations=truncations,
+        infos={k: np.asarray(v) for k, v in infos.items()},
+    )
     return buffer, bool(infos["task_success"][-1])
 
 
-def collect(spec: str, robot: str | None, dataset_id: str, policy: str = "scripted", episodes: int = 5, seed: int = 0,
-            root: str | Path | None = None, out: str | None = None, progress=None):
+def collect(
+    spec: str,
+    robot: str | None,
+    dataset_id: str,
+    policy: str = "scripted",
+    episodes: int = 5,
+    seed: int = 0,
+    root: str | Path | None = None,
+    out: str | None = None,
+    progress=None,
+):
     """Play ``policy`` for ``episodes`` episodes (seeds ``seed``, ``seed + 1``, ...) and write the
     Minari dataset ``dataset_id`` (e.g. ``assistive_compiler/feeding-jaco/scripted-v0``). Returns
     the ``MinariDataset``. ``progress(k, success)`` is called after each episode.
@@ -71,9 +87,13 @@ def collect(spec: str, robot: str | None, dataset_id: str, policy: str = "script
     result = compile_task(spec, robot, out)
     m = result.manifest
     env = AssistiveEnv.from_compiled(result)
-    env_spec = gym.envs.registration.EnvSpec(m.gym_id, entry_point="assistive_compiler.registration:make_env",
-                                             kwargs={"spec": str(Path(spec).resolve()), "robot": m.robot_name},
-                                             max_episode_steps=m.sim.episode_steps, disable_env_checker=True)
+    env_spec = gym.envs.registration.EnvSpec(
+        m.gym_id,
+        entry_point="assistive_compiler.registration:make_env",
+        kwargs={"spec": str(Path(spec).resolve()), "robot": m.robot_name},
+        max_episode_steps=m.sim.episode_steps,
+        disable_env_checker=True,
+    )
     act = make_policy(policy, env, seed=seed)
     buffers, successes = [], []
     try:
@@ -84,13 +104,30 @@ def collect(spec: str, robot: str | None, dataset_id: str, policy: str = "script
             if progress is not None:
                 progress(k, success)
         dataset = minari.create_dataset_from_buffers(
-            dataset_id, buffers, env=env_spec, observation_space=env.observation_space, action_space=env.action_space,
-            algorithm_name=f"assistive-compiler {policy} policy", data_format="hdf5",
+            dataset_id,
+            buffers,
+            env=env_spec,
+            observation_space=env.observation_space,
+            action_space=env.action_space,
+            algorithm_name=f"assistive-compiler {policy} policy",
+            data_format="hdf5",
             description=f"{m.title} with {m.robot.title}: {episodes} episodes of the {policy} policy from seed {seed} "
-                        f"(assistive-compiler, artifact {m.content_hash[:12]})")
+            f"(assistive-compiler, artifact {m.content_hash[:12]})",
+        )
     finally:
         env.close()
-    dataset.storage.update_metadata({"assistive_compiler": {
-        "content_hash": m.content_hash, "task": m.task, "robot": m.robot_name, "gym_id": m.gym_id, "policy": policy,
-        "seeds": [seed + k for k in range(episodes)], "successes": successes, "term_weights": {t.name: t.weight for t in m.reward}}})
+    dataset.storage.update_metadata(
+        {
+            "assistive_compiler": {
+                "content_hash": m.content_hash,
+                "task": m.task,
+                "robot": m.robot_name,
+                "gym_id": m.gym_id,
+                "policy": policy,
+                "seeds": [seed + k for k in range(episodes)],
+                "successes": successes,
+                "term_weights": {t.name: t.weight for t in m.reward},
+            }
+        }
+    )
     return minari.load_dataset(dataset_id)

@@ -63,8 +63,10 @@ __all__ = [
 Sex = Literal["male", "female"]
 
 #: Short citation of the source table, for messages.
-SOURCE = ("CDC/NCHS Anthropometric Reference Data for Children and Adults: United States, "
-          "August 2021–August 2023 (Vital Health Stat 3(50), 2025), Tables 3 and 7, adults 20 and older")
+SOURCE = (
+    "CDC/NCHS Anthropometric Reference Data for Children and Adults: United States, "
+    "August 2021–August 2023 (Vital Health Stat 3(50), 2025), Tables 3 and 7, adults 20 and older"
+)
 
 #: The percentiles the source tabulates.
 TABULATED_PERCENTILES: tuple[float, ...] = (5, 10, 15, 25, 50, 75, 85, 90, 95)
@@ -94,8 +96,10 @@ def check_percentile(percentile: float) -> float:
         raise ValueError(f"percentile must be a number, got {percentile!r}")
     low, high = TABULATED_PERCENTILES[0], TABULATED_PERCENTILES[-1]
     if not low <= percentile <= high:
-        raise ValueError(f"percentile {percentile:g} is outside the tabulated {low:g}th-{high:g}th "
-                         f"percentiles of the source table ({SOURCE})")
+        raise ValueError(
+            f"percentile {percentile:g} is outside the tabulated {low:g}th-{high:g}th "
+            f"percentiles of the source table ({SOURCE})"
+        )
     return float(percentile)
 
 

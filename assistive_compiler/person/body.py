@@ -16,9 +16,10 @@ This module is pure Python (no pybullet); the template renders with ``xacro`` al
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import Literal, Mapping, NamedTuple
+from typing import Literal, NamedTuple
 
 __all__ = [
     "PERSON_TEMPLATE",
@@ -69,19 +70,48 @@ ROOT_LINK = "chest"
 #: All 42 joints in the reference's depth-first order: pybullet joint index k == reference index
 #: k (index 24, ``stomach``, is the only fixed one).
 JOINT_NAMES: tuple[str, ...] = (
-    "right_pecs_x", "right_pecs_y", "right_pecs_z",
-    "right_shoulder_x", "right_shoulder_y", "right_shoulder_z",
-    "right_elbow", "right_forearm", "right_wrist_x", "right_wrist_y",
-    "left_pecs_x", "left_pecs_y", "left_pecs_z",
-    "left_shoulder_x", "left_shoulder_y", "left_shoulder_z",
-    "left_elbow", "left_forearm", "left_wrist_x", "left_wrist_y",
-    "neck", "head_x", "head_y", "head_z",
+    "right_pecs_x",
+    "right_pecs_y",
+    "right_pecs_z",
+    "right_shoulder_x",
+    "right_shoulder_y",
+    "right_shoulder_z",
+    "right_elbow",
+    "right_forearm",
+    "right_wrist_x",
+    "right_wrist_y",
+    "left_pecs_x",
+    "left_pecs_y",
+    "left_pecs_z",
+    "left_shoulder_x",
+    "left_shoulder_y",
+    "left_shoulder_z",
+    "left_elbow",
+    "left_forearm",
+    "left_wrist_x",
+    "left_wrist_y",
+    "neck",
+    "head_x",
+    "head_y",
+    "head_z",
     "stomach",
-    "waist_x", "waist_y", "waist_z",
-    "right_hip_x", "right_hip_y", "right_hip_z", "right_knee",
-    "right_ankle_x", "right_ankle_y", "right_ankle_z",
-    "left_hip_x", "left_hip_y", "left_hip_z", "left_knee",
-    "left_ankle_x", "left_ankle_y", "left_ankle_z",
+    "waist_x",
+    "waist_y",
+    "waist_z",
+    "right_hip_x",
+    "right_hip_y",
+    "right_hip_z",
+    "right_knee",
+    "right_ankle_x",
+    "right_ankle_y",
+    "right_ankle_z",
+    "left_hip_x",
+    "left_hip_y",
+    "left_hip_z",
+    "left_knee",
+    "left_ankle_x",
+    "left_ankle_y",
+    "left_ankle_z",
 )
 
 #: The 41 revolute joints (every joint but ``stomach``), in index order.
@@ -90,11 +120,23 @@ REVOLUTE_JOINTS: tuple[str, ...] = tuple(j for j in JOINT_NAMES if j != "stomach
 #: Landmark joint -> the link that carries the landmark name, for joints whose child link is not
 #: ``<joint>_link``. (The landmark link is the last link of its joint group.)
 _LANDMARK_CHILD: dict[str, str] = {
-    "right_pecs_z": "right_pecs", "right_shoulder_z": "right_shoulder", "right_forearm": "right_elbow",
-    "right_wrist_y": "right_wrist", "left_pecs_z": "left_pecs", "left_shoulder_z": "left_shoulder",
-    "left_forearm": "left_elbow", "left_wrist_y": "left_wrist", "neck": "neck", "head_z": "head",
-    "stomach": "stomach", "waist_z": "waist", "right_hip_z": "right_hip", "right_knee": "right_knee",
-    "right_ankle_z": "right_ankle", "left_hip_z": "left_hip", "left_knee": "left_knee",
+    "right_pecs_z": "right_pecs",
+    "right_shoulder_z": "right_shoulder",
+    "right_forearm": "right_elbow",
+    "right_wrist_y": "right_wrist",
+    "left_pecs_z": "left_pecs",
+    "left_shoulder_z": "left_shoulder",
+    "left_forearm": "left_elbow",
+    "left_wrist_y": "left_wrist",
+    "neck": "neck",
+    "head_z": "head",
+    "stomach": "stomach",
+    "waist_z": "waist",
+    "right_hip_z": "right_hip",
+    "right_knee": "right_knee",
+    "right_ankle_z": "right_ankle",
+    "left_hip_z": "left_hip",
+    "left_knee": "left_knee",
     "left_ankle_z": "left_ankle",
 }
 
@@ -104,11 +146,24 @@ LINK_NAMES: tuple[str, ...] = tuple(_LANDMARK_CHILD.get(j, f"{j}_link") for j in
 #: The landmark links specs may refer to. Each frame is at its joint centre.
 LANDMARKS: tuple[str, ...] = (
     "chest",
-    "right_pecs", "right_shoulder", "right_elbow", "right_wrist",
-    "left_pecs", "left_shoulder", "left_elbow", "left_wrist",
-    "neck", "head", "stomach", "waist",
-    "right_hip", "right_knee", "right_ankle",
-    "left_hip", "left_knee", "left_ankle",
+    "right_pecs",
+    "right_shoulder",
+    "right_elbow",
+    "right_wrist",
+    "left_pecs",
+    "left_shoulder",
+    "left_elbow",
+    "left_wrist",
+    "neck",
+    "head",
+    "stomach",
+    "waist",
+    "right_hip",
+    "right_knee",
+    "right_ankle",
+    "left_hip",
+    "left_knee",
+    "left_ankle",
 )
 
 #: The reference's joint groups (its ``*_joints`` lists), by joint name.
@@ -139,18 +194,47 @@ del _j
 
 #: Pose-independent joint limits in degrees (paper §III-A); the template emits the same in radians.
 JOINT_LIMITS_DEG: dict[str, tuple[float, float]] = {
-    "right_pecs_x": (-10, 10), "right_pecs_y": (-10, 30), "right_pecs_z": (-35, 35),
-    "right_shoulder_x": (5, 198), "right_shoulder_y": (-188, 61), "right_shoulder_z": (-90, 90),
-    "right_elbow": (-128, 0), "right_forearm": (-90, 90), "right_wrist_x": (-81, 90), "right_wrist_y": (-27, 47),
-    "left_pecs_x": (-10, 10), "left_pecs_y": (-30, 10), "left_pecs_z": (-35, 35),
-    "left_shoulder_x": (-198, -5), "left_shoulder_y": (-188, 61), "left_shoulder_z": (-90, 90),
-    "left_elbow": (-128, 0), "left_forearm": (-90, 90), "left_wrist_x": (-81, 90), "left_wrist_y": (-47, 27),
-    "neck": (-10, 20), "head_x": (-50, 50), "head_y": (-34, 34), "head_z": (-70, 70),
-    "waist_x": (-75, 30), "waist_y": (-30, 30), "waist_z": (-30, 30),
-    "right_hip_x": (-127, 30), "right_hip_y": (-40, 45), "right_hip_z": (-45, 40), "right_knee": (0, 130),
-    "right_ankle_x": (-35, 38), "right_ankle_y": (-23, 24), "right_ankle_z": (-43, 35),
-    "left_hip_x": (-127, 30), "left_hip_y": (-45, 40), "left_hip_z": (-40, 45), "left_knee": (0, 130),
-    "left_ankle_x": (-35, 38), "left_ankle_y": (-24, 23), "left_ankle_z": (-35, 43),
+    "right_pecs_x": (-10, 10),
+    "right_pecs_y": (-10, 30),
+    "right_pecs_z": (-35, 35),
+    "right_shoulder_x": (5, 198),
+    "right_shoulder_y": (-188, 61),
+    "right_shoulder_z": (-90, 90),
+    "right_elbow": (-128, 0),
+    "right_forearm": (-90, 90),
+    "right_wrist_x": (-81, 90),
+    "right_wrist_y": (-27, 47),
+    "left_pecs_x": (-10, 10),
+    "left_pecs_y": (-30, 10),
+    "left_pecs_z": (-35, 35),
+    "left_shoulder_x": (-198, -5),
+    "left_shoulder_y": (-188, 61),
+    "left_shoulder_z": (-90, 90),
+    "left_elbow": (-128, 0),
+    "left_forearm": (-90, 90),
+    "left_wrist_x": (-81, 90),
+    "left_wrist_y": (-47, 27),
+    "neck": (-10, 20),
+    "head_x": (-50, 50),
+    "head_y": (-34, 34),
+    "head_z": (-70, 70),
+    "waist_x": (-75, 30),
+    "waist_y": (-30, 30),
+    "waist_z": (-30, 30),
+    "right_hip_x": (-127, 30),
+    "right_hip_y": (-40, 45),
+    "right_hip_z": (-45, 40),
+    "right_knee": (0, 130),
+    "right_ankle_x": (-35, 38),
+    "right_ankle_y": (-23, 24),
+    "right_ankle_z": (-43, 35),
+    "left_hip_x": (-127, 30),
+    "left_hip_y": (-45, 40),
+    "left_hip_z": (-40, 45),
+    "left_knee": (0, 130),
+    "left_ankle_x": (-35, 38),
+    "left_ankle_y": (-24, 23),
+    "left_ankle_z": (-35, 43),
 }
 
 #: Joints whose limits the reference's limited-range-of-motion impairment multiplies by gamma
@@ -160,10 +244,18 @@ LIMIT_SCALED_JOINTS: tuple[str, ...] = JOINT_NAMES[0:24]
 #: Fraction of the body mass per segment (paper §III-A; sums to 1). ``abdomen`` is the reference's
 #: link 26 (waist_y) mass; ``hips`` is the ``waist`` link's capsule.
 MASS_FRACTIONS: dict[str, float] = {
-    "chest": 0.10, "pecs": 0.05, "neck": 0.01, "head": 0.07,
-    "upper_arm": 0.033, "forearm": 0.019, "hand": 0.0065,
-    "abdomen": 0.13, "hips": 0.14,
-    "thigh": 0.105, "shin": 0.0475, "foot": 0.014,
+    "chest": 0.10,
+    "pecs": 0.05,
+    "neck": 0.01,
+    "head": 0.07,
+    "upper_arm": 0.033,
+    "forearm": 0.019,
+    "hand": 0.0065,
+    "abdomen": 0.13,
+    "hips": 0.14,
+    "thigh": 0.105,
+    "shin": 0.0475,
+    "foot": 0.014,
 }
 # Segments that exist twice (left and right).
 _PAIRED = frozenset({"pecs", "upper_arm", "forearm", "hand", "thigh", "shin", "foot"})
@@ -221,38 +313,70 @@ _Scaling = Literal["r", "h"] | None
 
 _TABLES: dict[str, dict[str, tuple[float, _Scaling]]] = {
     "male": {
-        "chest_radius": (0.127, "r"), "chest_length": (0.056, None),
-        "pecs_radius": (0.106, "r"), "pecs_length": (0.253 / 8, None),
-        "pecs_offset": (0.253 / 2.5 - 0.253 / 16, None), "pecs_height": (0.1415, "h"),
-        "neck_radius": (0.06, "r"), "neck_length": (0.124, "h"),
-        "neck_height": (0.1515, "h"), "neck_offset": (0.2565 - 0.1415 - 0.025, "h"),
+        "chest_radius": (0.127, "r"),
+        "chest_length": (0.056, None),
+        "pecs_radius": (0.106, "r"),
+        "pecs_length": (0.253 / 8, None),
+        "pecs_offset": (0.253 / 2.5 - 0.253 / 16, None),
+        "pecs_height": (0.1415, "h"),
+        "neck_radius": (0.06, "r"),
+        "neck_length": (0.124, "h"),
+        "neck_height": (0.1515, "h"),
+        "neck_offset": (0.2565 - 0.1415 - 0.025, "h"),
         "head_height": (0.399 - 0.1415 - 0.1205, "h"),
-        "upper_arm_radius": (0.043, "r"), "upper_arm_length": (0.279, "h"),
-        "forearm_radius": (0.033, "r"), "forearm_length": (0.257, "h"),
+        "upper_arm_radius": (0.043, "r"),
+        "upper_arm_length": (0.279, "h"),
+        "forearm_radius": (0.033, "r"),
+        "forearm_length": (0.257, "h"),
         "hand_radius": (0.043, "r"),
-        "waist_radius": (0.1205, "r"), "waist_length": (0.049, None), "waist_drop": (0.156, "h"),
-        "hips_radius": (0.1335, "r"), "hips_length": (0.094, None), "hips_drop": (0.08125, "h"),
-        "thigh_radius": (0.08, "r"), "thigh_length": (0.424, "h"),
-        "shin_radius": (0.05, "r"), "shin_length": (0.403, "h"), "ankle_offset": (0.025, None),
-        "foot_radius": (0.05, "r"), "foot_length": (0.215, "h"),
-        "foot_forward": (0.10, None), "foot_drop": (0.025, "r"),
+        "waist_radius": (0.1205, "r"),
+        "waist_length": (0.049, None),
+        "waist_drop": (0.156, "h"),
+        "hips_radius": (0.1335, "r"),
+        "hips_length": (0.094, None),
+        "hips_drop": (0.08125, "h"),
+        "thigh_radius": (0.08, "r"),
+        "thigh_length": (0.424, "h"),
+        "shin_radius": (0.05, "r"),
+        "shin_length": (0.403, "h"),
+        "ankle_offset": (0.025, None),
+        "foot_radius": (0.05, "r"),
+        "foot_length": (0.215, "h"),
+        "foot_forward": (0.10, None),
+        "foot_drop": (0.025, "r"),
     },
     "female": {
-        "chest_radius": (0.127, "r"), "chest_length": (0.01, None),
-        "pecs_radius": (0.092, "r"), "pecs_length": (0.225 / 8, None),
-        "pecs_offset": (0.225 / 2.5 - 0.225 / 16, None), "pecs_height": (0.132, "h"),
-        "neck_radius": (0.05, "r"), "neck_length": (0.121, "h"),
-        "neck_height": (0.132, "h"), "neck_offset": (0.2565 - 0.1415 - 0.025, "h"),
+        "chest_radius": (0.127, "r"),
+        "chest_length": (0.01, None),
+        "pecs_radius": (0.092, "r"),
+        "pecs_length": (0.225 / 8, None),
+        "pecs_offset": (0.225 / 2.5 - 0.225 / 16, None),
+        "pecs_height": (0.132, "h"),
+        "neck_radius": (0.05, "r"),
+        "neck_length": (0.121, "h"),
+        "neck_height": (0.132, "h"),
+        "neck_offset": (0.2565 - 0.1415 - 0.025, "h"),
         "head_height": (0.12, "h"),
-        "upper_arm_radius": (0.0355, "r"), "upper_arm_length": (0.264, "h"),
-        "forearm_radius": (0.027, "r"), "forearm_length": (0.234, "h"),
+        "upper_arm_radius": (0.0355, "r"),
+        "upper_arm_length": (0.264, "h"),
+        "forearm_radius": (0.027, "r"),
+        "forearm_length": (0.234, "h"),
         "hand_radius": (0.0355, "r"),
-        "waist_radius": (0.11, "r"), "waist_length": (0.009, None), "waist_drop": (0.15, "h"),
-        "hips_radius": (0.127, "r"), "hips_length": (0.117, None), "hips_drop": (0.075, "h"),
-        "thigh_radius": (0.0775, "r"), "thigh_length": (0.391, "h"),
-        "shin_radius": (0.045, "r"), "shin_length": (0.367, "h"), "ankle_offset": (0.0225, None),
-        "foot_radius": (0.045, "r"), "foot_length": (0.195, "h"),
-        "foot_forward": (0.09, None), "foot_drop": (0.0225, "r"),
+        "waist_radius": (0.11, "r"),
+        "waist_length": (0.009, None),
+        "waist_drop": (0.15, "h"),
+        "hips_radius": (0.127, "r"),
+        "hips_length": (0.117, None),
+        "hips_drop": (0.075, "h"),
+        "thigh_radius": (0.0775, "r"),
+        "thigh_length": (0.391, "h"),
+        "shin_radius": (0.045, "r"),
+        "shin_length": (0.367, "h"),
+        "ankle_offset": (0.0225, None),
+        "foot_radius": (0.045, "r"),
+        "foot_length": (0.195, "h"),
+        "foot_forward": (0.09, None),
+        "foot_drop": (0.0225, "r"),
     },
 }
 
@@ -265,10 +389,22 @@ _HIP_GAP = {"male": 0.009, "female": 0.0145}
 # standing heights 1.733 / 1.584 m), plus a face sphere in front of it (-Y). The face sphere is
 # sized so that the mouth point lies about 1 cm in front of its surface.
 _HEADS: dict[str, dict[str, float]] = {
-    "male": {"head_top": 0.199, "head_radius": 0.095, "head_skull_y": 0.0,
-             "face_radius": 0.06, "face_y": -0.04, "face_z": 0.035},
-    "female": {"head_top": 0.184, "head_radius": 0.088, "head_skull_y": 0.0,
-               "face_radius": 0.055, "face_y": -0.036, "face_z": 0.033},
+    "male": {
+        "head_top": 0.199,
+        "head_radius": 0.095,
+        "head_skull_y": 0.0,
+        "face_radius": 0.06,
+        "face_y": -0.04,
+        "face_z": 0.035,
+    },
+    "female": {
+        "head_top": 0.184,
+        "head_radius": 0.088,
+        "head_skull_y": 0.0,
+        "face_radius": 0.055,
+        "face_y": -0.036,
+        "face_z": 0.033,
+    },
 }
 
 # Template args that are not body measurements (passed through xacro_args' keywords).
@@ -364,15 +500,31 @@ class BodyMeasurements:
             if getattr(self, name) <= 0:
                 raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
         # Each segment gives up to two intermediate links' mass (one for forearm and hand).
-        for seg, n in (("pecs", 2), ("head", 2), ("upper_arm", 2), ("forearm", 1), ("hand", 1),
-                       ("abdomen", 2), ("thigh", 2), ("foot", 2)):
+        for seg, n in (
+            ("pecs", 2),
+            ("head", 2),
+            ("upper_arm", 2),
+            ("forearm", 1),
+            ("hand", 1),
+            ("abdomen", 2),
+            ("thigh", 2),
+            ("foot", 2),
+        ):
             if getattr(self, f"mass_{seg}") <= n * self.joint_link_mass:
                 raise ValueError(f"mass_{seg} must exceed {n} x joint_link_mass")
-        chest_height = (self.waist_drop + 2 * self.hips_drop + self.thigh_length + self.shin_length
-                        + self.ankle_offset + self.foot_drop + self.foot_radius)
+        chest_height = (
+            self.waist_drop
+            + 2 * self.hips_drop
+            + self.thigh_length
+            + self.shin_length
+            + self.ankle_offset
+            + self.foot_drop
+            + self.foot_radius
+        )
         object.__setattr__(self, "chest_height_m", chest_height)
-        object.__setattr__(self, "standing_height_m",
-                           chest_height + self.neck_height + self.head_height + self.head_top)
+        object.__setattr__(
+            self, "standing_height_m", chest_height + self.neck_height + self.head_height + self.head_top
+        )
         object.__setattr__(self, "mouth_offset_m", _MOUTH_OFFSET[self.sex])
 
     @property
@@ -406,8 +558,7 @@ class BodyMeasurements:
         if cloth_spheres is not None:
             out["cloth_spheres"] = "true" if cloth_spheres else "false"
         if fixed_joints is not None:
-            out["fixed_joints"] = (fixed_joints if isinstance(fixed_joints, str)
-                                   else format_fixed_joints(fixed_joints))
+            out["fixed_joints"] = fixed_joints if isinstance(fixed_joints, str) else format_fixed_joints(fixed_joints)
         return out
 
     def standing_landmark_positions(self) -> dict[str, tuple[float, float, float]]:
@@ -442,7 +593,8 @@ class BodyMeasurements:
 
 
 _MEASUREMENT_ARGS: tuple[str, ...] = tuple(
-    f.name for f in fields(BodyMeasurements)
+    f.name
+    for f in fields(BodyMeasurements)
     if f.init and f.name not in ("sex", "mass_kg", "height_scale", "radius_scale")
 )
 
@@ -473,9 +625,13 @@ def body_measurements(
     geo.update(_HEADS[sex])
     masses = {f"mass_{seg}": frac * mass for seg, frac in MASS_FRACTIONS.items()}
     return BodyMeasurements(
-        sex=sex, mass_kg=mass, height_scale=hs, radius_scale=rs,
+        sex=sex,
+        mass_kg=mass,
+        height_scale=hs,
+        radius_scale=rs,
         joint_link_mass=min(0.01, 0.001 * mass),
-        **geo, **masses,
+        **geo,
+        **masses,
     )
 
 
@@ -496,12 +652,17 @@ def format_fixed_joints(angles: Mapping[str, float]) -> str:
     return " ".join(parts)
 
 
-def body_for_height(sex: Sex, height_m: float, mass_kg: float | None = None, radius_scale: float = 1.0) -> BodyMeasurements:
+def body_for_height(
+    sex: Sex, height_m: float, mass_kg: float | None = None, radius_scale: float = 1.0
+) -> BodyMeasurements:
     """The body of ``sex`` whose standing height is ``height_m`` (metres, within 0.1 mm): the
     height scale is solved for, since radii and some offsets do not scale with it."""
     low, high = 0.5, 1.5
-    if not (body_measurements(sex, mass_kg, low, radius_scale).standing_height_m <= height_m
-            <= body_measurements(sex, mass_kg, high, radius_scale).standing_height_m):
+    if not (
+        body_measurements(sex, mass_kg, low, radius_scale).standing_height_m
+        <= height_m
+        <= body_measurements(sex, mass_kg, high, radius_scale).standing_height_m
+    ):
         raise ValueError(f"a {sex} body cannot be {height_m} m tall with height scales 0.5-1.5")
     for _ in range(60):
         mid = 0.5 * (low + high)

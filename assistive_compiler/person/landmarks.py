@@ -14,8 +14,8 @@ Offsets are in the landmark's link frame, metres, at the person's zero pose: +x 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from ..urdf import urdf_info
 
@@ -28,7 +28,7 @@ class Landmark:
 
     link: str
     description: str
-    offset: Callable[["LinkShapes"], Vec3]
+    offset: Callable[[LinkShapes], Vec3]
 
 
 @dataclass(frozen=True)
@@ -73,6 +73,7 @@ def _cheek(sign: float) -> Callable[[LinkShapes], Vec3]:
         (cx, cy, cz), r = _jaw(s)
         a = math.radians(50)  # around the face from the front, toward the side
         return (sign * r * math.sin(a), cy - r * math.cos(a), cz + 0.2 * r)
+
     return offset
 
 
@@ -82,9 +83,11 @@ def _hand(s: LinkShapes) -> tuple[Vec3, float]:
 
 def _palm(toward_body: float) -> Callable[[LinkShapes], Vec3]:
     """The palm's centre: on the hand's surface on the side that faces the body at the zero pose."""
+
     def offset(s: LinkShapes) -> Vec3:
         (cx, cy, cz), r = _hand(s)
         return (cx + toward_body * r, cy, cz)
+
     return offset
 
 
@@ -114,8 +117,12 @@ LANDMARKS: dict[str, Landmark] = {
     "nose": Landmark("head", "the front of the face 0.6 jaw radii above the mouth", _nose),
     "right_cheek": Landmark("head", "the face's right side, 50° round from the front", _cheek(-1.0)),
     "left_cheek": Landmark("head", "the face's left side, 50° round from the front", _cheek(1.0)),
-    "right_palm": Landmark("right_wrist", "the right hand's surface toward the body (the palm's centre at the zero pose)", _palm(1.0)),
-    "left_palm": Landmark("left_wrist", "the left hand's surface toward the body (the palm's centre at the zero pose)", _palm(-1.0)),
+    "right_palm": Landmark(
+        "right_wrist", "the right hand's surface toward the body (the palm's centre at the zero pose)", _palm(1.0)
+    ),
+    "left_palm": Landmark(
+        "left_wrist", "the left hand's surface toward the body (the palm's centre at the zero pose)", _palm(-1.0)
+    ),
     "right_fingertips": Landmark("right_wrist", "the right hand's far end", _fingertips),
     "left_fingertips": Landmark("left_wrist", "the left hand's far end", _fingertips),
     "right_heel": Landmark("right_ankle", "the bottom of the right foot's back end", _heel),
@@ -152,5 +159,7 @@ def landmark_offsets(urdf_xml: str) -> dict[str, tuple[str, Vec3]]:
     """Every landmark of the person ``urdf_xml`` (one variant): name -> (link, offset in the link
     frame, m, rounded to 0.1 mm)."""
     shapes = link_shapes(urdf_xml)
-    return {name: (lm.link, tuple(round(v, 4) + 0.0 for v in lm.offset(shapes[lm.link])))  # type: ignore[misc]
-            for name, lm in LANDMARKS.items()}
+    return {
+        name: (lm.link, tuple(round(v, 4) + 0.0 for v in lm.offset(shapes[lm.link])))  # type: ignore[misc]
+        for name, lm in LANDMARKS.items()
+    }

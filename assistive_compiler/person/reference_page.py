@@ -34,8 +34,14 @@ def _shape_text(shapes: LinkShapes) -> str:
 
 
 def _axis_name(axis) -> str:
-    names = {(1.0, 0.0, 0.0): "x", (0.0, 1.0, 0.0): "y", (0.0, 0.0, 1.0): "z",
-             (-1.0, 0.0, 0.0): "−x", (0.0, -1.0, 0.0): "−y", (0.0, 0.0, -1.0): "−z"}
+    names = {
+        (1.0, 0.0, 0.0): "x",
+        (0.0, 1.0, 0.0): "y",
+        (0.0, 0.0, 1.0): "z",
+        (-1.0, 0.0, 0.0): "−x",
+        (0.0, -1.0, 0.0): "−y",
+        (0.0, 0.0, -1.0): "−z",
+    }
     return names.get(tuple(float(a) for a in axis), str(axis))
 
 
@@ -103,11 +109,15 @@ def person_reference_markdown() -> str:
         joint = parent_joint.get(name)
         moved_by = f"`{joint.get('name')}` ({joint.get('type')})" if joint is not None else "— (root)"
         shapes = [_shape_text(shapes_by_variant[v][name]) for v in PAGE_VARIANTS]
-        shape_text = shapes[0] if len(set(shapes)) == 1 else "<br>".join(f"{v}: {s}" for v, s in zip(PAGE_VARIANTS, shapes))
+        shape_text = (
+            shapes[0] if len(set(shapes)) == 1 else "<br>".join(f"{v}: {s}" for v, s in zip(PAGE_VARIANTS, shapes))
+        )
         nexts = []
         for child in children.get(name, []):
             xyz = [vec3(joints_by_variant[v][child.get("name")].find("origin").get("xyz")) for v in PAGE_VARIANTS]
-            where = _direction(xyz[0]) + (f" ({_direction(xyz[1])})" if _direction(xyz[1]) != _direction(xyz[0]) else "")
+            where = _direction(xyz[0]) + (
+                f" ({_direction(xyz[1])})" if _direction(xyz[1]) != _direction(xyz[0]) else ""
+            )
             nexts.append(f"`{child.get('name')}`: {where}")
         lines.append(f"| `{name}` | {moved_by} | {shape_text or 'none'} | {'<br>'.join(nexts) or '—'} |")
     marks = {v: landmark_offsets(urdfs[v]) for v in PAGE_VARIANTS}
@@ -148,6 +158,8 @@ def person_reference_markdown() -> str:
             limits = f"fixed at {math.degrees(max(rpy, key=abs)):.0f}" if any(rpy) else "fixed"
         else:
             limits = "—"
-        lines.append(f"| `{j.get('name')}` | {j.get('type')} | {axis} | `{j.find('parent').get('link')}` → "
-                     f"`{j.find('child').get('link')}` | {limits} |")
+        lines.append(
+            f"| `{j.get('name')}` | {j.get('type')} | {axis} | `{j.find('parent').get('link')}` → "
+            f"`{j.find('child').get('link')}` | {limits} |"
+        )
     return "\n".join(lines) + "\n"

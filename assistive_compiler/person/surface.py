@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..urdf import Capsule, Sphere, UrdfInfo
 from ..rotation import capsule_axes
+from ..urdf import Capsule, Sphere, UrdfInfo
 
 Vec3 = tuple[float, float, float]
 
@@ -97,7 +97,9 @@ def sphere_lattice(link: str, sphere: Sphere, spacing: float) -> list[SurfacePoi
         z = 1 - (2 * i + 1) / n
         ring = math.sqrt(max(0.0, 1 - z * z))
         normal = np.array([ring * math.cos(golden * i), ring * math.sin(golden * i), z])
-        out.append(SurfacePoint(link, _vec(np.asarray(sphere.centre) + r * normal), _vec(normal), _vec(_sphere_axis(normal))))
+        out.append(
+            SurfacePoint(link, _vec(np.asarray(sphere.centre) + r * normal), _vec(normal), _vec(_sphere_axis(normal)))
+        )
     return out
 
 
@@ -129,8 +131,10 @@ def link_surface(info: UrdfInfo, link: str, spacing: float, region: Region | Non
     shapes: list[Capsule | Sphere] = ([capsule] if capsule else []) + list(info.spheres.get(link, ()))
     out = []
     for i, shape in enumerate(shapes):
-        points = capsule_rings(link, shape, spacing) if isinstance(shape, Capsule) else sphere_lattice(link, shape, spacing)
-        others = shapes[:i] + shapes[i + 1:]
+        points = (
+            capsule_rings(link, shape, spacing) if isinstance(shape, Capsule) else sphere_lattice(link, shape, spacing)
+        )
+        others = shapes[:i] + shapes[i + 1 :]
         out += [p for p in points if not _inside(np.asarray(p.offset), others)]
     if region is not None:
         out = [p for p in out if region.keeps(p, capsule)]

@@ -4,7 +4,7 @@
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -12,8 +12,10 @@ POLICIES = ("random", "zero", "scripted")
 #: The person's policies in co-optimisation (see :mod:`assistive_compiler.coop.policies`).
 HUMAN_POLICIES = ("random", "zero", "hold")
 #: How ``--policy`` is described in every rollout command's help.
-POLICY_HELP = ("random, zero, scripted, pretrained:<task>-<robot> (a shipped trained policy, e.g. pretrained:feeding-jaco), "
-               "or a training run directory (its newest checkpoint)")
+POLICY_HELP = (
+    "random, zero, scripted, pretrained:<task>-<robot> (a shipped trained policy, e.g. pretrained:feeding-jaco), "
+    "or a training run directory (its newest checkpoint)"
+)
 
 
 def make_policy(name: str, env, seed: int = 0) -> Callable[[np.ndarray], np.ndarray]:

@@ -38,10 +38,19 @@ class MLPPolicy:
     Observations are in the env's observation units; actions are in the env's action units.
     """
 
-    def __init__(self, layers: list[tuple[np.ndarray, np.ndarray]], activation: str, head: str,
-                 action_low: np.ndarray, action_high: np.ndarray, obs_mean: np.ndarray | None = None,
-                 obs_var: np.ndarray | None = None, obs_clip: float = 10.0, obs_eps: float = 1e-8,
-                 info: dict | None = None):
+    def __init__(
+        self,
+        layers: list[tuple[np.ndarray, np.ndarray]],
+        activation: str,
+        head: str,
+        action_low: np.ndarray,
+        action_high: np.ndarray,
+        obs_mean: np.ndarray | None = None,
+        obs_var: np.ndarray | None = None,
+        obs_clip: float = 10.0,
+        obs_eps: float = 1e-8,
+        info: dict | None = None,
+    ):
         if activation not in ACTIVATIONS:
             raise ValueError(f"unknown activation '{activation}'; expected one of {', '.join(ACTIVATIONS)}")
         if head not in HEADS:
@@ -83,23 +92,32 @@ class MLPPolicy:
         """Write ``policy.json`` (``info`` plus the network's description) and ``weights.npz``."""
         directory = Path(directory)
         directory.mkdir(parents=True, exist_ok=True)
-        arrays: dict[str, np.ndarray] = {"action_low": self.low.astype(np.float32), "action_high": self.high.astype(np.float32)}
+        arrays: dict[str, np.ndarray] = {
+            "action_low": self.low.astype(np.float32),
+            "action_high": self.high.astype(np.float32),
+        }
         for k, (w, b) in enumerate(self.layers):
             arrays[f"layer{k}_weight"] = w.astype(np.float32)
             arrays[f"layer{k}_bias"] = b.astype(np.float32)
         if self.obs_mean is not None:
             arrays["obs_mean"] = self.obs_mean
             arrays["obs_var"] = self.obs_var
-        network = {"activation": self.activation, "head": self.head, "layers": len(self.layers),
-                   "sizes": [self.obs_dim] + [w.shape[0] for w, _ in self.layers],
-                   "obs_normalised": self.obs_mean is not None, "obs_clip": self.obs_clip, "obs_eps": self.obs_eps}
+        network = {
+            "activation": self.activation,
+            "head": self.head,
+            "layers": len(self.layers),
+            "sizes": [self.obs_dim] + [w.shape[0] for w, _ in self.layers],
+            "obs_normalised": self.obs_mean is not None,
+            "obs_clip": self.obs_clip,
+            "obs_eps": self.obs_eps,
+        }
         np.savez_compressed(directory / WEIGHTS_FILE, **arrays)
         (directory / POLICY_FILE).write_text(json.dumps({**info, "network": network}, indent=1) + "\n")
         self.info = {**info, "network": network}
         return directory
 
     @classmethod
-    def load(cls, directory: str | Path) -> "MLPPolicy":
+    def load(cls, directory: str | Path) -> MLPPolicy:
         """The policy stored in ``directory`` (``policy.json`` + ``weights.npz``)."""
         directory = Path(directory)
         info = json.loads((directory / POLICY_FILE).read_text())
@@ -109,4 +127,6 @@ class MLPPolicy:
             mean = z["obs_mean"] if net["obs_normalised"] else None
             var = z["obs_var"] if net["obs_normalised"] else None
             low, high = z["action_low"], z["action_high"]
-        return cls(layers, net["activation"], net["head"], low, high, mean, var, net["obs_clip"], net["obs_eps"], info=info)
+        return cls(
+            layers, net["activation"], net["head"], low, high, mean, var, net["obs_clip"], net["obs_eps"], info=info
+        )

@@ -49,8 +49,9 @@ def pretrained_folder(name: str) -> Path:
     names = shipped_names()
     if name not in names:
         shipped = one_of(names) if names else "none"
-        raise UsageError(f"--policy {PREFIX}{name}: no shipped policy of that name; shipped: {shipped}"
-                         f"{did_you_mean(name, names)}")
+        raise UsageError(
+            f"--policy {PREFIX}{name}: no shipped policy of that name; shipped: {shipped}{did_you_mean(name, names)}"
+        )
     return pretrained_dir() / name
 
 
@@ -80,7 +81,7 @@ def load_trained(source: str):
     run directory (newest checkpoint). Returns ``(policy, info)``; ``info`` has at least ``task``,
     ``robot`` and ``coop``."""
     if source.startswith(PREFIX):
-        policy = load_folder(pretrained_folder(source[len(PREFIX):]))
+        policy = load_folder(pretrained_folder(source[len(PREFIX) :]))
         return policy, policy.info
     path = Path(source)
     if (path / POLICY_FILE).is_file():
@@ -90,10 +91,16 @@ def load_trained(source: str):
         import importlib.util
 
         info = json.loads((path / "run.json").read_text())
-        missing = [m for m in ("torch", "stable_baselines3" if info["engine"] == "sb3" else "ray") if importlib.util.find_spec(m) is None]
+        missing = [
+            m
+            for m in ("torch", "stable_baselines3" if info["engine"] == "sb3" else "ray")
+            if importlib.util.find_spec(m) is None
+        ]
         if missing:
-            raise UsageError(f"--policy {source}: playing a run directory needs its training library ({', '.join(missing)} not "
-                             "installed): install the 'train' extra (README: Training), or play its export (assistive-compiler export)")
+            raise UsageError(
+                f"--policy {source}: playing a run directory needs its training library ({', '.join(missing)} not "
+                "installed): install the 'train' extra (README: Training), or play its export (assistive-compiler export)"
+            )
         from ..training.evaluate import latest_checkpoint, load_policy
         from ..training.run_dir import RunDir
 
@@ -101,11 +108,18 @@ def load_trained(source: str):
         run_info = run.info()
         steps, checkpoint = latest_checkpoint(run)
         policy = load_policy(run_info, checkpoint)
-        return policy, {"task": run_info.task, "robot": run_info.robot, "coop": run_info.coop, "run": display(path),
-                        "trained_steps": steps}
+        return policy, {
+            "task": run_info.task,
+            "robot": run_info.robot,
+            "coop": run_info.coop,
+            "run": display(path),
+            "trained_steps": steps,
+        }
     expected = f"{one_of(BASELINES)}, {PREFIX}<task>-<robot> (shipped: {', '.join(shipped_names()) or 'none'}), a run directory or an exported policy folder"
     if path.exists():
-        raise UsageError(f"--policy {source}: neither a run directory (no run.json) nor an exported policy (no {POLICY_FILE}); expected {expected}")
+        raise UsageError(
+            f"--policy {source}: neither a run directory (no run.json) nor an exported policy (no {POLICY_FILE}); expected {expected}"
+        )
     raise UsageError(f"--policy: unknown policy '{source}'; expected {expected}{did_you_mean(source, BASELINES)}")
 
 
@@ -114,7 +128,9 @@ def check_fits(info: dict, manifest, source: str, coop: bool = False) -> None:
     outside ``--coop``."""
     task, robot = info.get("task"), info.get("robot")
     if (task, robot) != (manifest.task, manifest.robot_name):
-        raise UsageError(f"--policy {source}: trained for {task} with {robot}, but the env is {manifest.task} with "
-                         f"{manifest.robot_name}")
+        raise UsageError(
+            f"--policy {source}: trained for {task} with {robot}, but the env is {manifest.task} with "
+            f"{manifest.robot_name}"
+        )
     if info.get("coop") and not coop:
         raise UsageError(f"--policy {source}: a co-optimised pair (robot and person) plays under --coop only")

@@ -28,7 +28,6 @@ import pybullet as pb
 from ..ik_options import ik_damping, ik_limits
 from ..rotation import quat_about, quat_conj, quat_mul, quat_rotate, quat_towards, vec_angle
 
-
 STALL_STEPS = 10  # steps without getting STALL_GAIN_M closer before moving on to the next waypoint
 STALL_GAIN_M = 0.002
 # face_normal_level: a level tool's pointing axis is at least the normal's elevation from the inward
@@ -43,9 +42,19 @@ class _Track:
     def __init__(self, env, section: dict, mount_link: str, joints: list[str]):
         snap, m = env.snap, env.manifest
         self.move = snap.point(section["move"])
-        self.waypoints = [(snap.point(w["to"]), np.asarray(w["offset_m"]), w["tolerance_m"], w.get("normal_offset_m", 0.0),
-                           w.get("axis_offset_m", 0.0)) for w in section["waypoints"]]
-        self.orientations = [pb.getQuaternionFromEuler(w["rpy_rad"]) if w.get("rpy_rad") else None for w in section["waypoints"]]
+        self.waypoints = [
+            (
+                snap.point(w["to"]),
+                np.asarray(w["offset_m"]),
+                w["tolerance_m"],
+                w.get("normal_offset_m", 0.0),
+                w.get("axis_offset_m", 0.0),
+            )
+            for w in section["waypoints"]
+        ]
+        self.orientations = [
+            pb.getQuaternionFromEuler(w["rpy_rad"]) if w.get("rpy_rad") else None for w in section["waypoints"]
+        ]
         self.face_normal = [w.get("face_normal_within_rad") for w in section["waypoints"]]
         self.face_level = [w.get("face_normal_level", False) for w in section["waypoints"]]
         self.steps_m = [w.get("step_m") for w in section["waypoints"]]
@@ -55,7 +64,9 @@ class _Track:
         self.ee_link = robot.links[mount_link]
         self.ee_point = snap.point({"body": "robot", "link": mount_link})
         order = list(m.robot.arm_joints)
-        self.action_cols = [order.index(j) for j in joints]  # columns among the arm joints (env.arm_idx, env.delta_scale)
+        self.action_cols = [
+            order.index(j) for j in joints
+        ]  # columns among the arm joints (env.arm_idx, env.delta_scale)
 
 
 class ScriptedPolicy:
@@ -69,27 +80,39 @@ class ScriptedPolicy:
         if m.scripted is None:
             from ..errors import SpecError
 
-            raise SpecError.at(m.sources[0] if m.sources else m.task, f"task '{m.task}' has no scripted: section, so there is no "
-                               "scripted policy for it; use --policy random or zero, or add scripted: waypoints")
+            raise SpecError.at(
+                m.sources[0] if m.sources else m.task,
+                f"task '{m.task}' has no scripted: section, so there is no "
+                "scripted policy for it; use --policy random or zero, or add scripted: waypoints",
+            )
         self.env = env
         links = m.robot.links
         if m.scripted.get("left") is not None:
-            self.tracks = [_Track(env, m.scripted, links["right_tool_mount"], m.joint_groups["robot.right_arm"]["joints"]),
-                           _Track(env, m.scripted["left"], links["left_tool_mount"], m.joint_groups["robot.left_arm"]["joints"])]
+            self.tracks = [
+                _Track(env, m.scripted, links["right_tool_mount"], m.joint_groups["robot.right_arm"]["joints"]),
+                _Track(env, m.scripted["left"], links["left_tool_mount"], m.joint_groups["robot.left_arm"]["joints"]),
+            ]
         else:
             self.tracks = [_Track(env, m.scripted, links["tool_mount"], list(m.robot.arm_joints))]
         robot = env.world.robot
         c = env.world.client
-        movable = [j for j in range(pb.getNumJoints(robot.id, physicsClientId=c)) if pb.getJointInfo(robot.id, j, physicsClientId=c)[2] != pb.JOINT_FIXED]
+        movable = [
+            j
+            for j in range(pb.getNumJoints(robot.id, physicsClientId=c))
+            if pb.getJointInfo(robot.id, j, physicsClientId=c)[2] != pb.JOINT_FIXED
+        ]
         self.movable = movable
         # Each arm joint with its followers: IK spreads a move over the group, the action is their mean.
         followers = m.robot.followers or {}
         for track in self.tracks:
-            track.cols = [[movable.index(env.arm_idx[k])] + [movable.index(robot.joints[f]) for f, lead in followers.items()
-                                                             if lead == m.robot.arm_joints[k]] for k in track.action_cols]
+            track.cols = [
+                [movable.index(env.arm_idx[k])]
+                + [movable.index(robot.joints[f]) for f, lead in followers.items() if lead == m.robot.arm_joints[k]]
+                for k in track.action_cols
+            ]
         self.lo_all = [pb.getJointInfo(robot.id, j, physicsClientId=c)[8] for j in movable]
         self.hi_all = [pb.getJointInfo(robot.id, j, physicsClientId=c)[9] for j in movable]
-        self.ranges = [max(h - l, 1e-3) for l, h in zip(self.lo_all, self.hi_all)]
+        self.ranges = [max(h - link, 1e-3) for link, h in zip(self.lo_all, self.hi_all)]
         # A mobile base drives: IK moves its planar joints with the arm, and the wheel actions head
         # for the planar change it asks of the base (see :meth:`_wheels`).
         # The robot's own script may damp some arm joints (e.g. a slow shoulder).
@@ -187,15 +210,18 @@ class ScriptedPolicy:
             orn = track.orientations[track.index] or track.keep_orn
             if track.face_normal[track.index] is not None:
                 turn = self._yawing if track.face_level[track.index] else self._facing
-                orn = turn(track, orn, -env.snap.normal(track.waypoints[track.index][0]), track.face_normal[track.index])
+                orn = turn(
+                    track, orn, -env.snap.normal(track.waypoints[track.index][0]), track.face_normal[track.index]
+                )
             turn_step = track.turn_steps[track.index]
             if turn_step is not None:  # a slow turn: the orientation handed to IK moves at most turn_step_rad a step,
                 # from the tool's own orientation when the waypoint began (not from the lagging tool's, which a contact can stop)
                 start = track.aimed_orn if track.aimed_orn is not None else env.snap.orientation(track.move)
                 orn = track.aimed_orn = quat_towards(start, orn, turn_step).tolist()
             ee_pos, ee_orn = pb.multiplyTransforms(goal.tolist(), orn, inv_pos, inv_orn)
-            sol = pb.calculateInverseKinematics(robot, track.ee_link, ee_pos, ee_orn, maxNumIterations=50, physicsClientId=c,
-                                                **ik_limits(self, rest))
+            sol = pb.calculateInverseKinematics(
+                robot, track.ee_link, ee_pos, ee_orn, maxNumIterations=50, physicsClientId=c, **ik_limits(self, rest)
+            )
             step = np.array([np.mean([sol[k] - rest[k] for k in group]) for group in track.cols])
             cols = track.action_cols
             action[[self.arm_offset + k for k in cols]] = np.clip(step / env.delta_scale[cols], -1.0, 1.0)

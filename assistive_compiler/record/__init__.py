@@ -12,7 +12,9 @@ from .wrapper import RecordEpisodes
 __all__ = ["RecordEpisodes", "Recording", "RecordingError", "episode_files", "load_recording", "record_episode"]
 
 
-def record_episode(env, policy, seed: int | None, directory, policy_name: str | None = None, options: dict | None = None) -> Recording:
+def record_episode(
+    env, policy, seed: int | None, directory, policy_name: str | None = None, options: dict | None = None
+) -> Recording:
     """Play one episode of ``env`` with ``policy`` (``obs -> action``) from ``reset(seed=seed)``
     and write it to ``directory`` (see :class:`RecordEpisodes`). Returns the recording."""
     recorder = RecordEpisodes(env, directory, policy=policy_name)

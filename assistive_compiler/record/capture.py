@@ -31,7 +31,9 @@ class SceneReader:
             self.links += [[body.name, name] for name in names]
             self.bodies.append({"name": body.name, "kind": body.kind, "urdf": body.urdf, "links": names})
             children = [handle.links[n] for n in names if handle.links[n] >= 0]
-            self._reads.append((handle, children, [first + k for k, n in enumerate(names) if handle.links[n] >= 0], first))
+            self._reads.append(
+                (handle, children, [first + k for k, n in enumerate(names) if handle.links[n] >= 0], first)
+            )
         for g in m.garments:
             self.bodies.append({"name": g.name, "kind": "garment", "urdf": g.obj, "links": []})
         self.targets = list(m.targets)
@@ -43,9 +45,19 @@ class SceneReader:
             "bodies": self.bodies,
             "links": self.links,
             "targets": self.targets,
-            "particles": [{"name": p.name, "count": p.count, "radius": p.radius, "colors": [list(c) for c in p.colors]} for p in m.particles],
-            "markers": [{"name": s.name, "count": self.env.markers.count(s.name), "radius": s.radius,
-                         "rgba": list(s.show_rgba) if s.show_rgba else None} for s in m.markers],
+            "particles": [
+                {"name": p.name, "count": p.count, "radius": p.radius, "colors": [list(c) for c in p.colors]}
+                for p in m.particles
+            ],
+            "markers": [
+                {
+                    "name": s.name,
+                    "count": self.env.markers.count(s.name),
+                    "radius": s.radius,
+                    "rgba": list(s.show_rgba) if s.show_rgba else None,
+                }
+                for s in m.markers
+            ],
             "garments": [{"name": g.name, "nodes": len(g.nodes_in_held)} for g in m.garments],
         }
 
@@ -57,7 +69,9 @@ class SceneReader:
         for handle, children, columns, base in self._reads:
             pos[base], quat[base] = w.base_frame(handle)
             if children:
-                for col, s in zip(columns, pb.getLinkStates(handle.id, children, computeForwardKinematics=1, physicsClientId=c)):
+                for col, s in zip(
+                    columns, pb.getLinkStates(handle.id, children, computeForwardKinematics=1, physicsClientId=c)
+                ):
                     pos[col], quat[col] = s[4], s[5]
         return pos, quat
 

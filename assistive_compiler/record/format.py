@@ -123,7 +123,9 @@ def load_recording(path: str | Path) -> Recording:
     if header.get("format") != FORMAT:
         raise RecordingError(f"{path}: not an episode recording: format {header.get('format')!r}, expected {FORMAT!r}")
     if header.get("format_version", 0) > FORMAT_VERSION:
-        raise RecordingError(f"{path}: recording format version {header['format_version']} is newer than this reader's ({FORMAT_VERSION})")
+        raise RecordingError(
+            f"{path}: recording format version {header['format_version']} is newer than this reader's ({FORMAT_VERSION})"
+        )
     return Recording(header, arrays)
 
 

@@ -39,8 +39,12 @@ class RecordEpisodes(gym.Wrapper):
         self._flush(complete=False)
         obs, info = self.env.reset(seed=seed, options=options)
         base = self.env.unwrapped
-        self._meta = {"seed": seed, "person_variant": info["person_variant"], "start": info["start"],
-                      "person_body": base.world.active_variant.body}
+        self._meta = {
+            "seed": seed,
+            "person_variant": info["person_variant"],
+            "start": info["start"],
+            "person_body": base.world.active_variant.body,
+        }
         self._rows = {"observations": [np.asarray(obs, dtype=np.float32)]}
         self._add_state()
         return obs, info
@@ -82,12 +86,23 @@ class RecordEpisodes(gym.Wrapper):
         arrays["observations"] = arrays["observations"].astype(np.float32)
         arrays["task_success"] = arrays["task_success"].astype(np.int8)
         header = {
-            "format": FORMAT, "format_version": FORMAT_VERSION, "task": m.task, "robot": m.robot_name, "gym_id": m.gym_id,
-            "content_hash": m.content_hash, "policy": self.policy, "episode": self.episode, **self._meta,
-            "dt": m.sim.time_step * m.sim.frame_skip, "steps": len(rows["rewards"]), "complete": complete,
-            "return": float(arrays["rewards"].sum()), "success": bool(arrays["task_success"][-1]),
+            "format": FORMAT,
+            "format_version": FORMAT_VERSION,
+            "task": m.task,
+            "robot": m.robot_name,
+            "gym_id": m.gym_id,
+            "content_hash": m.content_hash,
+            "policy": self.policy,
+            "episode": self.episode,
+            **self._meta,
+            "dt": m.sim.time_step * m.sim.frame_skip,
+            "steps": len(rows["rewards"]),
+            "complete": complete,
+            "return": float(arrays["rewards"].sum()),
+            "success": bool(arrays["task_success"][-1]),
             "success_metric": float(arrays["success_metric"][-1]),
-            "terms": self._term_names(), "term_weights": {t.name: t.weight for t in m.reward},
+            "terms": self._term_names(),
+            "term_weights": {t.name: t.weight for t in m.reward},
             "term_categories": {t.name: t.category for t in m.reward},
             **self.reader.header(),
         }

@@ -17,21 +17,38 @@ from __future__ import annotations
 from ..errors import Problem, SpecError
 from ..library import Library
 from ..spec.load import LoadedSpec
-from . import bodies, person, robot as robot_section, scripted, terms
+from . import bodies, person, scripted, terms
+from . import robot as robot_section
 from .landmarks import with_landmarks
 from .resolved import ResolvedTask, ResolvedTerm
 from .scope import GARMENT_HELD_LINK, RESERVED_BODIES, ROBOT_SEMANTIC_LINKS, Scope
 
-__all__ = ["GARMENT_HELD_LINK", "RESERVED_BODIES", "ROBOT_SEMANTIC_LINKS", "ResolvedTask", "ResolvedTerm", "resolve", "validate_all_robots"]
+__all__ = [
+    "GARMENT_HELD_LINK",
+    "RESERVED_BODIES",
+    "ROBOT_SEMANTIC_LINKS",
+    "ResolvedTask",
+    "ResolvedTerm",
+    "resolve",
+    "validate_all_robots",
+]
 
 
 def _load_parts(s: Scope) -> None:
     """The library parts the task uses on this robot (raises when the robot or every person is missing)."""
     spec = s.spec
     robot = s.part("robots", s.robot_name, ("robot", "default"), "robot")
-    s.furniture = {n: p for n, use in spec.scene.furniture.items() if (p := s.part("furniture", use.part, ("scene", "furniture", n, "part"), "furniture part"))}
+    s.furniture = {
+        n: p
+        for n, use in spec.scene.furniture.items()
+        if (p := s.part("furniture", use.part, ("scene", "furniture", n, "part"), "furniture part"))
+    }
     s.tools = {n: p for n, use in spec.tools.items() if (p := s.part("tools", use.part, ("tools", n, "part"), "tool"))}
-    s.people = {n: p for i, n in enumerate(spec.person.variants) if (p := s.part("people", n, ("person", "variants", i), "person"))}
+    s.people = {
+        n: p
+        for i, n in enumerate(spec.person.variants)
+        if (p := s.part("people", n, ("person", "variants", i), "person"))
+    }
     robot_section.check_per_robot_keys(s, ("robot", "per_robot"), spec.robot.per_robot)
     robot_section.check_per_robot_keys(s, ("camera", "per_robot"), spec.camera.per_robot)
     if s.problems or robot is None or not s.people:
@@ -69,11 +86,26 @@ def resolve(loaded: LoadedSpec, robot: str | None = None, library: Library | Non
     base_goals = robot_section.base_goals(s)
     s.fail_if_any()
     return ResolvedTask(
-        loaded=loaded, robot_name=s.robot_name, robot=s.robot, robot_urdf=s.robot_urdf, tools=s.tools,
-        furniture=s.furniture, people=s.people, person_urdf=s.person_urdf, robot_links=s.robot_links,
-        joint_groups=s.joint_groups, observations=observations, reward=reward, success_threshold=threshold,
-        points=points, scripted=script, base_goals=base_goals, markers=markers, sides=s.sides,
-        tool_uses={n: u for n, u in spec.tools.items() if n not in s.tool_aliases}, tool_aliases=s.tool_aliases,
+        loaded=loaded,
+        robot_name=s.robot_name,
+        robot=s.robot,
+        robot_urdf=s.robot_urdf,
+        tools=s.tools,
+        furniture=s.furniture,
+        people=s.people,
+        person_urdf=s.person_urdf,
+        robot_links=s.robot_links,
+        joint_groups=s.joint_groups,
+        observations=observations,
+        reward=reward,
+        success_threshold=threshold,
+        points=points,
+        scripted=script,
+        base_goals=base_goals,
+        markers=markers,
+        sides=s.sides,
+        tool_uses={n: u for n, u in spec.tools.items() if n not in s.tool_aliases},
+        tool_aliases=s.tool_aliases,
     )
 
 

@@ -24,14 +24,22 @@ def name_bodies(s: Scope) -> None:
     """Fill ``Scope.body_names``: each declared body name -> the section that declares it."""
     spec = s.spec
     s.body_names = {"robot": "robot", "person": "person"}
-    for section, names in (("scene.furniture", spec.scene.furniture), ("tools", spec.tools), ("particles", spec.particles),
-                           ("garments", spec.garments)):
+    for section, names in (
+        ("scene.furniture", spec.scene.furniture),
+        ("tools", spec.tools),
+        ("particles", spec.particles),
+        ("garments", spec.garments),
+    ):
         for name in names:
             path = tuple(section.split(".")) + (name,)
             if name in s.body_names:
                 other = s.body_names[name]
                 why = "is reserved" if name in RESERVED_BODIES else f"is already used in {other}"
-                s.problem(path, f"body name '{name}' {why}; every furniture, tool and particle set needs its own name", key=True)
+                s.problem(
+                    path,
+                    f"body name '{name}' {why}; every furniture, tool and particle set needs its own name",
+                    key=True,
+                )
             else:
                 s.body_names[name] = section
 
@@ -47,12 +55,18 @@ def targets(s: Scope) -> dict[str, dict[str, Any]]:
             if region and links:
                 region = _non_empty(s, region, links, SURFACE_TARGET_SPACING_M, ("targets", name, "region"))
             if links and region is not False:
-                out[name] = {"body": "person", "link": links[0], "surface_links": links} | ({"region": region} if region else {})
+                out[name] = {"body": "person", "link": links[0], "surface_links": links} | (
+                    {"region": region} if region else {}
+                )
             continue
         p = s.point(target.link, ("targets", name, "link"), allow_target=False)
         for variant in target.offset_by_variant:
             if variant not in spec.person.variants:
-                s.problem(("targets", name, "offset_by_variant", variant), f"'{variant}' is not a person variant of this task; variants are {one_of(spec.person.variants)}{did_you_mean(variant, spec.person.variants)}", key=True)
+                s.problem(
+                    ("targets", name, "offset_by_variant", variant),
+                    f"'{variant}' is not a person variant of this task; variants are {one_of(spec.person.variants)}{did_you_mean(variant, spec.person.variants)}",
+                    key=True,
+                )
         if p:
             out[name] = p
     return out
@@ -70,13 +84,22 @@ def markers(s: Scope) -> dict[str, dict[str, Any]]:
         region = region_of(s, ms.region, links, base + ("region",))
         tool = s.point(ms.cleared_by.tool, base + ("cleared_by", "tool"), allow_target=False)
         if tool is not None and tool["body"] not in spec.tools:
-            s.problem(base + ("cleared_by", "tool"), f"markers are cleared by a tool link; '{ms.cleared_by.tool}' is not on a tool (tools: {one_of(spec.tools)})")
+            s.problem(
+                base + ("cleared_by", "tool"),
+                f"markers are cleared by a tool link; '{ms.cleared_by.tool}' is not on a tool (tools: {one_of(spec.tools)})",
+            )
             tool = None
         if region and links:
             region = _non_empty(s, region, links, ms.spacing_m, base + ("region",))
         if links and tool and region is not False:
-            out[name] = {"links": links, "tool": tool, "radius_m": ms.cleared_by.radius_m, "spacing_m": ms.spacing_m,
-                         "show_rgba": ms.show_rgba, "region": region}
+            out[name] = {
+                "links": links,
+                "tool": tool,
+                "radius_m": ms.cleared_by.radius_m,
+                "spacing_m": ms.spacing_m,
+                "show_rgba": ms.show_rgba,
+                "region": region,
+            }
     return out
 
 
@@ -89,19 +112,29 @@ def surface_region(spec, region: dict[str, Any] | None, variant: str) -> Region 
         target = region["near"]["target"]
         t = spec.targets[target] if target else None
         centre = tuple(t.offset_by_variant.get(variant, t.offset_m)) if t else (0.0, 0.0, 0.0)
-    return Region(centre=centre, radius=region["radius_m"], facing=tuple(region["facing"]) if region["facing"] else None,
-                  max_angle=region["max_angle_rad"], along=tuple(region["along"]) if region["along"] else None)
+    return Region(
+        centre=centre,
+        radius=region["radius_m"],
+        facing=tuple(region["facing"]) if region["facing"] else None,
+        max_angle=region["max_angle_rad"],
+        along=tuple(region["along"]) if region["along"] else None,
+    )
 
 
-def _non_empty(s: Scope, region: dict[str, Any], links: list[str], spacing: float, path: tuple) -> dict[str, Any] | Literal[False]:
+def _non_empty(
+    s: Scope, region: dict[str, Any], links: list[str], spacing: float, path: tuple
+) -> dict[str, Any] | Literal[False]:
     """``region``, or False and a problem when it keeps no point of the links on some person variant."""
     for variant in s.spec.person.variants:
         info = s.lib.default_urdf("people", variant)
-        kept = sum(len(link_surface(info, l, spacing, surface_region(s.spec, region, variant))) for l in links)
+        kept = sum(len(link_surface(info, link, spacing, surface_region(s.spec, region, variant))) for link in links)
         if not kept:
-            total = sum(len(link_surface(info, l, spacing)) for l in links)
-            s.problem(path, f"the region keeps none of the {total} surface points of {', '.join('person.' + l for l in links)} "
-                            f"({spacing * 100:g} cm apart) on {variant}; widen it (radius_m, max_angle_deg, along)")
+            total = sum(len(link_surface(info, link, spacing)) for link in links)
+            s.problem(
+                path,
+                f"the region keeps none of the {total} surface points of {', '.join('person.' + link for link in links)} "
+                f"({spacing * 100:g} cm apart) on {variant}; widen it (radius_m, max_angle_deg, along)",
+            )
             return False
     return region
 
@@ -112,9 +145,13 @@ def region_of(s: Scope, region, links: list[str], path: tuple) -> dict[str, Any]
     ``max_angle_rad`` and ``along``. None when there is no region, False when it has a problem."""
     if region is None:
         return None
-    out: dict[str, Any] = {"radius_m": region.radius_m, "along": list(region.along) if region.along else None,
-                           "max_angle_rad": math.radians(region.max_angle_deg) if region.facing is not None else None,
-                           "facing": None, "near": None}
+    out: dict[str, Any] = {
+        "radius_m": region.radius_m,
+        "along": list(region.along) if region.along else None,
+        "max_angle_rad": math.radians(region.max_angle_deg) if region.facing is not None else None,
+        "facing": None,
+        "near": None,
+    }
     ok = True
     if region.facing is not None:
         n = math.sqrt(sum(v * v for v in region.facing))
@@ -127,26 +164,38 @@ def region_of(s: Scope, region, links: list[str], path: tuple) -> dict[str, Any]
         if target is not None:
             t = s.spec.targets[target]
             if t.surface_of:
-                s.problem(path + ("near",), f"'{region.near}' is drawn anew at every reset; a region is fixed on the link: give a landmark, a fixed target or a link")
+                s.problem(
+                    path + ("near",),
+                    f"'{region.near}' is drawn anew at every reset; a region is fixed on the link: give a landmark, a fixed target or a link",
+                )
                 return False
             p = s.point(t.link, ("targets", target, "link"), allow_target=False)
             if p is None:
                 return False
         if p["body"] != "person" or (links and p["link"] not in links):
             on = f"person.{p['link']}" if p["body"] == "person" else f"{p['body']}.{p['link']}"
-            s.problem(path + ("near",), f"'{region.near}' is on {on}; a region is centred on a covered link "
-                                        f"({', '.join('person.' + l for l in links)}), in that link's frame")
+            s.problem(
+                path + ("near",),
+                f"'{region.near}' is on {on}; a region is centred on a covered link "
+                f"({', '.join('person.' + link for link in links)}), in that link's frame",
+            )
             return False
         if len(links) > 1:
-            s.problem(path + ("near",), f"a region near a point covers one link, the point's (person.{p['link']}); "
-                                        f"surface_of names {len(links)}: give only person.{p['link']}")
+            s.problem(
+                path + ("near",),
+                f"a region near a point covers one link, the point's (person.{p['link']}); "
+                f"surface_of names {len(links)}: give only person.{p['link']}",
+            )
             return False
         out["near"] = {"link": p["link"], "target": target}
     if region.along is not None:
-        no_capsule = [l for l in links if l not in s.person_urdf.capsules]
+        no_capsule = [link for link in links if link not in s.person_urdf.capsules]
         if no_capsule:
-            s.problem(path + ("along",), f"'along' is a fraction of a limb's capsule; person.{no_capsule[0]} has none "
-                                         f"(capsule links: {one_of(['person.' + l for l in s.person_urdf.capsules])})")
+            s.problem(
+                path + ("along",),
+                f"'along' is a fraction of a limb's capsule; person.{no_capsule[0]} has none "
+                f"(capsule links: {one_of(['person.' + link for link in s.person_urdf.capsules])})",
+            )
             ok = False
     return out if ok else False
 
@@ -174,7 +223,9 @@ def _check_container(s: Scope, holder: str, path: tuple) -> None:
     if s.body(holder, path, allow_particles=False):
         if holder not in s.tools or s.tools[holder].part.container is None:
             with_container = [t for t, part in s.tools.items() if part.part.container is not None]
-            s.problem(path, f"'{holder}' is not a tool with a container; tools with one: {one_of(with_container) or 'none'}")
+            s.problem(
+                path, f"'{holder}' is not a tool with a container; tools with one: {one_of(with_container) or 'none'}"
+            )
 
 
 def check_garments(s: Scope) -> None:
@@ -185,12 +236,25 @@ def check_garments(s: Scope) -> None:
         base = ("garments", name, "held")
         if g.held.grip not in s.robot.part.grips:
             grips = list(s.robot.part.grips)
-            s.problem(base + ("grip",), f"robot '{s.robot_name}' has no grip '{g.held.grip}' to hold garment '{name}' (add it under grips: in {s.robot.shown}); its grips are {one_of(grips)}{did_you_mean(g.held.grip, grips)}")
+            s.problem(
+                base + ("grip",),
+                f"robot '{s.robot_name}' has no grip '{g.held.grip}' to hold garment '{name}' (add it under grips: in {s.robot.shown}); its grips are {one_of(grips)}{did_you_mean(g.held.grip, grips)}",
+            )
         for i, body in enumerate(g.collides_with or []):
             if s.body(body, ("garments", name, "collides_with", i), allow_particles=False) == name:
-                s.problem(("garments", name, "collides_with", i), f"garment '{name}' cannot collide with itself (self-collision is off)")
+                s.problem(
+                    ("garments", name, "collides_with", i),
+                    f"garment '{name}' cannot collide with itself (self-collision is off)",
+                )
         sets = sleeve_node_sets(g.shape.rings, g.shape.segments)
         if g.held.nodes not in sets:
-            s.problem(base + ("nodes",), f"unknown node set '{g.held.nodes}' of garment '{name}'; {expected(sets, g.held.nodes)}")
+            s.problem(
+                base + ("nodes",),
+                f"unknown node set '{g.held.nodes}' of garment '{name}'; {expected(sets, g.held.nodes)}",
+            )
     if spec.garments and spec.tools:
-        s.problem(("garments",), "a task with a garment holds no tool (the garment is what the hand holds); remove tools: or garments:", key=True)
+        s.problem(
+            ("garments",),
+            "a task with a garment holds no tool (the garment is what the hand holds); remove tools: or garments:",
+            key=True,
+        )

@@ -10,7 +10,8 @@ the manifest, renders) treats it as any other target. A target written on a land
 from __future__ import annotations
 
 import dataclasses
-from typing import Any, Iterator
+from collections.abc import Iterator
+from typing import Any
 
 from ..errors import SpecError
 from ..library import Library
@@ -34,7 +35,7 @@ def _strings(value: Any) -> Iterator[str]:
 
 def referenced_landmarks(data: dict) -> list[str]:
     """The landmarks a spec's data names (``person.<landmark>`` anywhere), sorted."""
-    return sorted({s[len(PREFIX):] for s in _strings(data) if s.startswith(PREFIX) and s[len(PREFIX):] in LANDMARKS})
+    return sorted({s[len(PREFIX) :] for s in _strings(data) if s.startswith(PREFIX) and s[len(PREFIX) :] in LANDMARKS})
 
 
 def with_landmarks(loaded: LoadedSpec, library: Library) -> LoadedSpec:
@@ -55,12 +56,21 @@ def with_landmarks(loaded: LoadedSpec, library: Library) -> LoadedSpec:
     for name in used:
         link = LANDMARKS[name].link
         by_variant = {v: offsets[v][name][1] for v in spec.person.variants}
-        targets[PREFIX + name] = Target(link=PREFIX + link, offset_m=by_variant[spec.person.variants[0]], offset_by_variant=by_variant)
+        targets[PREFIX + name] = Target(
+            link=PREFIX + link, offset_m=by_variant[spec.person.variants[0]], offset_by_variant=by_variant
+        )
     for tname, target in spec.targets.items():  # a target on a landmark: onto its link, offsets added
-        if target.link is not None and target.link.startswith(PREFIX) and target.link[len(PREFIX):] in LANDMARKS:
-            name = target.link[len(PREFIX):]
+        if target.link is not None and target.link.startswith(PREFIX) and target.link[len(PREFIX) :] in LANDMARKS:
+            name = target.link[len(PREFIX) :]
             own = {v: target.offset_by_variant.get(v, target.offset_m) for v in spec.person.variants}
-            by_variant = {v: tuple(round(a + b, 6) for a, b in zip(offsets[v][name][1], own[v])) for v in spec.person.variants}
-            targets[tname] = target.model_copy(update={"link": PREFIX + LANDMARKS[name].link, "offset_m": by_variant[spec.person.variants[0]],
-                                                       "offset_by_variant": by_variant})
+            by_variant = {
+                v: tuple(round(a + b, 6) for a, b in zip(offsets[v][name][1], own[v])) for v in spec.person.variants
+            }
+            targets[tname] = target.model_copy(
+                update={
+                    "link": PREFIX + LANDMARKS[name].link,
+                    "offset_m": by_variant[spec.person.variants[0]],
+                    "offset_by_variant": by_variant,
+                }
+            )
     return dataclasses.replace(loaded, spec=spec.model_copy(update={"targets": targets}))

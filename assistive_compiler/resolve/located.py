@@ -8,7 +8,8 @@ found, so a user sees all the mistakes of a spec at once.
 
 from __future__ import annotations
 
-from typing import Any, Iterable
+from collections.abc import Iterable
+from typing import Any
 
 from ..errors import Location, Problem, SpecError, did_you_mean, one_of
 from ..spec.load import LoadedSpec

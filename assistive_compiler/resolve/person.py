@@ -17,7 +17,11 @@ from .scope import Scope
 
 
 def _deg_range(lower: float | None, upper: float | None) -> str:
-    return f"[{math.degrees(lower):.0f}°, {math.degrees(upper):.0f}°]" if lower is not None and upper is not None else "unlimited"
+    return (
+        f"[{math.degrees(lower):.0f}°, {math.degrees(upper):.0f}°]"
+        if lower is not None and upper is not None
+        else "unlimited"
+    )
 
 
 def check_person(s: Scope) -> None:
@@ -37,7 +41,7 @@ def _check_joint_angles(s: Scope) -> None:
                 s.problem(path, f"unknown person joint '{name}'; {expected(movable, name)}", key=True)
                 continue
             j = movable[name]
-            lows, highs = (value.uniform if isinstance(value, Uniform) else (value, value))
+            lows, highs = value.uniform if isinstance(value, Uniform) else (value, value)
             for deg in (lows, highs):
                 rad = math.radians(deg)
                 if j.lower is not None and not (j.lower - 1e-9 <= rad <= j.upper + 1e-9):
@@ -52,7 +56,9 @@ def _check_control(s: Scope) -> None:
         group = s.joints(ref, ("person", "control", "policy_joints", i))
         if group:
             if group["body"] != "person":
-                s.problem(("person", "control", "policy_joints", i), f"policy_joints must be person joint groups, got '{ref}'")
+                s.problem(
+                    ("person", "control", "policy_joints", i), f"policy_joints must be person joint groups, got '{ref}'"
+                )
             else:
                 s.policy_joints += [j for j in group["joints"] if j not in s.policy_joints]
     if person.control.compliant:
@@ -77,9 +83,16 @@ def _check_settle_stage(s: Scope) -> None:
             s.problem(base + ("dynamic", i), f"dynamic joints must be person joint groups, got '{ref}'")
     for name, deg in stage.joints_deg.items():
         if name not in movable:
-            s.problem(base + ("joints_deg", name), f"unknown person joint '{name}'; {expected(movable, name)}", key=True)
-        elif movable[name].lower is not None and not (movable[name].lower - 1e-9 <= math.radians(deg) <= movable[name].upper + 1e-9):
-            s.problem(base + ("joints_deg", name), f"{name} = {deg:g}° is outside the joint's limits {_deg_range(movable[name].lower, movable[name].upper)}")
+            s.problem(
+                base + ("joints_deg", name), f"unknown person joint '{name}'; {expected(movable, name)}", key=True
+            )
+        elif movable[name].lower is not None and not (
+            movable[name].lower - 1e-9 <= math.radians(deg) <= movable[name].upper + 1e-9
+        ):
+            s.problem(
+                base + ("joints_deg", name),
+                f"{name} = {deg:g}° is outside the joint's limits {_deg_range(movable[name].lower, movable[name].upper)}",
+            )
 
 
 def _check_seat(s: Scope) -> None:

@@ -9,11 +9,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..urdf import UrdfInfo
 from ..library import LoadedPart
 from ..spec.load import LoadedSpec
 from ..spec.models import TaskSpec
 from ..terms.registry import Category
+from ..urdf import UrdfInfo
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,8 @@ robot's semantic links, the joint groups (robot arms and person groups) and the 
 
 from __future__ import annotations
 
-from typing import Any, Iterable
+from collections.abc import Iterable
+from typing import Any
 
 from ..errors import did_you_mean, one_of
 from ..library import LoadedPart
@@ -23,11 +24,17 @@ def check_supported(s: Scope) -> None:
     spec = s.spec
     for i, name in enumerate(spec.robot.supported):
         if not s.lib.path_of("robots", name):
-            s.problem(("robot", "supported", i), f"unknown robot '{name}'; {expected(s.lib.names('robots'), name)}{s.lib.searched('robots')}")
+            s.problem(
+                ("robot", "supported", i),
+                f"unknown robot '{name}'; {expected(s.lib.names('robots'), name)}{s.lib.searched('robots')}",
+            )
     if s.robot_name not in spec.robot.supported:
         # Located at the list that decides (robot.supported), wherever it was written.
-        s.problem(("robot", "supported"), f"robot '{s.robot_name}' is not supported by task '{spec.name}'; supported: "
-                  f"{one_of(spec.robot.supported)}{did_you_mean(s.robot_name, spec.robot.supported)}")
+        s.problem(
+            ("robot", "supported"),
+            f"robot '{s.robot_name}' is not supported by task '{spec.name}'; supported: "
+            f"{one_of(spec.robot.supported)}{did_you_mean(s.robot_name, spec.robot.supported)}",
+        )
         s.fail_if_any()
 
 
@@ -65,16 +72,28 @@ def tool_aliases(s: Scope) -> dict[str, str]:
                 continue
             target = spec.tools[other]
             if target.one_arm_same_as is not None:
-                s.problem(path + ("one_arm_same_as",), f"tool '{other}' is itself one_arm_same_as '{target.one_arm_same_as}'; name a tool that is a body of its own")
+                s.problem(
+                    path + ("one_arm_same_as",),
+                    f"tool '{other}' is itself one_arm_same_as '{target.one_arm_same_as}'; name a tool that is a body of its own",
+                )
             elif target.part != use.part:
-                s.problem(path + ("one_arm_same_as",), f"tool '{other}' is a '{target.part}' but '{name}' is a '{use.part}'; one body can only stand for tools of the same part")
+                s.problem(
+                    path + ("one_arm_same_as",),
+                    f"tool '{other}' is a '{target.part}' but '{name}' is a '{use.part}'; one body can only stand for tools of the same part",
+                )
             elif target.hand == use.hand:
-                s.problem(path + ("one_arm_same_as",), f"tool '{other}' is already in the {use.hand} hand; one_arm_same_as names the tool in the other hand")
+                s.problem(
+                    path + ("one_arm_same_as",),
+                    f"tool '{other}' is already in the {use.hand} hand; one_arm_same_as names the tool in the other hand",
+                )
             elif one_arm:
                 aliases[name] = other
                 continue
         if one_arm and spec.robot.arm != "both" and robot_arms > 1 and use.hand != spec.robot.arm:
-            s.problem(path + ("hand",), f"tool '{name}' is held in the {use.hand} hand, but the task acts with the {spec.robot.arm} arm only; use hand: {spec.robot.arm} or robot.arm: both")
+            s.problem(
+                path + ("hand",),
+                f"tool '{name}' is held in the {use.hand} hand, but the task acts with the {spec.robot.arm} arm only; use hand: {spec.robot.arm} or robot.arm: both",
+            )
     if one_arm:
         held = [n for n in spec.tools if n not in aliases]
         hands = {spec.tools[n].hand for n in held}
@@ -82,7 +101,10 @@ def tool_aliases(s: Scope) -> dict[str, str]:
             first = held[0]
             for n in held[1:]:
                 if spec.tools[n].hand != spec.tools[first].hand:
-                    s.problem(("tools", n, "hand"), f"robot '{s.robot_name}' acts with one arm, which would hold both '{first}' ({spec.tools[first].hand} hand) and '{n}' ({spec.tools[n].hand} hand); give '{n}' one_arm_same_as: {first} (one tool serving both hands) or a hand the arm already uses")
+                    s.problem(
+                        ("tools", n, "hand"),
+                        f"robot '{s.robot_name}' acts with one arm, which would hold both '{first}' ({spec.tools[first].hand} hand) and '{n}' ({spec.tools[n].hand} hand); give '{n}' one_arm_same_as: {first} (one tool serving both hands) or a hand the arm already uses",
+                    )
     return aliases
 
 
@@ -110,7 +132,11 @@ def joint_groups(s: Scope) -> dict[str, dict[str, Any]]:
         arm_joints += part.arm_for(side)[1].joints
     groups["robot.arm"] = {"body": "robot", "group": "arm", "joints": arm_joints}
     for side in ("right", "left"):
-        groups[f"robot.{side}_arm"] = {"body": "robot", "group": f"{side}_arm", "joints": list(part.arm_for(side)[1].joints)}
+        groups[f"robot.{side}_arm"] = {
+            "body": "robot",
+            "group": f"{side}_arm",
+            "joints": list(part.arm_for(side)[1].joints),
+        }
     for name, joints in JOINT_GROUPS.items():
         groups[f"person.{name}"] = {"body": "person", "group": name, "joints": list(joints)}
     return groups
@@ -127,9 +153,11 @@ def check_mount(s: Scope) -> None:
             s.problem(("robot", "mount_on"), f"furniture '{mount}' has no mount_link for the robot")
     for name, use in spec.scene.furniture.items():
         if use.only_when_mounted and name != mount:
-            s.problem(("scene", "furniture", name, "only_when_mounted"),
-                      f"furniture '{name}' is only_when_mounted but the robot mounts on {repr(mount) if mount else 'nothing'} "
-                      "(robot.mount_on); only the mount furniture can be left out for robots that stand on the floor")
+            s.problem(
+                ("scene", "furniture", name, "only_when_mounted"),
+                f"furniture '{name}' is only_when_mounted but the robot mounts on {repr(mount) if mount else 'nothing'} "
+                "(robot.mount_on); only the mount furniture can be left out for robots that stand on the floor",
+            )
     if spec.robot.mount_base == "search":
         _check_searched_mount(s, mount)
     for name, use in spec.tools.items():
@@ -137,8 +165,11 @@ def check_mount(s: Scope) -> None:
         if grip not in s.robot.part.grips:
             grips = list(s.robot.part.grips)
             where = ("tools", name, "grip" if use.grip else "part")
-            s.problem(where, f"robot '{s.robot_name}' has no grip '{grip}' for tool '{name}' (add it under grips: in {s.robot.shown}, "
-                             f"or set tools.{name}.grip to one of its grips: {one_of(grips)}){did_you_mean(grip, grips)}")
+            s.problem(
+                where,
+                f"robot '{s.robot_name}' has no grip '{grip}' for tool '{name}' (add it under grips: in {s.robot.shown}, "
+                f"or set tools.{name}.grip to one of its grips: {one_of(grips)}){did_you_mean(grip, grips)}",
+            )
 
 
 def check_arm_rest(s: Scope) -> None:
@@ -148,13 +179,19 @@ def check_arm_rest(s: Scope) -> None:
         return
     where = ("robot", "per_robot", s.robot_name, "arm_rest_rad")
     if len(s.sides) > 1:
-        s.problem(where, "arm_rest_rad is the acting arm's rest in a task acting with one arm; this task acts with both "
-                         f"arms of '{s.robot_name}' (set rest_rad per arm in {s.robot.shown})")
+        s.problem(
+            where,
+            "arm_rest_rad is the acting arm's rest in a task acting with one arm; this task acts with both "
+            f"arms of '{s.robot_name}' (set rest_rad per arm in {s.robot.shown})",
+        )
         return
     joints = s.robot.part.arm_for(s.sides[0])[1].joints
     if len(rest) != len(joints):
-        s.problem(where, f"arm_rest_rad has {len(rest)} values but the arm of '{s.robot_name}' has {len(joints)} "
-                         f"joints ({', '.join(joints)})")
+        s.problem(
+            where,
+            f"arm_rest_rad has {len(rest)} values but the arm of '{s.robot_name}' has {len(joints)} "
+            f"joints ({', '.join(joints)})",
+        )
 
 
 def _check_searched_mount(s: Scope, mount: str | None) -> None:
@@ -162,31 +199,51 @@ def _check_searched_mount(s: Scope, mount: str | None) -> None:
     only_when_mounted, and without a placement of its own."""
     use = s.spec.scene.furniture.get(mount) if mount else None
     if mount is None:
-        s.problem(("robot", "mount_base"), "mount_base 'search' carries the mount furniture under the searched base, "
-                                           "but robot.mount_on names no furniture; set robot.mount_on or use mount_base: furniture")
+        s.problem(
+            ("robot", "mount_base"),
+            "mount_base 'search' carries the mount furniture under the searched base, "
+            "but robot.mount_on names no furniture; set robot.mount_on or use mount_base: furniture",
+        )
     elif use is not None and not use.only_when_mounted:
-        s.problem(("robot", "mount_base"), f"mount_base 'search' places furniture '{mount}' under a mounted robot's base, "
-                                           f"so without one it has no place: set scene.furniture.{mount}.only_when_mounted: true")
+        s.problem(
+            ("robot", "mount_base"),
+            f"mount_base 'search' places furniture '{mount}' under a mounted robot's base, "
+            f"so without one it has no place: set scene.furniture.{mount}.only_when_mounted: true",
+        )
     elif use is not None:
         for field in ("position_m", "rpy_deg", "position_noise_m"):
             if field in use.model_fields_set:
-                s.problem(("scene", "furniture", mount, field),
-                          f"furniture '{mount}' is carried under the robot's searched base (robot.mount_base: search), "
-                          f"so its {field} is not used; remove it (move the base search instead)")
+                s.problem(
+                    ("scene", "furniture", mount, field),
+                    f"furniture '{mount}' is carried under the robot's searched base (robot.mount_base: search), "
+                    f"so its {field} is not used; remove it (move the base search instead)",
+                )
 
 
 def base_goals(s: Scope) -> list[dict[str, Any]]:
     """The base search's goals: a resolved point, an offset (m) and the arm that should reach it."""
     spec = s.spec
     own = spec.robot.per_robot.get(s.robot_name)
-    where = ("robot", "per_robot", s.robot_name, "base_search") if own is not None and own.base_search is not None else ("robot", "base_search")
+    where = (
+        ("robot", "per_robot", s.robot_name, "base_search")
+        if own is not None and own.base_search is not None
+        else ("robot", "base_search")
+    )
     search = spec.robot.search_for(s.robot_name)
     goals = [
-        {"point": s.point(g.point, where + ("goals", i, "point")), "offset_m": list(g.offset_m),
-         "oriented": g.oriented, "required": g.required, "arm": (g.arm or "right") if len(s.sides) > 1 else s.sides[0]}
+        {
+            "point": s.point(g.point, where + ("goals", i, "point")),
+            "offset_m": list(g.offset_m),
+            "oriented": g.oriented,
+            "required": g.required,
+            "arm": (g.arm or "right") if len(s.sides) > 1 else s.sides[0],
+        }
         for i, g in enumerate(search.goals)
     ]
     for i, g in enumerate(search.goals):
         if g.arm is not None and spec.robot.arm != "both":
-            s.problem(where + ("goals", i, "arm"), f"a goal names an arm only in a task acting with both arms (robot.arm: both); this task's arm is '{spec.robot.arm}'")
+            s.problem(
+                where + ("goals", i, "arm"),
+                f"a goal names an arm only in a task acting with both arms (robot.arm: both); this task's arm is '{spec.robot.arm}'",
+            )
     return goals

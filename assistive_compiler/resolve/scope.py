@@ -16,10 +16,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..urdf import UrdfInfo
 from ..errors import SpecError
 from ..library import Library, LoadedPart
 from ..spec.load import LoadedSpec
+from ..urdf import UrdfInfo
 from .located import Collector, expected
 
 RESERVED_BODIES = ("robot", "person")
@@ -56,7 +56,9 @@ class Scope(Collector):
         try:
             return self.lib.get(kind, name)
         except KeyError:
-            self.problem(path, f"unknown {what} '{name}'; {expected(self.lib.names(kind), name)}{self.lib.searched(kind)}")
+            self.problem(
+                path, f"unknown {what} '{name}'; {expected(self.lib.names(kind), name)}{self.lib.searched(kind)}"
+            )
         except SpecError as exc:
             self.problems.extend(exc.problems)
         return None
@@ -67,7 +69,7 @@ class Scope(Collector):
         if body == "robot":
             return self.robot_links
         if body == "person":
-            return {l: l for l in self.person_urdf.links}
+            return {link: link for link in self.person_urdf.links}
         if body in self.tools:
             return dict(self.tools[body].part.links) | {"base": self.tools[body].part.base_link}
         if body in self.furniture:
@@ -106,8 +108,11 @@ class Scope(Collector):
         use = self.spec.scene.furniture.get(body)
         if use is None or not use.only_when_mounted:
             return False
-        self.problem(path, f"furniture '{body}' is in the scene only when the robot is mounted on it (only_when_mounted: true), "
-                           "so nothing may refer to it; refer to furniture that is always there")
+        self.problem(
+            path,
+            f"furniture '{body}' is in the scene only when the robot is mounted on it (only_when_mounted: true), "
+            "so nothing may refer to it; refer to furniture that is always there",
+        )
         return True
 
     def point(self, value: str, path: tuple, *, allow_target: bool = True) -> dict[str, Any] | None:
@@ -117,7 +122,9 @@ class Scope(Collector):
         if body in self.body_names:
             body = self.tool_aliases.get(body, body)  # a one-arm robot's second name for its tool
         if body not in self.body_names or self.body_names[body] == "particles":
-            pool = [b for b, s in self.body_names.items() if s != "particles"] + (list(self.spec.targets) if allow_target else [])
+            pool = [b for b, s in self.body_names.items() if s != "particles"] + (
+                list(self.spec.targets) if allow_target else []
+            )
             what = "target or body" if allow_target else "body"
             self.problem(path, f"unknown {what} '{value}'; {expected(pool, body)}")
             return None
@@ -142,8 +149,10 @@ class Scope(Collector):
             if p is None:
                 continue
             if p["body"] != "person" or p["link"] not in self.person_urdf.surface_links:
-                pool = ["person." + l for l in self.person_urdf.surface_links]
-                self.problem(path + (i,), f"'{ref}' is not a person link with a collision shape; {expected(pool, ref, limit=21)}")
+                pool = ["person." + link for link in self.person_urdf.surface_links]
+                self.problem(
+                    path + (i,), f"'{ref}' is not a person link with a collision shape; {expected(pool, ref, limit=21)}"
+                )
                 continue
             out.append(p["link"])
         return out
@@ -167,7 +176,10 @@ class Scope(Collector):
         shape = self.spec.garments[name].shape
         sets = sleeve_node_sets(shape.rings, shape.segments)
         if set_name not in sets:
-            self.problem(path, f"unknown node set '{set_name}' of garment '{name}'; {expected(sets, set_name)} (write {name}.<set>)")
+            self.problem(
+                path,
+                f"unknown node set '{set_name}' of garment '{name}'; {expected(sets, set_name)} (write {name}.<set>)",
+            )
             return None
         return {"garment": name, "set": set_name, "nodes": [int(i) for i in sets[set_name]]}
 
@@ -175,7 +187,10 @@ class Scope(Collector):
         """``value`` if the spec's ``section`` (particles, markers, garments) declares it."""
         declared = getattr(self.spec, section)
         if value not in declared:
-            self.problem(path, f"unknown {what} '{value}'; {expected(declared, value, empty=f'none (declare one under {section}:)')}")
+            self.problem(
+                path,
+                f"unknown {what} '{value}'; {expected(declared, value, empty=f'none (declare one under {section}:)')}",
+            )
             return None
         return value
 
@@ -198,15 +213,34 @@ class Scope(Collector):
         return value  # frame: a literal pydantic already checked
 
 
-PERSON_PART_LINKS = {"hand": "wrist", "palm": "wrist", "fingers": "wrist", "forearm": "elbow", "upper_arm": "shoulder",
-                     "arm": "shoulder", "thigh": "hip", "leg": "hip", "shin": "knee", "calf": "knee", "lower_leg": "knee",
-                     "foot": "ankle", "heel": "ankle", "toes": "ankle"}
+PERSON_PART_LINKS = {
+    "hand": "wrist",
+    "palm": "wrist",
+    "fingers": "wrist",
+    "forearm": "elbow",
+    "upper_arm": "shoulder",
+    "arm": "shoulder",
+    "thigh": "hip",
+    "leg": "hip",
+    "shin": "knee",
+    "calf": "knee",
+    "lower_leg": "knee",
+    "foot": "ankle",
+    "heel": "ankle",
+    "toes": "ankle",
+}
 """Body parts by their everyday names → the person link that is that part (a limb link is named
 after the joint at its top, the reference's naming: the hand is ``right_wrist``)."""
 
 
-PERSON_PART_LANDMARKS = {"hand": ("palm", "fingertips"), "palm": ("palm",), "fingers": ("fingertips",), "foot": ("heel", "toes"),
-                         "heel": ("heel",), "toes": ("toes",)}
+PERSON_PART_LANDMARKS = {
+    "hand": ("palm", "fingertips"),
+    "palm": ("palm",),
+    "fingers": ("fingertips",),
+    "foot": ("heel", "toes"),
+    "heel": ("heel",),
+    "toes": ("toes",),
+}
 """Body parts → the landmarks on them (``person.right_palm`` ...)."""
 
 
@@ -216,14 +250,21 @@ def unknown_person_link(link: str, links) -> str:
     links and their frames are listed."""
     from ..person.landmarks import LANDMARKS
 
-    where = (f"; all {len(links)} links of the person and their frames: docs/person.md; landmarks: "
-             + ", ".join(LANDMARKS))
+    where = f"; all {len(links)} links of the person and their frames: docs/person.md; landmarks: " + ", ".join(
+        LANDMARKS
+    )
     side, _, part = link.partition("_") if link.startswith(("right_", "left_")) else ("", "", link)
     if part in PERSON_PART_LINKS:
-        names = [f"{side}_{PERSON_PART_LINKS[part]}"] if side else [f"right_{PERSON_PART_LINKS[part]}", f"left_{PERSON_PART_LINKS[part]}"]
+        names = (
+            [f"{side}_{PERSON_PART_LINKS[part]}"]
+            if side
+            else [f"right_{PERSON_PART_LINKS[part]}", f"left_{PERSON_PART_LINKS[part]}"]
+        )
         if all(n in links for n in names):
             points = [f"person.{side}_{lm}" for lm in PERSON_PART_LANDMARKS.get(part, ())] if side else []
             on_it = f", and person points on it: {', '.join(points)}" if points else ""
-            return (f"unknown link '{link}' of person; the {part.replace('_', ' ')} is link {' or '.join(repr(n) for n in names)} "
-                    f"(limb links are named after the joint at their top){on_it}{where}")
+            return (
+                f"unknown link '{link}' of person; the {part.replace('_', ' ')} is link {' or '.join(repr(n) for n in names)} "
+                f"(limb links are named after the joint at their top){on_it}{where}"
+            )
     return f"unknown link '{link}' of person; {expected(links, link)}{where}"

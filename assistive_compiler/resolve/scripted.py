@@ -29,10 +29,17 @@ def scripted(s: Scope) -> dict[str, Any] | None:
     check_per_robot_keys(s, ("scripted", "per_robot"), spec.scripted.per_robot)
     check_segments(s)
     own = spec.scripted.per_robot.get(s.robot_name)
-    out = _script(s, own, ("scripted", "per_robot", s.robot_name)) if own is not None else _script(s, spec.scripted, ("scripted",))
+    out = (
+        _script(s, own, ("scripted", "per_robot", s.robot_name))
+        if own is not None
+        else _script(s, spec.scripted, ("scripted",))
+    )
     if own is not None and own.ik_damping:
         out["ik_damping"] = _ik_damping(s, own.ik_damping)
-    for side in ("left", "right"):  # a two-arm robot: the left arm's part, and the right arm's own (replacing the main one)
+    for side in (
+        "left",
+        "right",
+    ):  # a two-arm robot: the left arm's part, and the right arm's own (replacing the main one)
         arm = getattr(spec.scripted, side)
         if arm is None or len(s.sides) < 2:
             continue
@@ -57,19 +64,29 @@ def check_segments(s: Scope) -> None:
                 continue
             used.add(item.segment)
             if item.segment not in names:
-                s.problem(("scripted",) + where + ("waypoints", i, "segment"), f"unknown segment '{item.segment}'; "
-                          f"{expected(names, item.segment, empty='none (declare one under scripted.segments:)')}")
+                s.problem(
+                    ("scripted",) + where + ("waypoints", i, "segment"),
+                    f"unknown segment '{item.segment}'; "
+                    f"{expected(names, item.segment, empty='none (declare one under scripted.segments:)')}",
+                )
     this_file = s.at().path
     for name, items in names.items():
         path = ("scripted", "segments", name)
         for j, item in enumerate(items):
             if isinstance(item, SegmentUse):
-                s.problem(path + (j, "segment"), f"segment '{name}' uses segment '{item.segment}'; a segment holds waypoints "
-                          "only: write them here, or splice both segments into the script one after the other")
+                s.problem(
+                    path + (j, "segment"),
+                    f"segment '{name}' uses segment '{item.segment}'; a segment holds waypoints "
+                    "only: write them here, or splice both segments into the script one after the other",
+                )
         if not items:
             s.problem(path, f"segment '{name}' has no waypoints; give it at least one, or delete it")
         elif name not in used and s.at(*path).path == this_file:
-            s.problem(path, f"segment '{name}' is never used; splice it into a script with {{segment: {name}}}, or delete it", key=True)
+            s.problem(
+                path,
+                f"segment '{name}' is never used; splice it into a script with {{segment: {name}}}, or delete it",
+                key=True,
+            )
 
 
 def _ik_damping(s: Scope, damping: dict[str, float]) -> dict[str, float]:
@@ -78,8 +95,10 @@ def _ik_damping(s: Scope, damping: dict[str, float]) -> dict[str, float]:
     arm = s.joint_groups["robot.arm"]["joints"]
     for name in damping:
         if name not in arm:
-            s.problem(("scripted", "per_robot", s.robot_name, "ik_damping", name),
-                      f"'{name}' is not an acting arm joint of robot '{s.robot_name}' ({', '.join(arm)})")
+            s.problem(
+                ("scripted", "per_robot", s.robot_name, "ik_damping", name),
+                f"'{name}' is not an acting arm joint of robot '{s.robot_name}' ({', '.join(arm)})",
+            )
     return dict(damping)
 
 
@@ -91,20 +110,39 @@ def _script(s: Scope, script, base: tuple) -> dict[str, Any]:
     step_m = getattr(script, "step_m", None)  # a robot's own script may set every straight-line waypoint's look-ahead
     for w, at in spec.scripted.spliced(script.waypoints, base + ("waypoints",)):
         to = s.point(w.to, at + ("to",))
-        used = {"normal_offset_m": w.normal_offset_m != 0.0, "axis_offset_m": w.axis_offset_m != 0.0,
-                "face_normal_within_deg": w.face_normal_within_deg is not None}
+        used = {
+            "normal_offset_m": w.normal_offset_m != 0.0,
+            "axis_offset_m": w.axis_offset_m != 0.0,
+            "face_normal_within_deg": w.face_normal_within_deg is not None,
+        }
         if w.face_normal_level and w.face_normal_within_deg is None:
-            s.problem(at + ("face_normal_level",), "face_normal_level turns the tool to face the surface only "
-                      "with face_normal_within_deg (how far to turn); add it or drop face_normal_level")
+            s.problem(
+                at + ("face_normal_level",),
+                "face_normal_level turns the tool to face the surface only "
+                "with face_normal_within_deg (how far to turn); add it or drop face_normal_level",
+            )
         for key in used:
             if used[key] and not (w.to in spec.targets and spec.targets[w.to].surface_of):
                 s.problem(at + (key,), f"{key} needs a target drawn on a surface (surface_of); '{w.to}' is not one")
-        waypoints.append({"to": to, "offset_m": list(w.offset_m), "tolerance_m": w.tolerance_m,
-                          "normal_offset_m": w.normal_offset_m, "axis_offset_m": w.axis_offset_m,
-                          "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
-                          "face_normal_within_rad": math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None}
-                         | ({"step_m": step_m or w.step_m} if w.step_m is not None else {})  # absent when unset: other artifacts unchanged
-                         | ({"face_normal_level": True} if w.face_normal_level else {})
-                         | ({"turn_step_rad": math.radians(w.turn_step_deg)} if w.turn_step_deg is not None else {}))
-    move, where = (script.move, base + ("move",)) if script.move is not None else (spec.scripted.move, ("scripted", "move"))  # a robot's own script may keep the task's point
+        waypoints.append(
+            {
+                "to": to,
+                "offset_m": list(w.offset_m),
+                "tolerance_m": w.tolerance_m,
+                "normal_offset_m": w.normal_offset_m,
+                "axis_offset_m": w.axis_offset_m,
+                "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
+                "face_normal_within_rad": math.radians(w.face_normal_within_deg)
+                if w.face_normal_within_deg is not None
+                else None,
+            }
+            | (
+                {"step_m": step_m or w.step_m} if w.step_m is not None else {}
+            )  # absent when unset: other artifacts unchanged
+            | ({"face_normal_level": True} if w.face_normal_level else {})
+            | ({"turn_step_rad": math.radians(w.turn_step_deg)} if w.turn_step_deg is not None else {})
+        )
+    move, where = (
+        (script.move, base + ("move",)) if script.move is not None else (spec.scripted.move, ("scripted", "move"))
+    )  # a robot's own script may keep the task's point
     return {"move": s.point(move, where), "waypoints": waypoints, "repeat_from": script.repeat_from}

@@ -28,7 +28,9 @@ def observations(s: Scope) -> dict[str, list[ResolvedTerm]]:
     out: dict[str, list[ResolvedTerm]] = {}
     for agent in ("robot", "human"):
         uses = getattr(s.spec.observations, agent)
-        resolved = [_term(s, use, "observation", ("observations", agent, i), f"{agent}_{i}", 1.0) for i, use in enumerate(uses)]
+        resolved = [
+            _term(s, use, "observation", ("observations", agent, i), f"{agent}_{i}", 1.0) for i, use in enumerate(uses)
+        ]
         out[agent] = [t for t in resolved if t]
     return out
 
@@ -37,11 +39,17 @@ def reward(s: Scope) -> list[ResolvedTerm]:
     """The reward terms that apply to this robot's number of acting arms, then the preferences."""
     spec = s.spec
     arms = len(s.sides)
-    out = [_term(s, t, "reward", ("reward", i), t.name, t.weight) for i, t in enumerate(spec.reward) if t.arms in (None, arms)]
+    out = [
+        _term(s, t, "reward", ("reward", i), t.name, t.weight)
+        for i, t in enumerate(spec.reward)
+        if t.arms in (None, arms)
+    ]
     names_seen: dict[str, int] = {}
     for i, t in enumerate(spec.reward):
         if t.name in names_seen:
-            s.problem(("reward", i, "name"), f"reward term name '{t.name}' is already used by reward[{names_seen[t.name]}]")
+            s.problem(
+                ("reward", i, "name"), f"reward term name '{t.name}' is already used by reward[{names_seen[t.name]}]"
+            )
         names_seen[t.name] = i
     out += _preferences(s)
     return [t for t in out if t]
@@ -103,7 +111,10 @@ def success_threshold(s: Scope) -> float:
             return success.threshold  # a fraction: the runtime multiplies by the variant's marker count
         if success.relative_to not in spec.particles:
             pool = list(spec.particles) + list(spec.markers)
-            s.problem(("success", "relative_to"), f"unknown particle or marker set '{success.relative_to}'; {expected(pool, success.relative_to, empty='none')}")
+            s.problem(
+                ("success", "relative_to"),
+                f"unknown particle or marker set '{success.relative_to}'; {expected(pool, success.relative_to, empty='none')}",
+            )
             return success.threshold
         return success.threshold * spec.particles[success.relative_to].count
     return success.threshold

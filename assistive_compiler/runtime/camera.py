@@ -33,8 +33,11 @@ def overlay_spheres(env) -> list[tuple[list[float], float, tuple]]:
     """(position m, radius m, rgba) of everything drawn for people only: shown targets, markers
     not yet cleared, carried particles."""
     m, snap = env.manifest, env.snap
-    spheres = [(snap.position(snap.point({"target": name})).tolist(), TARGET_RADIUS_M, tuple(t.show_rgba))
-                for name, t in m.targets.items() if t.show_rgba is not None]
+    spheres = [
+        (snap.position(snap.point({"target": name})).tolist(), TARGET_RADIUS_M, tuple(t.show_rgba))
+        for name, t in m.targets.items()
+        if t.show_rgba is not None
+    ]
     return spheres + env.markers.visual_spheres() + env.particles.visual_spheres()
 
 
@@ -55,8 +58,16 @@ def render_rgb(env, width: int = 480, height: int = 360, view: dict | None = Non
     for g in w.garments:  # TinyRenderer's soft-body mesh may be stale (see the module doc)
         pb.changeVisualShape(g.soft_id, -1, rgbaColor=[*g.rgba[:3], 0.0], physicsClientId=c)
     try:
-        _, _, rgba, depth, _ = pb.getCameraImage(width, height, view_m, proj, renderer=pb.ER_TINY_RENDERER,
-                                                 lightDirection=list(LIGHT_DIRECTION), shadow=0, physicsClientId=c)
+        _, _, rgba, depth, _ = pb.getCameraImage(
+            width,
+            height,
+            view_m,
+            proj,
+            renderer=pb.ER_TINY_RENDERER,
+            lightDirection=list(LIGHT_DIRECTION),
+            shadow=0,
+            physicsClientId=c,
+        )
     finally:
         for g in w.garments:
             pb.changeVisualShape(g.soft_id, -1, rgbaColor=list(g.rgba), physicsClientId=c)
@@ -115,7 +126,7 @@ def draw_frames(image: np.ndarray, frames, view_m, proj) -> None:
             labels.append((np.asarray(pos, dtype=float), [label]))
         else:
             near[1].append(label)
-    for label, pos, rot in frames:
+    for _label, pos, rot in frames:
         ends = [pos] + ([pos + FRAME_AXIS_M * rot[:, k] for k in range(3)] if rot is not None else [])
         px, w = to_pixels(np.asarray(ends), to_clip, width, height)
         if (w <= NEAR_M).any():
@@ -156,7 +167,9 @@ def _view_distance_m(depth: np.ndarray) -> np.ndarray:
     return FAR_M * NEAR_M / (FAR_M - (FAR_M - NEAR_M) * depth)
 
 
-def draw_mesh(image: np.ndarray, depth: np.ndarray, vertices: np.ndarray, faces: np.ndarray, rgba, view_m, proj) -> None:
+def draw_mesh(
+    image: np.ndarray, depth: np.ndarray, vertices: np.ndarray, faces: np.ndarray, rgba, view_m, proj
+) -> None:
     """Paint a triangle mesh (world-frame ``vertices`` m, ``faces`` vertex indices) onto ``image``
     in place, flat shaded from both sides and blended by ``rgba``'s alpha, where it is nearer
     than the depth buffer; ``depth`` is updated where it is drawn."""

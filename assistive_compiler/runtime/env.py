@@ -31,9 +31,10 @@ but can differ in the last digits from a replay.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
-from typing import Any, Callable
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -42,9 +43,9 @@ import pybullet as pb
 from ..artifact import Manifest, TermUse
 from ..rotation import capsule_axes
 from ..terms.registry import ref_fields, terms
-from .markers import MarkerSystem
 from .drive import BaseDriveControl, FollowerControl
 from .human import PersonController, draw_impairment  # noqa: F401  (draw_impairment: re-exported)
+from .markers import MarkerSystem
 from .particles import ParticleSystem
 from .snapshot import Snapshot
 from .world import PARK, World
@@ -114,8 +115,14 @@ class AssistiveEnv(gym.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
 
-    def __init__(self, artifact_dir: str | Path, render_mode: str | None = None, render_size: tuple[int, int] = (480, 360),
-                 camera: dict | None = None, manifest: Manifest | None = None):
+    def __init__(
+        self,
+        artifact_dir: str | Path,
+        render_mode: str | None = None,
+        render_size: tuple[int, int] = (480, 360),
+        camera: dict | None = None,
+        manifest: Manifest | None = None,
+    ):
         """``camera``: eye / target (world m) / fov_deg overriding the task's camera in renders.
         ``manifest``: the artifact's manifest when the caller has just compiled or checked it
         (``compile_task``'s result); otherwise it is read and every file checked against it."""
@@ -136,7 +143,11 @@ class AssistiveEnv(gym.Env):
         self.lower = np.array(m.robot.joint_lower)
         self.upper = np.array(m.robot.joint_upper)
         #: Per arm joint: target change per unit action per env step (rad or m).
-        self.delta_scale = m.robot.action_scale * m.sim.frame_skip * np.asarray(m.robot.action_multipliers or [1.0] * len(self.arm_idx))
+        self.delta_scale = (
+            m.robot.action_scale
+            * m.sim.frame_skip
+            * np.asarray(m.robot.action_multipliers or [1.0] * len(self.arm_idx))
+        )
         self._gains = [m.robot.position_gain] * len(self.arm_idx)
         self._forces = [m.robot.max_force] * len(self.arm_idx)
         # Followers (moved with an arm joint) and a mobile base's drive, both commanded with the arm.
@@ -144,8 +155,12 @@ class AssistiveEnv(gym.Env):
         self.follow = FollowerControl(self.world, m.robot.followers or {}, list(m.robot.arm_joints), self.delta_scale)
         self._arm_slice = slice(2, None) if self.drive else slice(None)
         self._command_idx = self.arm_idx + self.follow.idx + (self.drive.idx if self.drive else [])
-        self._command_gains = self._gains + [m.robot.position_gain] * len(self.follow.idx) + (self.drive.gains if self.drive else [])
-        self._command_forces = self._forces + [m.robot.max_force] * len(self.follow.idx) + (self.drive.forces if self.drive else [])
+        self._command_gains = (
+            self._gains + [m.robot.position_gain] * len(self.follow.idx) + (self.drive.gains if self.drive else [])
+        )
+        self._command_forces = (
+            self._forces + [m.robot.max_force] * len(self.follow.idx) + (self.drive.forces if self.drive else [])
+        )
 
         self.robot_features = Features(m.observations["robot"], self.snap)
         self.reward_fns = [(t.name, t.weight, bind_term(t, self.snap)) for t in m.reward]
@@ -153,7 +168,10 @@ class AssistiveEnv(gym.Env):
         self.markers = MarkerSystem(self.world, self.snap)
         self.success_threshold = m.success.threshold
         self.tool_point = self.snap.point({"body": "robot", "link": m.robot.links["tool_mount"]})
-        self._force_on_person = ([b.name for b in m.bodies if b.kind in ("robot", "tool")] + [g.name for g in m.garments], ["person"])
+        self._force_on_person = (
+            [b.name for b in m.bodies if b.kind in ("robot", "tool")] + [g.name for g in m.garments],
+            ["person"],
+        )
         self.observation_space = self.robot_features.space
         self.action_space = gym.spaces.Box(-1.0, 1.0, (m.robot.action_size,), np.float32)
         self.steps = 0
@@ -169,8 +187,9 @@ class AssistiveEnv(gym.Env):
         self.human_observation_space = self.human_features.space
 
     @classmethod
-    def from_spec(cls, spec: str | Path, robot: str | None = None, out_dir: str | Path | None = None,
-                  library=None, **kwargs) -> "AssistiveEnv":
+    def from_spec(
+        cls, spec: str | Path, robot: str | None = None, out_dir: str | Path | None = None, library=None, **kwargs
+    ) -> AssistiveEnv:
         """Compile ``spec`` for ``robot`` (a cache hit when unchanged) and build the env.
         ``library``: extra part directories (see :func:`assistive_compiler.library.Library.for_spec`)."""
         from ..compile.compiler import compile_task
@@ -178,7 +197,7 @@ class AssistiveEnv(gym.Env):
         return cls.from_compiled(compile_task(spec, robot, out_dir, library=library), **kwargs)
 
     @classmethod
-    def from_compiled(cls, result, **kwargs) -> "AssistiveEnv":
+    def from_compiled(cls, result, **kwargs) -> AssistiveEnv:
         """The env of ``result`` (a :class:`~assistive_compiler.compile.compiler.CompileResult`),
         on the manifest it carries: the artifact was just written or checked, so it is not read again."""
         return cls(result.out_dir, manifest=result.manifest, **kwargs)
@@ -206,7 +225,9 @@ class AssistiveEnv(gym.Env):
         for i, v in enumerate(m.person.variants):
             body = m.body(v.body)
             parked = (PARK[0] + 10.0 * i, PARK[1], PARK[2])
-            w.set_base_frame(w.variant_bodies[v.name], body.position if v.name == variant.name else parked, body.orientation)
+            w.set_base_frame(
+                w.variant_bodies[v.name], body.position if v.name == variant.name else parked, body.orientation
+            )
             w.set_asleep(w.variant_bodies[v.name], v.name != variant.name)
         person = w.variant_bodies[variant.name]
         # Joint angles (randomised), the impairment, and the hold: all drawn and set by the person controller.
@@ -232,8 +253,15 @@ class AssistiveEnv(gym.Env):
         q0 = list(start.joints) + self.follow.start(start.joints) + ([0.0, 0.0, 0.0] if self.drive else [])
         for i, q in zip(self._command_idx, q0):
             pb.resetJointState(w.robot.id, i, q, physicsClientId=c)
-        pb.setJointMotorControlArray(w.robot.id, self._command_idx, pb.POSITION_CONTROL, targetPositions=q0,
-                                     positionGains=self._command_gains, forces=self._command_forces, physicsClientId=c)
+        pb.setJointMotorControlArray(
+            w.robot.id,
+            self._command_idx,
+            pb.POSITION_CONTROL,
+            targetPositions=q0,
+            positionGains=self._command_gains,
+            forces=self._command_forces,
+            physicsClientId=c,
+        )
         # Tools follow the hand exactly.
         for att in m.tools:
             link_pos, link_orn = w.link_frame(w.robot, w.robot.links[att.parent_link])
@@ -288,8 +316,15 @@ class AssistiveEnv(gym.Env):
         target = np.minimum(np.maximum(q + self.delta_scale * arm_action, self.lower), self.upper).tolist()
         if len(self._command_idx) > len(self.arm_idx):  # followers and a drive, in one command with the arm
             target += self.follow.targets(arm_action) + (self.drive.targets(clipped[:2]) if self.drive else [])
-        pb.setJointMotorControlArray(w.robot.id, self._command_idx, pb.POSITION_CONTROL, targetPositions=target,
-                                     positionGains=self._command_gains, forces=self._command_forces, physicsClientId=c)
+        pb.setJointMotorControlArray(
+            w.robot.id,
+            self._command_idx,
+            pb.POSITION_CONTROL,
+            targetPositions=target,
+            positionGains=self._command_gains,
+            forces=self._command_forces,
+            physicsClientId=c,
+        )
         # The person: held / tremoring without a human action, else its policy joints act (runtime/human.py).
         human = None if human_action is None else np.asarray(human_action, dtype=np.float64).reshape(-1)
         self.human.apply(human, self.steps)

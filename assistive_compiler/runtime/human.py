@@ -161,13 +161,22 @@ class PersonController:
         strength = impairment.get("strength", 1.0)
         weak = set(impairment.get("joints", ()))
         self.hold_gains = [m.person.compliant_gain if j in compliant else m.person.hold_gain for j in movable]
-        self.hold_forces = [(m.person.compliant_force if j in compliant else m.person.hold_force)
-                            * (strength if j in weak else 1.0) for j in movable]
+        self.hold_forces = [
+            (m.person.compliant_force if j in compliant else m.person.hold_force) * (strength if j in weak else 1.0)
+            for j in movable
+        ]
         amplitude = impairment.get("amplitude", {})
         self._tremor = [(k, amplitude[j]) for k, j in enumerate(movable) if j in amplitude]
         if idx:
-            pb.setJointMotorControlArray(person.id, idx, pb.POSITION_CONTROL, targetPositions=self.hold,
-                                         positionGains=self.hold_gains, forces=self.hold_forces, physicsClientId=c)
+            pb.setJointMotorControlArray(
+                person.id,
+                idx,
+                pb.POSITION_CONTROL,
+                targetPositions=self.hold,
+                positionGains=self.hold_gains,
+                forces=self.hold_forces,
+                physicsClientId=c,
+            )
         # Policy joints: their places in the movable list, limits, gains and (weakened) forces.
         pol = [movable.index(j) for j in self.policy_joints]
         self._pol = pol
@@ -204,8 +213,15 @@ class PersonController:
                 targets = list(self.hold)
                 for k, eps in self._tremor:
                     targets[k] = self.hold[k] + sign * eps
-                pb.setJointMotorControlArray(self.body_id, self.idx, pb.POSITION_CONTROL, targetPositions=targets,
-                                             positionGains=self.hold_gains, forces=self.hold_forces, physicsClientId=c)
+                pb.setJointMotorControlArray(
+                    self.body_id,
+                    self.idx,
+                    pb.POSITION_CONTROL,
+                    targetPositions=targets,
+                    positionGains=self.hold_gains,
+                    forces=self.hold_forces,
+                    physicsClientId=c,
+                )
             if self._acting:  # back to the hold: tremor targets accumulate from the hold pose again
                 self._base = np.array([self.hold[k] for k in self._pol])
             self._acting = False
@@ -220,14 +236,26 @@ class PersonController:
             target = np.minimum(np.maximum(base + self.delta_scale * a, self._pol_lower), self._pol_upper)
             self._base = target
             command = target + sign * self._pol_eps
-            pb.setJointMotorControlArray(self.body_id, self.policy_idx, pb.POSITION_CONTROL, targetPositions=command.tolist(),
-                                         positionGains=self._pol_gains, forces=self.policy_forces, physicsClientId=c)
+            pb.setJointMotorControlArray(
+                self.body_id,
+                self.policy_idx,
+                pb.POSITION_CONTROL,
+                targetPositions=command.tolist(),
+                positionGains=self._pol_gains,
+                forces=self.policy_forces,
+                physicsClientId=c,
+            )
             if self._rest_tremor:  # tremoring joints outside the policy keep their oscillating hold
                 ks = [k for k, _ in self._rest_tremor]
-                pb.setJointMotorControlArray(self.body_id, [self.idx[k] for k in ks], pb.POSITION_CONTROL,
-                                             targetPositions=[self.hold[k] + sign * e for k, e in self._rest_tremor],
-                                             positionGains=[self.hold_gains[k] for k in ks], forces=[self.hold_forces[k] for k in ks],
-                                             physicsClientId=c)
+                pb.setJointMotorControlArray(
+                    self.body_id,
+                    [self.idx[k] for k in ks],
+                    pb.POSITION_CONTROL,
+                    targetPositions=[self.hold[k] + sign * e for k, e in self._rest_tremor],
+                    positionGains=[self.hold_gains[k] for k in ks],
+                    forces=[self.hold_forces[k] for k in ks],
+                    physicsClientId=c,
+                )
             self._acting = True
         self.world.after_physics_step = self.after_physics_step if (self._acting or self._static_hook) else None
 

@@ -24,7 +24,9 @@ class MarkerSystem:
     def __init__(self, world: World, snap: Snapshot):
         self.world, self.snap = world, snap
         self.sets = world.m.markers
-        self._tool = {ms.name: (world.bodies[ms.tool].id, world.bodies[ms.tool].links[ms.tool_link]) for ms in self.sets}
+        self._tool = {
+            ms.name: (world.bodies[ms.tool].id, world.bodies[ms.tool].links[ms.tool_link]) for ms in self.sets
+        }
         self.remaining: dict[str, np.ndarray] = {}
         self._groups: dict[str, list[tuple[int, np.ndarray, np.ndarray]]] = {}
 
@@ -77,5 +79,9 @@ class MarkerSystem:
             if ms.show_rgba is None:
                 continue
             where = self.positions(ms.name)
-            out += [(where[k].tolist(), MARKER_RADIUS_M, tuple(ms.show_rgba)) for k in range(len(where)) if self.remaining[ms.name][k]]
+            out += [
+                (where[k].tolist(), MARKER_RADIUS_M, tuple(ms.show_rgba))
+                for k in range(len(where))
+                if self.remaining[ms.name][k]
+            ]
         return out

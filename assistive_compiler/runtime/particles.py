@@ -85,7 +85,9 @@ class ParticleSystem:
         #: when the world has no downward gravity.
         g = -world.world_gravity
         self.repark_steps = max(1, int(math.sqrt(2.0 * (PARK[2] - 1.0) / g) / self._dt)) if g > 0 else None
-        self._parked_age: dict[int, tuple[int, int]] = {}  # parked particle id → (env steps since parked, index k in its set)
+        self._parked_age: dict[
+            int, tuple[int, int]
+        ] = {}  # parked particle id → (env steps since parked, index k in its set)
 
     # -- containers ------------------------------------------------------------------------------
     def _container_state(self, box: Container):
@@ -116,11 +118,13 @@ class ParticleSystem:
     def _inside(box: Container, local: np.ndarray) -> np.ndarray:
         """Which container-frame points (n, 3) lie in the container's cylinder."""
         r2 = local[:, 0] ** 2 + local[:, 1] ** 2
-        return (r2 <= box.radius ** 2) & (local[:, 2] >= -box.radius) & (local[:, 2] <= box.height)
+        return (r2 <= box.radius**2) & (local[:, 2] >= -box.radius) & (local[:, 2] <= box.height)
 
     def _positions(self, ids: list[int]) -> np.ndarray:
         c, pose = self.world.client, pb.getBasePositionAndOrientation
-        return np.array([pose(pid, c)[0] for pid in ids], dtype=float).reshape(-1, 3)  # positional: pybullet parses keywords slowly
+        return np.array([pose(pid, c)[0] for pid in ids], dtype=float).reshape(
+            -1, 3
+        )  # positional: pybullet parses keywords slowly
 
     def _carry(self, ps: ParticleSet, ids: list[int], which: np.ndarray, local: np.ndarray) -> None:
         """Park the particles ``which`` (bool mask) and remember their container-frame positions."""
@@ -140,7 +144,7 @@ class ParticleSystem:
 
     def _release(self, ps: ParticleSet, ids: list[int]) -> None:
         """Put the carried particles back where they were carried, moving with the container."""
-        w, c = self.world, self.world.client
+        c = self.world.client
         pos, rot, com, lin, ang = self._container_state(ps.rest.container)
         carried, at = self.carried[ps.name], self.carried_at[ps.name]
         for k in np.flatnonzero(carried):
@@ -185,8 +189,11 @@ class ParticleSystem:
             if ps.rest is None or not self.carried[ps.name].any():
                 continue
             up = self._last_up[ps.name]
-            if (vec_angle(up, self._rest_up[ps.name]) > ps.rest.max_turn or vec_angle(up, _AXIS) > ps.rest.max_tilt
-                    or self._near.get(ps.name, False)):
+            if (
+                vec_angle(up, self._rest_up[ps.name]) > ps.rest.max_turn
+                or vec_angle(up, _AXIS) > ps.rest.max_tilt
+                or self._near.get(ps.name, False)
+            ):
                 self._release(ps, ids)
 
     def _container_near(self, ps: ParticleSet) -> bool:
@@ -196,8 +203,11 @@ class ParticleSystem:
             return False
         w = self.world
         holder, near = w.bodies[rest.container.body], self.snap.handle(self.snap.body_key(rest.near_body))
-        return bool(pb.getClosestPoints(holder.id, near.id, rest.near_distance, holder.links[rest.container.link],
-                                        physicsClientId=w.client))
+        return bool(
+            pb.getClosestPoints(
+                holder.id, near.id, rest.near_distance, holder.links[rest.container.link], physicsClientId=w.client
+            )
+        )
 
     def _maybe_carry(self, ps: ParticleSet, ids: list[int], settled: bool = False) -> None:
         """After an env step: carry the set's free particles if they have rested in their container
@@ -229,8 +239,17 @@ class ParticleSystem:
         self._rest_up[name] = up
         self._still_steps[name] = 0
 
-    def _still(self, ps: ParticleSet, ids: list[int], idx: np.ndarray, world: np.ndarray, local: np.ndarray,
-               com: np.ndarray, lin: np.ndarray, ang: np.ndarray) -> bool:
+    def _still(
+        self,
+        ps: ParticleSet,
+        ids: list[int],
+        idx: np.ndarray,
+        world: np.ndarray,
+        local: np.ndarray,
+        com: np.ndarray,
+        lin: np.ndarray,
+        ang: np.ndarray,
+    ) -> bool:
         """Whether the free particles ``idx`` (world and container-frame positions, m) are still in
         their container this env step: all inside it, and their mean speed relative to it (m/s) at
         most ``rest.max_speed``."""
@@ -244,7 +263,9 @@ class ParticleSystem:
     def _park(self, pid: int, k: int) -> None:
         """Put particle ``pid`` (index ``k`` in its set) at its parking spot, at rest."""
         c = self.world.client
-        pb.resetBasePositionAndOrientation(pid, (PARK[0] - 5.0 - 0.1 * k, PARK[1], PARK[2]), (0, 0, 0, 1), physicsClientId=c)
+        pb.resetBasePositionAndOrientation(
+            pid, (PARK[0] - 5.0 - 0.1 * k, PARK[1], PARK[2]), (0, 0, 0, 1), physicsClientId=c
+        )
         pb.resetBaseVelocity(pid, (0, 0, 0), (0, 0, 0), physicsClientId=c)
         self.world.parked.add(pid)
         self._parked_age[pid] = (0, k)
@@ -312,8 +333,11 @@ class ParticleSystem:
                     ev.consumed_speed_sum += math.hypot(*base_velocity(pid, physicsClientId=c)[0])
                     active[k] = False
                     self._park(pid, int(k))
-                elif (lost_id is not None and to_anchor[j] >= ps.lost_distance
-                      and not closest(pid, lost_id, ps.lost_distance, physicsClientId=c)):
+                elif (
+                    lost_id is not None
+                    and to_anchor[j] >= ps.lost_distance
+                    and not closest(pid, lost_id, ps.lost_distance, physicsClientId=c)
+                ):
                     # Within lost_distance of a point inside the holder means certainly near it;
                     # only otherwise is the exact closest-points query needed.
                     ev.lost += 1

@@ -20,8 +20,9 @@ import pybullet as pb
 from ..rotation import quat_conj, quat_mul, quat_rotate  # noqa: F401  (re-exported)
 from .world import World, rotation_matrix
 
-
-CLOSEST_SLACK_M = 0.05  # closest_distance first looks this far beyond its last answer (m); any value gives the same result
+CLOSEST_SLACK_M = (
+    0.05  # closest_distance first looks this far beyond its last answer (m); any value gives the same result
+)
 
 
 @dataclass(frozen=True)
@@ -82,7 +83,9 @@ class Snapshot:
         self.pos, self.orn, self.vel = np.zeros((0, 3)), np.zeros((0, 4)), np.zeros((0, 3))
         self.frames: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self._ids: dict[tuple[str, ...], tuple[int, ...]] = {}
-        self._closest_hint: dict[tuple, float] = {}  # last closest_distance per (body, bodies): where the next query starts
+        self._closest_hint: dict[
+            tuple, float
+        ] = {}  # last closest_distance per (body, bodies): where the next query starts
         self._garment_nodes: dict[int, np.ndarray] = {}
         # pybullet reports a soft body's contact forces of its last solver sub-step only: scale them
         # back to the physics step (docs/dressing-study.md: then Σ|f_n| ≈ the weight it rests on).
@@ -168,7 +171,9 @@ class Snapshot:
         for key, reads in self._reads.items():
             h = self.handle(key)
             if reads.links:
-                states = pb.getLinkStates(h.id, reads.links, computeLinkVelocity=1, computeForwardKinematics=1, physicsClientId=c)
+                states = pb.getLinkStates(
+                    h.id, reads.links, computeLinkVelocity=1, computeForwardKinematics=1, physicsClientId=c
+                )
                 for slot, s in zip(reads.slots, states):
                     pos[slot] = s[4]
                     orn[slot] = s[5]
@@ -323,5 +328,7 @@ class Snapshot:
     def contact_force_and_count(self, a: str, b, distance: float) -> tuple[float, int]:
         """Contact force of body ``a`` on ``b`` (N) and the number of closest points within ``distance``."""
         ia = self.body_ids([a])[0]
-        count = sum(len(pb.getClosestPoints(ia, ib, distance, physicsClientId=self.world.client)) for ib in self.body_ids(b))
+        count = sum(
+            len(pb.getClosestPoints(ia, ib, distance, physicsClientId=self.world.client)) for ib in self.body_ids(b)
+        )
         return self.contact_force([a], b), count

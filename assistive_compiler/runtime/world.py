@@ -28,9 +28,9 @@ Frames: pybullet reports a base's pose at its centre of mass; :meth:`base_frame`
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 import pybullet as pb
@@ -38,7 +38,11 @@ import pybullet as pb
 from ..artifact import Manifest
 from ..bullet import connect, use_contact_breaking_threshold
 
-PARK = (0.0, 500.0, 50.0)  # where inactive bodies (other person variants, removed particles) wait: far away, beyond the floor's edge, m
+PARK = (
+    0.0,
+    500.0,
+    50.0,
+)  # where inactive bodies (other person variants, removed particles) wait: far away, beyond the floor's edge, m
 FLOOR_HALF_M = 20.0  # the floor slab's half width, m: the scene sits near the origin
 
 
@@ -96,18 +100,29 @@ class World:
         self._build()
 
     def _build(self) -> None:
-        self.client = connect(self.m.sim.contact_breaking_threshold, deformable=bool(self.m.garments))  # cloth needs Bullet's deformable world
+        self.client = connect(
+            self.m.sim.contact_breaking_threshold, deformable=bool(self.m.garments)
+        )  # cloth needs Bullet's deformable world
         c = self.client
         sim = self.m.sim
-        pb.setPhysicsEngineParameter(numSolverIterations=sim.solver_iterations, deterministicOverlappingPairs=1, physicsClientId=c)
+        pb.setPhysicsEngineParameter(
+            numSolverIterations=sim.solver_iterations, deterministicOverlappingPairs=1, physicsClientId=c
+        )
 
         # The floor: a slab, top face at z = 0, not a GEOM_PLANE. A plane's bounding box is
         # infinite, so every link in the world overlapped it in the broadphase and got a
         # narrowphase test each physics step (a tenth of a Scratch Itch step's physics); the slab
         # pairs only with what comes near the floor. Outside it (beyond ±FLOOR_HALF_M) is the
         # parking area, where nothing should touch anything.
-        floor = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[FLOOR_HALF_M, FLOOR_HALF_M, 0.5], collisionFramePosition=[0, 0, -0.5], physicsClientId=c)
-        floor_visual = pb.createVisualShape(pb.GEOM_BOX, halfExtents=[5, 5, 0.0005], rgbaColor=[0.85, 0.85, 0.82, 1], physicsClientId=c)
+        floor = pb.createCollisionShape(
+            pb.GEOM_BOX,
+            halfExtents=[FLOOR_HALF_M, FLOOR_HALF_M, 0.5],
+            collisionFramePosition=[0, 0, -0.5],
+            physicsClientId=c,
+        )
+        floor_visual = pb.createVisualShape(
+            pb.GEOM_BOX, halfExtents=[5, 5, 0.0005], rgbaColor=[0.85, 0.85, 0.82, 1], physicsClientId=c
+        )
         self.ground = pb.createMultiBody(0, floor, floor_visual, [0, 0, 0], physicsClientId=c)
 
         self.bodies: dict[str, BodyHandle] = {}
@@ -116,7 +131,14 @@ class World:
             self_collision = body.kind == "person" and bool(self.m.person.self_collision)
             if self_collision:
                 flags |= pb.URDF_USE_SELF_COLLISION
-            bid = pb.loadURDF(str(self.dir / body.urdf), body.position, body.orientation, useFixedBase=body.fixed_base, flags=flags, physicsClientId=c)
+            bid = pb.loadURDF(
+                str(self.dir / body.urdf),
+                body.position,
+                body.orientation,
+                useFixedBase=body.fixed_base,
+                flags=flags,
+                physicsClientId=c,
+            )
             self.bodies[body.name] = self._handle(body.name, bid)
             if self_collision:
                 self._set_self_collision(self.bodies[body.name])
@@ -126,7 +148,9 @@ class World:
             # Disable the default velocity motors so joints are free unless we drive them.
             joints = list(range(pb.getNumJoints(bid, physicsClientId=c)))
             if joints:
-                pb.setJointMotorControlArray(bid, joints, pb.VELOCITY_CONTROL, forces=[0.0] * len(joints), physicsClientId=c)
+                pb.setJointMotorControlArray(
+                    bid, joints, pb.VELOCITY_CONTROL, forces=[0.0] * len(joints), physicsClientId=c
+                )
 
         self._skip_immovable_pairs()
         self.robot = self.bodies["robot"]
@@ -137,8 +161,12 @@ class World:
         self._create_garments()
         self._set_gravity()
         self._set_stepping()
-        visual_only = {b for g in self.garments for b in (g.soft_id, g.anchor_id)}  # garments are reset by reset_garments()
-        self._all_bodies = [b for b in range(pb.getNumBodies(physicsClientId=c)) if b != self.ground and b not in visual_only]
+        visual_only = {
+            b for g in self.garments for b in (g.soft_id, g.anchor_id)
+        }  # garments are reset by reset_garments()
+        self._all_bodies = [
+            b for b in range(pb.getNumBodies(physicsClientId=c)) if b != self.ground and b not in visual_only
+        ]
         # Bodies at rest would otherwise fall asleep after ~2 s; sleep is not part of a saved state,
         # so an episode would depend on how long the previous one left something resting.
         for bid in self._all_bodies:
@@ -176,13 +204,16 @@ class World:
             if not body.fixed_base:
                 continue
             bid = self.bodies[body.name].id
-            moving = {l for l, _ in self._moving_links(bid)}
-            links = [l for l in range(-1, pb.getNumJoints(bid, physicsClientId=c))
-                     if l not in moving and pb.getCollisionShapeData(bid, l, physicsClientId=c)]
+            moving = {index for index, _ in self._moving_links(bid)}
+            links = [
+                index
+                for index in range(-1, pb.getNumJoints(bid, physicsClientId=c))
+                if index not in moving and pb.getCollisionShapeData(bid, index, physicsClientId=c)
+            ]
             if links:
                 still.append((bid, links))
         for i, (a, links_a) in enumerate(still):
-            for b, links_b in still[i + 1:]:
+            for b, links_b in still[i + 1 :]:
                 for la in links_a:
                     for lb in links_b:
                         if la >= 0 or lb >= 0:  # two fixed bases are static colliders: Bullet never pairs them
@@ -201,7 +232,7 @@ class World:
         c, bid = self.client, handle.id
         links = sorted(handle.links.values())
         for i, a in enumerate(links):
-            for b in links[i + 1:]:
+            for b in links[i + 1 :]:
                 pb.setCollisionFilterPair(bid, bid, a, b, 0, physicsClientId=c)
         for a, b in self.m.person.self_collision:
             if a in handle.links and b in handle.links:
@@ -224,8 +255,19 @@ class World:
             p_inv = pb.invertTransform(*p_inertial)
             parent_pos, parent_orn = pb.multiplyTransforms(p_inv[0], p_inv[1], att.position, att.orientation)
             child_pos, child_orn = tool.inertial_inv
-            cid = pb.createConstraint(self.robot.id, parent, tool.id, -1, pb.JOINT_FIXED, [0, 0, 0], parent_pos, child_pos,
-                                      parent_orn, child_orn, physicsClientId=c)
+            cid = pb.createConstraint(
+                self.robot.id,
+                parent,
+                tool.id,
+                -1,
+                pb.JOINT_FIXED,
+                [0, 0, 0],
+                parent_pos,
+                child_pos,
+                parent_orn,
+                child_orn,
+                physicsClientId=c,
+            )
             pb.changeConstraint(cid, maxForce=500, physicsClientId=c)
             self.tool_constraints[att.body] = cid
             for link in self.robot.links.values():
@@ -240,8 +282,14 @@ class World:
             shape = pb.createCollisionShape(pb.GEOM_SPHERE, radius=ps.radius, physicsClientId=c)
             ids = []
             for i in range(ps.count):
-                visual = pb.createVisualShape(pb.GEOM_SPHERE, radius=ps.radius, rgbaColor=list(ps.colors[i]), physicsClientId=c)
-                ids.append(pb.createMultiBody(ps.mass, shape, visual, [PARK[0] - 5.0 - 0.1 * i, PARK[1] + 1.0, PARK[2]], physicsClientId=c))
+                visual = pb.createVisualShape(
+                    pb.GEOM_SPHERE, radius=ps.radius, rgbaColor=list(ps.colors[i]), physicsClientId=c
+                )
+                ids.append(
+                    pb.createMultiBody(
+                        ps.mass, shape, visual, [PARK[0] - 5.0 - 0.1 * i, PARK[1] + 1.0, PARK[2]], physicsClientId=c
+                    )
+                )
             self.particles[ps.name] = ids
 
     def _create_garments(self) -> None:
@@ -255,14 +303,45 @@ class World:
         self.garments: list[GarmentHandle] = []
         for k, g in enumerate(self.m.garments):
             park = (PARK[0] + 20.0 + 5.0 * k, PARK[1], PARK[2])
-            sb, anchor = load_garment(pb, c, self.dir / g.obj, park, (0, 0, 0, 1), g.mass, g.collision_margin, g.elastic_stiffness,
-                                      g.damping_stiffness, g.bending_stiffness, g.friction, g.anchored, rgba=g.rgba)
-            self.garments.append(GarmentHandle(g.name, sb, anchor, self.robot.links[g.parent_link], (g.grip_position, g.grip_orientation),
-                                               np.asarray(g.nodes_in_held, dtype=float), read_obj_faces(self.dir / g.obj), tuple(g.rgba)))
-            self.bodies[g.name] = BodyHandle(g.name, sb, {"held": -1}, {}, ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)), pose_id=anchor)
+            sb, anchor = load_garment(
+                pb,
+                c,
+                self.dir / g.obj,
+                park,
+                (0, 0, 0, 1),
+                g.mass,
+                g.collision_margin,
+                g.elastic_stiffness,
+                g.damping_stiffness,
+                g.bending_stiffness,
+                g.friction,
+                g.anchored,
+                rgba=g.rgba,
+            )
+            self.garments.append(
+                GarmentHandle(
+                    g.name,
+                    sb,
+                    anchor,
+                    self.robot.links[g.parent_link],
+                    (g.grip_position, g.grip_orientation),
+                    np.asarray(g.nodes_in_held, dtype=float),
+                    read_obj_faces(self.dir / g.obj),
+                    tuple(g.rgba),
+                )
+            )
+            self.bodies[g.name] = BodyHandle(
+                g.name, sb, {"held": -1}, {}, ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)), pose_id=anchor
+            )
             if g.collides_with is not None:  # contact with every other body (and the floor) off
-                keep = {b.name for b in self.m.bodies if (b.kind == "person" and "person" in g.collides_with) or b.name in g.collides_with}
-                others = [self.ground] + [h.id for name, h in self.bodies.items() if name not in keep and name != g.name]
+                keep = {
+                    b.name
+                    for b in self.m.bodies
+                    if (b.kind == "person" and "person" in g.collides_with) or b.name in g.collides_with
+                }
+                others = [self.ground] + [
+                    h.id for name, h in self.bodies.items() if name not in keep and name != g.name
+                ]
                 for bid in others:
                     for link in range(-1, pb.getNumJoints(bid, physicsClientId=c)):
                         pb.setCollisionFilterPair(sb, bid, -1, link, 0, physicsClientId=c)
@@ -294,7 +373,10 @@ class World:
 
     def garment_nodes(self, g: GarmentHandle) -> np.ndarray:
         """(n, 3) node positions of a garment, world frame, m."""
-        return np.asarray(pb.getMeshData(g.soft_id, -1, flags=pb.MESH_DATA_SIMULATION_MESH, physicsClientId=self.client)[1], dtype=float)
+        return np.asarray(
+            pb.getMeshData(g.soft_id, -1, flags=pb.MESH_DATA_SIMULATION_MESH, physicsClientId=self.client)[1],
+            dtype=float,
+        )
 
     def _set_gravity(self) -> None:
         """Choose the world gravity needing the fewest compensated links; list those links."""
@@ -302,7 +384,7 @@ class World:
         candidates: dict[float, list[tuple[int, int, float]]] = {}
         declared = {b.name: (self.m.sim.gravity if b.gravity is None else b.gravity) for b in self.m.bodies}
         for ps in self.m.particles:
-            for k, pid in enumerate(self.particles[ps.name]):
+            for k in range(len(self.particles[ps.name])):
                 declared[f"{ps.name}#{k}"] = self.m.sim.gravity
         options = sorted(set(declared.values()) | ({self.m.sim.gravity} if self.m.garments else set()))
         for g_world in options:
@@ -315,7 +397,9 @@ class World:
                     comp.append((bid, link, mass * (g - g_world)))
             candidates[g_world] = comp
         # A soft body feels only the world gravity: with a garment that is the spec's sim gravity.
-        self.world_gravity = self.m.sim.gravity if self.m.garments else min(options, key=lambda g: (len(candidates[g]), -abs(g)))
+        self.world_gravity = (
+            self.m.sim.gravity if self.m.garments else min(options, key=lambda g: (len(candidates[g]), -abs(g)))
+        )
         groups: dict[int, tuple[list[int], list[float]]] = {}
         for bid, link, fz in candidates[self.world_gravity]:
             links, forces = groups.setdefault(bid, ([], []))
@@ -323,7 +407,9 @@ class World:
             forces.append(fz)
         #: Per body: (id, links, z-forces) applied before every physics step; ids in ``parked`` are skipped.
         self.gravity_groups = [(bid, links, forces) for bid, (links, forces) in groups.items()]
-        self._gravity_plan = None  # gravity_groups and loads rearranged for the per-step loop (see _apply_gravity_compensation)
+        self._gravity_plan = (
+            None  # gravity_groups and loads rearranged for the per-step loop (see _apply_gravity_compensation)
+        )
         #: (body id, link) → a z-force (N, world frame) applied at the link's centre of mass with the gravity compensation.
         self.loads: dict[tuple[int, int], float] = {}
         self.parked: set[int] = set()
@@ -396,14 +482,27 @@ class World:
         base_pose, link_states = pb.getBasePositionAndOrientation, pb.getLinkStates
         parked = self.parked
         plan = self._gravity_plan
-        if plan is None or plan[0] is not self.gravity_groups:  # per body: base force, child links, their forces (built on change)
+        if (
+            plan is None or plan[0] is not self.gravity_groups
+        ):  # per body: base force, child links, their forces (built on change)
             per_body: dict[int, dict[int, float]] = {}
-            for (bid, link), fz in [((bid, l), f) for bid, links, forces in self.gravity_groups for l, f in zip(links, forces)] + list(self.loads.items()):
+            for (bid, link), fz in [
+                ((bid, index), f) for bid, links, forces in self.gravity_groups for index, f in zip(links, forces)
+            ] + list(self.loads.items()):
                 on_body = per_body.setdefault(bid, {})
                 on_body[link] = on_body.get(link, 0.0) + fz
-            plan = self._gravity_plan = (self.gravity_groups, [
-                (bid, (0.0, 0.0, f[-1]) if -1 in f else None, [l for l in f if l >= 0], [(0.0, 0.0, f[l]) for l in f if l >= 0])
-                for bid, f in per_body.items()])
+            plan = self._gravity_plan = (
+                self.gravity_groups,
+                [
+                    (
+                        bid,
+                        (0.0, 0.0, f[-1]) if -1 in f else None,
+                        [index for index in f if index >= 0],
+                        [(0.0, 0.0, f[index]) for index in f if index >= 0],
+                    )
+                    for bid, f in per_body.items()
+                ],
+            )
         # Positional arguments: pybullet parses keywords slowly (0.5 µs per force here, up to 90 per env step).
         for bid, base_force, children, child_forces in plan[1]:
             if bid in parked:
@@ -424,14 +523,19 @@ class World:
         touches nothing and so is never woken during an episode. Only for bodies at rest: waking
         does not give a multibody back the velocity it had.
         """
-        flags = (pb.ACTIVATION_STATE_ENABLE_SLEEPING | pb.ACTIVATION_STATE_SLEEP) if asleep else \
-            (pb.ACTIVATION_STATE_DISABLE_SLEEPING | pb.ACTIVATION_STATE_WAKE_UP)
+        flags = (
+            (pb.ACTIVATION_STATE_ENABLE_SLEEPING | pb.ACTIVATION_STATE_SLEEP)
+            if asleep
+            else (pb.ACTIVATION_STATE_DISABLE_SLEEPING | pb.ACTIVATION_STATE_WAKE_UP)
+        )
         pb.changeDynamics(handle.id, -1, activationState=flags, physicsClientId=self.client)
 
     # -- frames --------------------------------------------------------------------------------
     def base_frame(self, handle: BodyHandle):
         """World pose of a body's URDF base frame (a garment's: its held frame)."""
-        com_pos, com_orn = pb.getBasePositionAndOrientation(handle.id if handle.pose_id is None else handle.pose_id, physicsClientId=self.client)
+        com_pos, com_orn = pb.getBasePositionAndOrientation(
+            handle.id if handle.pose_id is None else handle.pose_id, physicsClientId=self.client
+        )
         return pb.multiplyTransforms(com_pos, com_orn, *handle.inertial_inv)
 
     def set_base_frame(self, handle: BodyHandle, pos, orn) -> None:
@@ -457,7 +561,9 @@ class World:
         use_contact_breaking_threshold(c, self.m.sim.contact_breaking_threshold)  # process-wide in pybullet
         pb.restoreState(self.initial_state, physicsClientId=c)
         for k, bid in enumerate(self._all_bodies):
-            pb.resetBasePositionAndOrientation(bid, (PARK[0] + 1000.0 + 10.0 * k, PARK[1], PARK[2]), (0, 0, 0, 1), physicsClientId=c)
+            pb.resetBasePositionAndOrientation(
+                bid, (PARK[0] + 1000.0 + 10.0 * k, PARK[1], PARK[2]), (0, 0, 0, 1), physicsClientId=c
+            )
         pb.performCollisionDetection(physicsClientId=c)
         pb.restoreState(self.initial_state, physicsClientId=c)
 

@@ -60,7 +60,12 @@ class _Merger:
         if REPLACE in override:
             if len(override) > 1:
                 others = ", ".join(sorted(k for k in override if k != REPLACE))
-                self.problems.append(Problem(self.smap.key(at + (REPLACE,)), f"'{REPLACE}' stands alone in its mapping (it replaces the whole inherited value); move {others} inside it"))
+                self.problems.append(
+                    Problem(
+                        self.smap.key(at + (REPLACE,)),
+                        f"'{REPLACE}' stands alone in its mapping (it replaces the whole inherited value); move {others} inside it",
+                    )
+                )
             self.cleared.append(path)
             return self.merge(None, override[REPLACE], at + (REPLACE,), path)
         out = dict(base) if isinstance(base, dict) else {}
@@ -79,12 +84,18 @@ class _Merger:
         names = [names] if isinstance(names, str) else names
         inherited = sorted(base) if isinstance(base, dict) else []
         if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
-            self.problems.append(Problem(where, f"'{DELETE}' takes a list of inherited keys to remove, e.g. {DELETE}: [female_50th]"))
+            self.problems.append(
+                Problem(where, f"'{DELETE}' takes a list of inherited keys to remove, e.g. {DELETE}: [female_50th]")
+            )
             return []
         for name in names:
             if name not in inherited:
                 has = f"inherited keys here: {', '.join(inherited)}" if inherited else "nothing is inherited here"
-                self.problems.append(Problem(where, f"'{DELETE}': no inherited key '{name}' to remove ({has}){did_you_mean(name, inherited)}"))
+                self.problems.append(
+                    Problem(
+                        where, f"'{DELETE}': no inherited key '{name}' to remove ({has}){did_you_mean(name, inherited)}"
+                    )
+                )
         return names
 
 
@@ -98,7 +109,7 @@ def _merged_source_map(smap: SourceMap, base: SourceMap | None, cleared: list[tu
         return tuple(k for k in path if k != REPLACE)
 
     def kept(path: tuple) -> bool:
-        return not any(path[:len(c)] == c for c in cleared)
+        return not any(path[: len(c)] == c for c in cleared)
 
     out = SourceMap(default=smap.default or (base.default if base else None))
     if base is not None:
@@ -109,7 +120,9 @@ def _merged_source_map(smap: SourceMap, base: SourceMap | None, cleared: list[tu
     return out
 
 
-def deep_merge(base: Any, override: Any, smap: SourceMap | None = None, base_smap: SourceMap | None = None) -> tuple[Any, SourceMap]:
+def deep_merge(
+    base: Any, override: Any, smap: SourceMap | None = None, base_smap: SourceMap | None = None
+) -> tuple[Any, SourceMap]:
     """``override`` laid over ``base``: mappings merge key by key, anything else is replaced;
     ``$delete`` / ``$replace`` (see :data:`DELETE`) remove or replace inherited values. Returns
     the merged data and where each of its values was written (``smap`` over ``base_smap``).
@@ -124,7 +137,7 @@ def deep_merge(base: Any, override: Any, smap: SourceMap | None = None, base_sma
 
 def _parent_path(path: Path, ref: str) -> Path:
     if ref.startswith(SHIPPED_PREFIX):
-        return (specs_dir() / ref[len(SHIPPED_PREFIX):]).resolve()
+        return (specs_dir() / ref[len(SHIPPED_PREFIX) :]).resolve()
     return (path.parent / ref).resolve()
 
 
@@ -144,7 +157,9 @@ def _load_tree(path: Path, chain: tuple[Path, ...]) -> tuple[dict, SourceMap, tu
         raise SpecError([Problem(where, f"extends forms a cycle: {cycle}")])
     if not parent.is_file():
         relative_to = "the shipped specs/" if parent_ref.startswith(SHIPPED_PREFIX) else f"{display(path.parent)}/"
-        raise SpecError([Problem(where, f"extends: file not found: {display(parent)} (paths are relative to {relative_to})")])
+        raise SpecError(
+            [Problem(where, f"extends: file not found: {display(parent)} (paths are relative to {relative_to})")]
+        )
     if len(chain) >= MAX_EXTENDS_DEPTH:
         raise SpecError([Problem(where, f"extends is nested more than {MAX_EXTENDS_DEPTH} deep")])
     base_data, base_smap, base_files = _load_tree(parent, chain + (path,))

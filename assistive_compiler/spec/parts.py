@@ -38,19 +38,26 @@ class Arm(Strict):
         "tubes, one action). Followers are not in the action or in joint-angle observations.",
     )
     action_multipliers: list[float] | None = Field(
-        None, description="Per arm joint, a factor on the task's action scale (the reference's per-robot action multipliers, "
-        "e.g. Stretch's lift 2, telescoping 1, wrist 2); default 1 for every joint."
+        None,
+        description="Per arm joint, a factor on the task's action scale (the reference's per-robot action multipliers, "
+        "e.g. Stretch's lift 2, telescoping 1, wrist 2); default 1 for every joint.",
     )
 
     @model_validator(mode="after")
-    def _followers_and_multipliers(self) -> "Arm":
+    def _followers_and_multipliers(self) -> Arm:
         for follower, leader in self.follow.items():
             if leader not in self.joints:
-                raise ValueError(f"@follow: follower '{follower}' follows '{leader}', which is not one of this arm's joints {self.joints}")
+                raise ValueError(
+                    f"@follow: follower '{follower}' follows '{leader}', which is not one of this arm's joints {self.joints}"
+                )
             if follower in self.joints:
-                raise ValueError(f"@follow: '{follower}' is one of the arm's joints; a follower is a joint moved with them, not one of them")
+                raise ValueError(
+                    f"@follow: '{follower}' is one of the arm's joints; a follower is a joint moved with them, not one of them"
+                )
         if self.action_multipliers is not None and len(self.action_multipliers) != len(self.joints):
-            raise ValueError(f"@action_multipliers: {len(self.action_multipliers)} multipliers for {len(self.joints)} arm joints; give one per joint")
+            raise ValueError(
+                f"@action_multipliers: {len(self.action_multipliers)} multipliers for {len(self.joints)} arm joints; give one per joint"
+            )
         return self
 
 
@@ -80,13 +87,19 @@ class BaseDrive(Strict):
     the three joints' targets as the wheels rolling without slip would: forward
     ``r (Δθ_r + Δθ_l) / 2`` along the current heading and turning by ``r (Δθ_r − Δθ_l) / separation``."""
 
-    joints: tuple[str, str, str] = Field(description="The planar chain's joints (URDF names): x, y (prismatic, m) and yaw (revolute, rad).")
-    base_link: str = Field(description="The link the chain carries (the moving base): the frame of robot_base observations.")
+    joints: tuple[str, str, str] = Field(
+        description="The planar chain's joints (URDF names): x, y (prismatic, m) and yaw (revolute, rad)."
+    )
+    base_link: str = Field(
+        description="The link the chain carries (the moving base): the frame of robot_base observations."
+    )
     wheel_radius_m: float = Field(gt=0, le=1, description="Wheel radius, m.")
     wheel_separation_m: float = Field(gt=0, le=5, description="Distance between the two wheels' contact points, m.")
     action_multiplier: float = Field(1.0, gt=0, description="Factor on the task's action scale for the wheel actions.")
     position_gain: float = Field(gt=0, le=1, description="Position gain of the three drive joints.")
-    max_force_n: float = Field(gt=0, description="Force limit of the x and y joints, N (what the wheel motors can push).")
+    max_force_n: float = Field(
+        gt=0, description="Force limit of the x and y joints, N (what the wheel motors can push)."
+    )
     max_torque_nm: float = Field(gt=0, description="Torque limit of the yaw joint, N·m.")
 
 
@@ -114,17 +127,26 @@ class RobotPart(Strict):
     )
     gripper: dict[Literal["right", "left"], Gripper] = Field(default_factory=dict, description="Grippers by side.")
     grips: dict[Name, ToolGrip] = Field(default_factory=dict, description="Tool attachment per tool part.")
-    mountable: bool = Field(False, description="Mounted on furniture (e.g. Jaco on a wheelchair) when a task offers it.")
-    control: RobotControlDefaults = Field(default_factory=RobotControlDefaults, description="Control defaults for tasks that do not set them.")
+    mountable: bool = Field(
+        False, description="Mounted on furniture (e.g. Jaco on a wheelchair) when a task offers it."
+    )
+    control: RobotControlDefaults = Field(
+        default_factory=RobotControlDefaults, description="Control defaults for tasks that do not set them."
+    )
     base_height_m: float = Field(0.0, ge=0, description="Height of the base link above the floor when on the floor.")
-    base_drive: BaseDrive | None = Field(None, description="A mobile base driven by wheel actions (None: the base stays where it is placed).")
+    base_drive: BaseDrive | None = Field(
+        None, description="A mobile base driven by wheel actions (None: the base stays where it is placed)."
+    )
     facing_yaw_deg: float = Field(
-        0.0, ge=-180, le=180, description="Base yaw (degrees) at which the robot works towards world +x (added to base_search.yaw_deg): 0 "
-        "for arms reaching along their base's +x; 90 for Stretch, whose arm extends along its base's -y."
+        0.0,
+        ge=-180,
+        le=180,
+        description="Base yaw (degrees) at which the robot works towards world +x (added to base_search.yaw_deg): 0 "
+        "for arms reaching along their base's +x; 90 for Stretch, whose arm extends along its base's -y.",
     )
 
     @model_validator(mode="after")
-    def _one_source(self) -> "RobotPart":
+    def _one_source(self) -> RobotPart:
         if (self.template is None) == (self.urdf is None):
             raise ValueError("give exactly one of 'template' or 'urdf'")
         return self
@@ -133,7 +155,7 @@ class RobotPart(Strict):
         """The arm acting as ``side``: itself, or the only arm of a single-arm robot."""
         if side in self.arms:
             return side, self.arms[side]  # type: ignore[index]
-        (only_side, only_arm), = self.arms.items()
+        ((only_side, only_arm),) = self.arms.items()
         return only_side, only_arm
 
 
@@ -179,7 +201,10 @@ class PersonPart(Strict):
     name: Name = Field(description="Person part name, e.g. male_50th.")
     sex: Literal["male", "female"] = Field(description="Body model (the reference's male or female segment tables).")
     mass_kg: float | None = Field(
-        None, gt=20, le=250, description="Total body mass, kg (paper: 78.4 male, 62.5 female); required unless percentile is given."
+        None,
+        gt=20,
+        le=250,
+        description="Total body mass, kg (paper: 78.4 male, 62.5 female); required unless percentile is given.",
     )
     percentile: float | None = Field(
         None,
@@ -188,20 +213,23 @@ class PersonPart(Strict):
         "and height_scale.",
     )
     height_m: float | None = Field(
-        None, gt=1.0, le=2.3, description="Standing height, metres (the segment-length scale is solved for); or give height_scale."
+        None,
+        gt=1.0,
+        le=2.3,
+        description="Standing height, metres (the segment-length scale is solved for); or give height_scale.",
     )
     height_scale: float = Field(1.0, gt=0.5, le=1.5, description="Multiplier of segment lengths (1.0: 50th pct).")
     radius_scale: float = Field(1.0, gt=0.5, le=2.0, description="Multiplier of segment radii.")
     skin_rgba: tuple[float, float, float, float] = Field((0.8, 0.6, 0.4, 1.0), description="Skin colour.")
 
     @model_validator(mode="after")
-    def _one_height(self) -> "PersonPart":
+    def _one_height(self) -> PersonPart:
         if self.height_m is not None and self.height_scale != 1.0:
             raise ValueError("@height_m: give height_m or height_scale, not both")
         return self
 
     @model_validator(mode="after")
-    def _size(self) -> "PersonPart":
+    def _size(self) -> PersonPart:
         if self.percentile is None:
             if self.mass_kg is None:
                 raise ValueError("@mass_kg: give mass_kg (kg) or percentile")

@@ -34,7 +34,11 @@ REFERENCE_SOLVER: dict[str, dict] = {
 def solver_settings(spec: TaskSpec) -> dict:
     """The spec's ``sim.solver`` as a plain dict (the keys of :data:`PYBULLET_DEFAULT_SOLVER`)."""
     s = spec.sim.solver
-    return {"sub_steps": s.sub_steps, "iterations": s.iterations, "contact_breaking_threshold_m": s.contact_breaking_threshold_m}
+    return {
+        "sub_steps": s.sub_steps,
+        "iterations": s.iterations,
+        "contact_breaking_threshold_m": s.contact_breaking_threshold_m,
+    }
 
 
 def reference_solver(task: str) -> dict | None:
@@ -47,8 +51,10 @@ def write_solver_variant(spec_path: str | Path, solver: dict, out: str | Path) -
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     settings = ", ".join(f"{k}: {v}" for k, v in solver.items())
-    out.write_text(f"# {Path(spec_path).name} with other solver settings (spec/reference_solver.py)\n"
-                   f"extends: {Path(spec_path).resolve()}\nsim:\n  solver: {{{settings}}}\n")
+    out.write_text(
+        f"# {Path(spec_path).name} with other solver settings (spec/reference_solver.py)\n"
+        f"extends: {Path(spec_path).resolve()}\nsim:\n  solver: {{{settings}}}\n"
+    )
     return out
 
 

@@ -65,9 +65,9 @@ def _describe_input(value: Any) -> str:
 def _strip(msg: str) -> str:
     for prefix in ("Value error, ", "Assertion failed, "):
         if msg.startswith(prefix):
-            msg = msg[len(prefix):]
+            msg = msg[len(prefix) :]
     if msg.startswith("Input should be "):
-        msg = "must be " + msg[len("Input should be "):]
+        msg = "must be " + msg[len("Input should be ") :]
     return msg
 
 
@@ -102,16 +102,28 @@ def model_at(root: type[BaseModel], path: DataPath, data: Any) -> type[BaseModel
                 elif origin in (list, tuple) and isinstance(element, int):
                     args = typing.get_args(typ)
                     if args:
-                        next_candidates.append(args[0] if origin is list or len(args) == 1 or args[-1] is Ellipsis else args[min(element, len(args) - 1)])
+                        next_candidates.append(
+                            args[0]
+                            if origin is list or len(args) == 1 or args[-1] is Ellipsis
+                            else args[min(element, len(args) - 1)]
+                        )
         candidates = next_candidates
-        node = node.get(element) if isinstance(node, dict) else (node[element] if isinstance(node, list) and isinstance(element, int) and element < len(node) else None)
+        node = (
+            node.get(element)
+            if isinstance(node, dict)
+            else (
+                node[element] if isinstance(node, list) and isinstance(element, int) and element < len(node) else None
+            )
+        )
     models = [t for c in candidates for t in _unwrap(c) if isinstance(t, type) and issubclass(t, BaseModel)]
     if len(models) > 1 and isinstance(node, dict) and "kind" in node:
         for m in models:
             kind_field = m.model_fields.get("kind")
             if kind_field is not None and node["kind"] in typing.get_args(kind_field.annotation):
                 return m
-    if len(models) > 1 and isinstance(node, dict):  # e.g. a waypoint or {segment: NAME}: the model whose required keys are all there
+    if len(models) > 1 and isinstance(
+        node, dict
+    ):  # e.g. a waypoint or {segment: NAME}: the model whose required keys are all there
         for m in models:
             if all(name in node for name, f in m.model_fields.items() if f.is_required()):
                 return m
@@ -158,7 +170,9 @@ def problems_from_validation(
             note = inherited_note(smap, problem.location, _problem_path(err, path, prefix))
             if _strip(err["msg"]).startswith("@"):  # a check across the keys of one mapping
                 field = _problem_path(err, path, ())
-                note += inherited_siblings_note(smap, prefix + field[:-1], _value_at(data, field[:-1]), problem.message, skip=field[-1])
+                note += inherited_siblings_note(
+                    smap, prefix + field[:-1], _value_at(data, field[:-1]), problem.message, skip=field[-1]
+                )
             problems.append(Problem(problem.location, problem.message + note))
     unique = {(str(p.location), p.message): p for p in problems}
     return list(unique.values())
@@ -194,8 +208,10 @@ def inherited_siblings_note(smap: SourceMap, mapping: DataPath, siblings: Any, m
         if key == skip or where.path == own or isinstance(value, (dict, list)) or f"'{value}'" not in message:
             continue
         parent = _section(mapping)
-        notes.append(f"{key}: {value} is inherited from {where}; remove it in {own} with {parent}: {{$delete: [{key}]}}, "
-                     f"or rewrite {parent} whole with {parent}: {{$replace: {{...}}}}")
+        notes.append(
+            f"{key}: {value} is inherited from {where}; remove it in {own} with {parent}: {{$delete: [{key}]}}, "
+            f"or rewrite {parent} whole with {parent}: {{$replace: {{...}}}}"
+        )
     return f" ({'; '.join(notes)})" if notes else ""
 
 
@@ -243,7 +259,10 @@ def _one(err: dict, path: DataPath, data: Any, smap: SourceMap, root: type[BaseM
         return Problem(smap.value(full), f"{_section(full)}: expected {expected}, got {len(_value_at(data, path))}")
     if kind == "missing":
         key = path[-1]
-        return Problem(smap.key(full[:-1]) if full[:-1] else smap.value(()), f"missing required key '{key}' in {_section(full[:-1])}")
+        return Problem(
+            smap.key(full[:-1]) if full[:-1] else smap.value(()),
+            f"missing required key '{key}' in {_section(full[:-1])}",
+        )
     if kind == "union_tag_invalid":
         ctx = err.get("ctx", {})
         tag = str(ctx.get("tag"))
@@ -263,17 +282,34 @@ def _one(err: dict, path: DataPath, data: Any, smap: SourceMap, root: type[BaseM
         full, path = full + tuple(field.split(".")), path + tuple(field.split("."))
         return Problem(smap.value(full), f"{_section(full)}: {message}")
     if kind == "literal_error":
-        expected = [e.strip().strip("'") for e in str(err.get("ctx", {}).get("expected", "")).replace(" or ", ", ").split(",") if e.strip()]
+        expected = [
+            e.strip().strip("'")
+            for e in str(err.get("ctx", {}).get("expected", "")).replace(" or ", ", ").split(",")
+            if e.strip()
+        ]
         got = err.get("input")
-        return Problem(smap.value(full), f"{_section(full)}: expected one of {one_of(expected)}, got {_describe_input(got)}{did_you_mean(str(got), expected)}")
+        return Problem(
+            smap.value(full),
+            f"{_section(full)}: expected one of {one_of(expected)}, got {_describe_input(got)}{did_you_mean(str(got), expected)}",
+        )
     if kind == "string_pattern_mismatch":
-        return Problem(smap.value(full), f"{_section(full)}: {_describe_input(err.get('input'))} is not a valid name; expected lowercase letters, digits and underscores, starting with a letter (e.g. 'my_task')")
+        return Problem(
+            smap.value(full),
+            f"{_section(full)}: {_describe_input(err.get('input'))} is not a valid name; expected lowercase letters, digits and underscores, starting with a letter (e.g. 'my_task')",
+        )
     if kind in ("model_type", "model_attributes_type", "dict_type"):
         message = f"expected a mapping, got {_describe_input(err.get('input'))}"
     elif kind in ("list_type", "tuple_type"):
         message = f"expected a list, got {_describe_input(err.get('input'))}"
-    elif kind == "too_short" and isinstance(err.get("input"), (list, tuple)) and path and isinstance(_value_at(data, path[:-1]), dict):
+    elif (
+        kind == "too_short"
+        and isinstance(err.get("input"), (list, tuple))
+        and path
+        and isinstance(_value_at(data, path[:-1]), dict)
+    ):
         message = f"{message.replace('must be ', 'expected ')}"
-    elif "input" in err and not isinstance(err["input"], (dict, list)) and kind not in ("value_error", "assertion_error"):
+    elif (
+        "input" in err and not isinstance(err["input"], (dict, list)) and kind not in ("value_error", "assertion_error")
+    ):
         message = f"{message}, got {_describe_input(err['input'])}"
     return Problem(smap.value(full), f"{_section(full)}: {message}")

@@ -8,6 +8,7 @@ active cost into a reward term named ``preference_<name>`` so ``info`` reports i
 from __future__ import annotations
 
 import math
+
 from pydantic import Field
 
 from .registry import BodiesRef, BodyRef, Params, ParticlesRef, PointRef, term
@@ -68,7 +69,9 @@ def force_nontarget(snap, p) -> float:
     ``target_radius_m`` of ``target`` (0 when no target is given, as in feeding: all force counts).
     """
     total = snap.contact_force(p.by, p.onto)
-    at_target = _tool_force(snap, p.target_tool, p.onto, p.target, p.target_radius_m) if p.target_tool and p.target else 0.0
+    at_target = (
+        _tool_force(snap, p.target_tool, p.onto, p.target, p.target_radius_m) if p.target_tool and p.target else 0.0
+    )
     return -float(total - at_target)
 
 

@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import types
 import typing
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Annotated, Any, Callable, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict
 
@@ -66,7 +67,7 @@ class TermDef:
     params: type[Params]
     fn: Callable[..., Any]
     doc: str
-    size: Callable[[Params, "SizeContext"], int] | None = None
+    size: Callable[[Params, SizeContext], int] | None = None
 
     def summary(self) -> str:
         """The docstring's first paragraph, whole (its lines joined)."""

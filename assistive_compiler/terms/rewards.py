@@ -23,7 +23,7 @@ class DistanceSum(Params):
     b: list[PointRef] = Field(min_length=1, description="Second point of each pair (as many as a).")
 
     @model_validator(mode="after")
-    def _paired(self) -> "DistanceSum":
+    def _paired(self) -> DistanceSum:
         if len(self.a) != len(self.b):
             raise ValueError(f"a and b must pair up: a has {len(self.a)} points, b has {len(self.b)}")
         return self
@@ -45,7 +45,9 @@ class ContactForce(Params):
 @term("distance", "reward", Distance)
 def distance(snap, p) -> float:
     """Euclidean distance between two points (m)."""
-    return math.dist(snap.position(p.a).tolist(), snap.position(p.b).tolist())  # lists: math.dist is slow on numpy scalars
+    return math.dist(
+        snap.position(p.a).tolist(), snap.position(p.b).tolist()
+    )  # lists: math.dist is slow on numpy scalars
 
 
 @term("negative_distance_sum", "reward", DistanceSum)
@@ -85,7 +87,9 @@ class ContactEvents(Params):
     onto: BodiesRef
     target: PointRef
     radius_m: float = Field(0.025, gt=0, description="Contacts within this distance of the target count, m.")
-    min_move_m: float = Field(0.01, ge=0, description="An event needs the contact to have moved this far since the last event, m.")
+    min_move_m: float = Field(
+        0.01, ge=0, description="An event needs the contact to have moved this far since the last event, m."
+    )
     max_force_n: float = Field(10.0, gt=0, description="An event needs the force at the target below this, N.")
 
 
@@ -121,7 +125,9 @@ class ContactEventCounter:
 
 class Tilt(Params):
     of: PointRef
-    axis: tuple[float, float, float] = Field((0.0, 0.0, 1.0), description="Axis in the point's link frame (unit vector not required).")
+    axis: tuple[float, float, float] = Field(
+        (0.0, 0.0, 1.0), description="Axis in the point's link frame (unit vector not required)."
+    )
     up: tuple[float, float, float] = Field((0.0, 0.0, 1.0), description="World direction the axis should point along.")
 
 
@@ -154,14 +160,33 @@ def markers_cleared(snap, p) -> float:
 
 
 class SleeveProgress(Params):
-    opening: NodesRef = Field(description="The garment's opening ring, e.g. sleeve.opening (its nodes in order around the ring).")
+    opening: NodesRef = Field(
+        description="The garment's opening ring, e.g. sleeve.opening (its nodes in order around the ring)."
+    )
     shoulder: PointRef = Field(description="The dressed arm's shoulder joint centre, e.g. person.left_shoulder.")
     elbow: PointRef = Field(description="Its elbow joint centre, e.g. person.left_elbow.")
     wrist: PointRef = Field(description="Its wrist joint centre, e.g. person.left_wrist.")
-    hand_beyond_wrist_m: float = Field(0.086, ge=0, le=0.5, description="The hand's end beyond the wrist along the forearm, m (the reference: 2× the upper-arm radius).")
-    beyond_elbow_m: float = Field(0.043, ge=0, le=0.5, description="The forearm segment's end beyond the elbow, m (the reference: the upper-arm radius).")
-    beyond_shoulder_m: float = Field(0.043, ge=0, le=0.5, description="The upper-arm segment's end beyond the shoulder, m (the reference: the upper-arm radius).")
-    ordered: bool = Field(True, description="The upper arm counts only after the forearm was in the sleeve earlier in the episode.")
+    hand_beyond_wrist_m: float = Field(
+        0.086,
+        ge=0,
+        le=0.5,
+        description="The hand's end beyond the wrist along the forearm, m (the reference: 2× the upper-arm radius).",
+    )
+    beyond_elbow_m: float = Field(
+        0.043,
+        ge=0,
+        le=0.5,
+        description="The forearm segment's end beyond the elbow, m (the reference: the upper-arm radius).",
+    )
+    beyond_shoulder_m: float = Field(
+        0.043,
+        ge=0,
+        le=0.5,
+        description="The upper-arm segment's end beyond the shoulder, m (the reference: the upper-arm radius).",
+    )
+    ordered: bool = Field(
+        True, description="The upper arm counts only after the forearm was in the sleeve earlier in the episode."
+    )
 
 
 @term("sleeve_progress", "reward", SleeveProgress)
@@ -185,8 +210,16 @@ class SleeveProgressTerm:
     def __call__(self, snap, p) -> float:
         from ..garment import sleeve_progress as r_dress
 
-        value = r_dress(snap.node_positions(p.opening), snap.position(p.shoulder), snap.position(p.elbow), snap.position(p.wrist),
-                        p.hand_beyond_wrist_m, p.beyond_elbow_m, p.beyond_shoulder_m, upper_arm_counts=self.forearm_seen or not p.ordered)
+        value = r_dress(
+            snap.node_positions(p.opening),
+            snap.position(p.shoulder),
+            snap.position(p.elbow),
+            snap.position(p.wrist),
+            p.hand_beyond_wrist_m,
+            p.beyond_elbow_m,
+            p.beyond_shoulder_m,
+            upper_arm_counts=self.forearm_seen or not p.ordered,
+        )
         if 0.0 <= value:  # only the forearm branch (and the upper arm's) is non-negative
             self.forearm_seen = True
         return value

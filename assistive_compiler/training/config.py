@@ -29,13 +29,15 @@ class Network(Strict):
     """The policy and value networks: separate MLPs of the same shape."""
 
     hidden: list[int] = Field(
-        [64, 64], min_length=1, max_length=8,
+        [64, 64],
+        min_length=1,
+        max_length=8,
         description="Hidden layer widths (the paper: [64, 64]; the reference v1.0 RLlib config: [100, 100]).",
     )
     activation: Literal["tanh", "relu"] = Field("tanh", description="Hidden-layer activation (the paper: tanh).")
 
     @model_validator(mode="after")
-    def _positive(self) -> "Network":
+    def _positive(self) -> Network:
         if any(w < 1 for w in self.hidden):
             raise ValueError(f"@hidden: every layer width must be ≥ 1, got {self.hidden}")
         return self
@@ -45,11 +47,14 @@ class PPO(Strict):
     """Proximal policy optimisation (Schulman et al. 2017) settings."""
 
     rollout_steps: int = Field(
-        ge=1, le=1_000_000,
+        ge=1,
+        le=1_000_000,
         description="Env steps each env process collects per update; the batch is rollout_steps × envs (the paper: 200 × 36 = 7,200).",
     )
     minibatch_size: int = Field(ge=1, description="Samples per gradient step (the reference v1.0 RLlib config: 128).")
-    epochs: int = Field(ge=1, le=1000, description="Passes over each batch (the paper: 10; the reference v1.0 RLlib config: 50).")
+    epochs: int = Field(
+        ge=1, le=1000, description="Passes over each batch (the paper: 10; the reference v1.0 RLlib config: 50)."
+    )
     gamma: float = Field(0.99, gt=0, le=1, description="Discount factor γ per env step.")
     gae_lambda: float = Field(0.95, ge=0, le=1, description="GAE λ (the reference: 0.95).")
     learning_rate: float = Field(3e-4, gt=0, le=1, description="Adam learning rate.")
@@ -58,19 +63,27 @@ class PPO(Strict):
     value_coef: float = Field(0.5, ge=0, le=10, description="Weight of the value loss.")
     max_grad_norm: float = Field(0.5, gt=0, le=100, description="Gradient norm clip.")
     normalize_observations: bool = Field(
-        True, description="Running mean/std normalisation of observations (pytorch-a2c-ppo-acktr, the paper's trainer, does this)."
+        True,
+        description="Running mean/std normalisation of observations (pytorch-a2c-ppo-acktr, the paper's trainer, does this).",
     )
-    normalize_rewards: bool = Field(True, description="Scale rewards by a running std of the discounted return (as that trainer).")
+    normalize_rewards: bool = Field(
+        True, description="Scale rewards by a running std of the discounted return (as that trainer)."
+    )
 
 
 class SAC(Strict):
     """Soft actor-critic (Haarnoja et al. 2018) settings: off-policy, a replay buffer, twin Q
     critics and an entropy temperature tuned to a target entropy."""
 
-    learning_rate: float = Field(3e-4, gt=0, le=1, description="Adam learning rate of the actor, the critics and the temperature.")
-    buffer_size: int = Field(1_000_000, ge=1, description="Transitions the replay buffer holds (the oldest are overwritten).")
+    learning_rate: float = Field(
+        3e-4, gt=0, le=1, description="Adam learning rate of the actor, the critics and the temperature."
+    )
+    buffer_size: int = Field(
+        1_000_000, ge=1, description="Transitions the replay buffer holds (the oldest are overwritten)."
+    )
     learning_starts: int = Field(
-        5_000, ge=0,
+        5_000,
+        ge=0,
         description="Env steps of uniformly random actions before the first update (fills the buffer with varied data).",
     )
     batch_size: int = Field(256, ge=1, description="Transitions per gradient step, sampled uniformly from the buffer.")
@@ -78,7 +91,9 @@ class SAC(Strict):
     gamma: float = Field(0.99, gt=0, le=1, description="Discount factor γ per env step.")
     train_freq: int = Field(1, ge=1, description="Env steps (per env process) between updates.")
     gradient_steps: int = Field(
-        1, ge=1, le=1000,
+        1,
+        ge=1,
+        le=1000,
         description="Gradient steps per update; updates per env step = gradient_steps / (train_freq × envs).",
     )
     ent_coef: float | Literal["auto"] = Field(
@@ -89,7 +104,7 @@ class SAC(Strict):
     )
 
     @model_validator(mode="after")
-    def _positive_temperature(self) -> "SAC":
+    def _positive_temperature(self) -> SAC:
         if not isinstance(self.ent_coef, str) and self.ent_coef <= 0:
             raise ValueError(f"@ent_coef: the entropy temperature must be > 0 (or 'auto'), got {self.ent_coef}")
         return self
@@ -103,31 +118,39 @@ class TrainingConfig(Strict):
 
     algorithm: Literal["ppo", "sac"] = Field(
         description="The learning algorithm: 'ppo' (the paper's) or 'sac' (off-policy: far fewer env steps per success). "
-                    "Its settings go in the section of the same name."
+        "Its settings go in the section of the same name."
     )
     description: str = Field("", description="What this config is for, in a sentence.")
-    network: Network = Field(default_factory=Network, description="Network shape: PPO's policy and value MLPs, SAC's actor and each critic.")
+    network: Network = Field(
+        default_factory=Network, description="Network shape: PPO's policy and value MLPs, SAC's actor and each critic."
+    )
     ppo: PPO | None = Field(None, description="PPO settings (algorithm: ppo).")
     sac: SAC | None = Field(None, description="SAC settings (algorithm: sac).")
-    total_steps: int = Field(ge=1, description="Env steps to train for, over all env processes (the paper: 10,000,000).")
+    total_steps: int = Field(
+        ge=1, description="Env steps to train for, over all env processes (the paper: 10,000,000)."
+    )
     envs: int = Field(1, ge=1, le=1024, description="Env processes collecting experience in parallel (the paper: 36).")
     seed: int = Field(0, ge=0, description="Seed of the policy's initialisation, the envs and the sampling.")
-    checkpoint_every_steps: int = Field(ge=1, description="Env steps between checkpoints (a checkpoint is also written at the end and on Ctrl-C).")
+    checkpoint_every_steps: int = Field(
+        ge=1, description="Env steps between checkpoints (a checkpoint is also written at the end and on Ctrl-C)."
+    )
     eval_episodes: int = Field(100, ge=1, description="Episodes `evaluate` runs by default (the paper: 100 rollouts).")
 
     @model_validator(mode="after")
-    def _one_algorithm_section(self) -> "TrainingConfig":
+    def _one_algorithm_section(self) -> TrainingConfig:
         for name in ALGORITHM_SECTIONS:
             given = getattr(self, name) is not None
             if name == self.algorithm and not given:
                 raise ValueError(f"@{name}: algorithm '{name}' needs its settings in a '{name}:' section")
             if name != self.algorithm and given:
-                raise ValueError(f"@{name}: a '{name}:' section configures algorithm '{name}', but algorithm is "
-                                 f"'{self.algorithm}'; remove it or set algorithm: {name}")
+                raise ValueError(
+                    f"@{name}: a '{name}:' section configures algorithm '{name}', but algorithm is "
+                    f"'{self.algorithm}'; remove it or set algorithm: {name}"
+                )
         return self
 
     @model_validator(mode="after")
-    def _batch(self) -> "TrainingConfig":
+    def _batch(self) -> TrainingConfig:
         if self.ppo is None:
             return self
         batch = self.ppo.rollout_steps * self.envs
@@ -150,7 +173,9 @@ class TrainingConfig(Strict):
         """The discount factor of whichever algorithm is configured."""
         return (self.ppo or self.sac).gamma
 
-    def with_overrides(self, *, steps: int | None = None, seed: int | None = None, envs: int | None = None) -> "TrainingConfig":
+    def with_overrides(
+        self, *, steps: int | None = None, seed: int | None = None, envs: int | None = None
+    ) -> TrainingConfig:
         """This config with command-line overrides applied, validated again."""
         data = self.model_dump()
         for key, value in (("total_steps", steps), ("seed", seed), ("envs", envs)):

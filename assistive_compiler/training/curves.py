@@ -21,7 +21,9 @@ def read_curve(path: Path) -> list[dict[str, float]]:
     return rows
 
 
-def plot_curves(curves: dict[str, list[dict[str, float]]], out: Path, title: str = "", baselines: dict[str, float] | None = None) -> None:
+def plot_curves(
+    curves: dict[str, list[dict[str, float]]], out: Path, title: str = "", baselines: dict[str, float] | None = None
+) -> None:
     """Mean episode return and success rate against env steps, one line per run.
 
     ``baselines``: horizontal reference lines of the return (e.g. random and scripted policies)."""

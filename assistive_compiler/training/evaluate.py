@@ -116,10 +116,22 @@ def evaluate_exported(source: str, episodes: int = 100, seed: int = 0, render: s
     coop = bool(info.get("coop"))
     compiled = compile_for_policy(info)
     results = play_episodes(compiled.out_dir, policy, coop, episodes, seed)
-    out = {"run": source, "gym_id": info["gym_id"], "task": info["task"], "robot": info["robot"], "coop": coop,
-           "engine": info["engine"], "checkpoint": source, "trained_steps": info["trained_steps"], "episodes": episodes,
-           "seed": seed, "content_hash": compiled.manifest.content_hash, "trained_on_content_hash": info["content_hash"],
-           **_figures(results), "per_episode": results}
+    out = {
+        "run": source,
+        "gym_id": info["gym_id"],
+        "task": info["task"],
+        "robot": info["robot"],
+        "coop": coop,
+        "engine": info["engine"],
+        "checkpoint": source,
+        "trained_steps": info["trained_steps"],
+        "episodes": episodes,
+        "seed": seed,
+        "content_hash": compiled.manifest.content_hash,
+        "trained_on_content_hash": info["content_hash"],
+        **_figures(results),
+        "per_episode": results,
+    }
     if render:
         out["render"] = write_rollout(compiled.out_dir, policy, coop, seed, Path(render))
     return out
@@ -129,12 +141,23 @@ def _figures(results: list[dict]) -> dict:
     mean_r, std_r = _stats([e["return"] for e in results])
     mean_f, std_f = _stats([e["mean_force_on_human_n"] for e in results])
     mean_s, std_s = _stats([float(e["success"]) for e in results])
-    return {"mean_return": mean_r, "std_return": std_r, "success_rate": mean_s, "std_success": std_s,
-            "mean_force_on_human_n": mean_f, "std_force_on_human_n": std_f}
+    return {
+        "mean_return": mean_r,
+        "std_return": std_r,
+        "success_rate": mean_s,
+        "std_success": std_s,
+        "mean_force_on_human_n": mean_f,
+        "std_force_on_human_n": std_f,
+    }
 
 
-def evaluate(run_dir: str | Path, episodes: int | None = None, seed: int = 0, render: str | None = None,
-             checkpoint_steps: int | None = None) -> dict:
+def evaluate(
+    run_dir: str | Path,
+    episodes: int | None = None,
+    seed: int = 0,
+    render: str | None = None,
+    checkpoint_steps: int | None = None,
+) -> dict:
     """Evaluate the run's checkpoint at ``checkpoint_steps`` env steps (None: the newest); optionally
     write a rollout (``render``: .gif or .png)."""
     run = RunDir(run_dir)
@@ -144,9 +167,18 @@ def evaluate(run_dir: str | Path, episodes: int | None = None, seed: int = 0, re
     policy = load_policy(info, checkpoint)
     results = play_episodes(run.artifact, policy, info.coop, episodes, seed)
     out = {
-        "run": display(run.path), "gym_id": info.gym_id, "task": info.task, "robot": info.robot, "coop": info.coop,
-        "engine": info.engine, "checkpoint": display(checkpoint), "trained_steps": steps, "episodes": episodes, "seed": seed,
-        **_figures(results), "per_episode": results,
+        "run": display(run.path),
+        "gym_id": info.gym_id,
+        "task": info.task,
+        "robot": info.robot,
+        "coop": info.coop,
+        "engine": info.engine,
+        "checkpoint": display(checkpoint),
+        "trained_steps": steps,
+        "episodes": episodes,
+        "seed": seed,
+        **_figures(results),
+        "per_episode": results,
     }
     if render:
         out["render"] = render_rollout(run, info, checkpoint, seed, Path(render))
@@ -171,10 +203,13 @@ def save_evaluation(run: RunDir, result: dict) -> Path:
 
 def format_report(result: dict) -> str:
     """The human-readable evaluation summary."""
-    return "\n".join([
-        f"{result['gym_id']}  {result['engine']}  checkpoint {result['checkpoint']} ({result['trained_steps']:,} steps)",
-        f"episodes {result['episodes']} (seeds {result['seed']}..{result['seed'] + result['episodes'] - 1}), deterministic actions",
-        f"return          {result['mean_return']:9.2f} ± {result['std_return']:.2f}",
-        f"success rate    {result['success_rate']:9.2f} ± {result['std_success']:.2f}",
-        f"force on person {result['mean_force_on_human_n']:9.2f} ± {result['std_force_on_human_n']:.2f} N (per-episode mean)",
-    ] + ([result["render"]] if "render" in result else []))
+    return "\n".join(
+        [
+            f"{result['gym_id']}  {result['engine']}  checkpoint {result['checkpoint']} ({result['trained_steps']:,} steps)",
+            f"episodes {result['episodes']} (seeds {result['seed']}..{result['seed'] + result['episodes'] - 1}), deterministic actions",
+            f"return          {result['mean_return']:9.2f} ± {result['std_return']:.2f}",
+            f"success rate    {result['success_rate']:9.2f} ± {result['std_success']:.2f}",
+            f"force on person {result['mean_force_on_human_n']:9.2f} ± {result['std_force_on_human_n']:.2f} N (per-episode mean)",
+        ]
+        + ([result["render"]] if "render" in result else [])
+    )

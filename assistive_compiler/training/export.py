@@ -36,7 +36,10 @@ def _linears(module) -> list:
 
 
 def _layers(linears) -> list[tuple[np.ndarray, np.ndarray]]:
-    return [(m.weight.detach().cpu().numpy().astype(np.float64), m.bias.detach().cpu().numpy().astype(np.float64)) for m in linears]
+    return [
+        (m.weight.detach().cpu().numpy().astype(np.float64), m.bias.detach().cpu().numpy().astype(np.float64))
+        for m in linears
+    ]
 
 
 def mlp_from_sb3(loaded, algorithm: str, activation: str) -> MLPPolicy:
@@ -50,7 +53,9 @@ def mlp_from_sb3(loaded, algorithm: str, activation: str) -> MLPPolicy:
     layers = _layers(_linears(model.policy.mlp_extractor.policy_net) + [model.policy.action_net])
     if loaded.obs_rms is None:
         return MLPPolicy(layers, activation, "clip", low, high)
-    return MLPPolicy(layers, activation, "clip", low, high, loaded.obs_rms.mean, loaded.obs_rms.var, loaded.clip, loaded.eps)
+    return MLPPolicy(
+        layers, activation, "clip", low, high, loaded.obs_rms.mean, loaded.obs_rms.var, loaded.clip, loaded.eps
+    )
 
 
 def mlp_from_rllib(module, algorithm: str, activation: str) -> MLPPolicy:
@@ -70,7 +75,9 @@ def check_same_actions(exported: MLPPolicy, original, observations: np.ndarray, 
     ``observations``; raises when it exceeds ``atol`` (an export that changed the policy)."""
     worst = max(float(np.max(np.abs(exported(o) - np.asarray(original(o), dtype=np.float64)))) for o in observations)
     if worst > atol:
-        raise RuntimeError(f"the exported policy's actions differ from the checkpoint's by up to {worst:.2e} (> {atol:g})")
+        raise RuntimeError(
+            f"the exported policy's actions differ from the checkpoint's by up to {worst:.2e} (> {atol:g})"
+        )
     return worst
 
 
@@ -83,10 +90,17 @@ def evaluate_policy(artifact: Path, policy, episodes: int, seed: int) -> dict:
     runs = play_episodes(artifact, policy, isinstance(policy, CoopPolicy), episodes, seed)
     returns = [r["return"] for r in runs]
     forces = [r["mean_force_on_human_n"] for r in runs]
-    return {"episodes": episodes, "seed": seed, "mean_return": float(np.mean(returns)), "std_return": float(np.std(returns)),
-            "success_rate": float(np.mean([r["success"] for r in runs])), "mean_force_on_human_n": float(np.mean(forces)),
-            "std_force_on_human_n": float(np.std(forces)), "successes": [bool(r["success"]) for r in runs],
-            "returns": [round(float(x), 3) for x in returns]}
+    return {
+        "episodes": episodes,
+        "seed": seed,
+        "mean_return": float(np.mean(returns)),
+        "std_return": float(np.std(returns)),
+        "success_rate": float(np.mean([r["success"] for r in runs])),
+        "mean_force_on_human_n": float(np.mean(forces)),
+        "std_force_on_human_n": float(np.std(forces)),
+        "successes": [bool(r["success"]) for r in runs],
+        "returns": [round(float(x), 3) for x in returns],
+    }
 
 
 def _wall_at(run: RunDir, steps: int) -> float | None:
@@ -105,8 +119,15 @@ def _default_label(info) -> str:
     return f"{info.training_config.algorithm.upper()} ({Path(config).stem})"
 
 
-def export_run(run_dir: str | Path, out: str | Path | None = None, *, episodes: int = 100, seed: int = EVAL_SEED,
-               label: str = "", progress=None) -> dict:
+def export_run(
+    run_dir: str | Path,
+    out: str | Path | None = None,
+    *,
+    episodes: int = 100,
+    seed: int = EVAL_SEED,
+    label: str = "",
+    progress=None,
+) -> dict:
     """Export the run's newest checkpoint to ``out`` and evaluate the exported policy there;
     returns its ``policy.json``. ``label`` names the table row (e.g. ``"PPO (paper) baseline"``)."""
     from ..policies.pretrained import pretrained_dir
@@ -130,9 +151,14 @@ def export_run(run_dir: str | Path, out: str | Path | None = None, *, episodes: 
         from .rllib import SINGLE_MODULE, RLlibPolicy
 
         original = RLlibPolicy(checkpoint, info.coop, config.algorithm)
-        parts = {name: mlp_from_rllib(module, config.algorithm, config.network.activation) for name, module in original.modules.items()}
-        worst = max(check_same_actions(part, lambda o, n=name: original._act(n, o), rng.normal(0.0, 1.0, (32, part.obs_dim)))
-                    for name, part in parts.items())
+        parts = {
+            name: mlp_from_rllib(module, config.algorithm, config.network.activation)
+            for name, module in original.modules.items()
+        }
+        worst = max(
+            check_same_actions(part, lambda o, n=name: original._act(n, o), rng.normal(0.0, 1.0, (32, part.obs_dim)))
+            for name, part in parts.items()
+        )
         policy = CoopPolicy(parts["robot"], parts["human"], {}) if info.coop else parts[SINGLE_MODULE]
 
     name = f"{info.task}-{info.robot}{'-coop' if info.coop else ''}"
@@ -141,16 +167,33 @@ def export_run(run_dir: str | Path, out: str | Path | None = None, *, episodes: 
     if progress:
         progress(f"evaluated {episodes} episodes: success {evaluation['success_rate']:.2f}")
     first = min(REGRESSION_EPISODES, episodes)
-    regression = {"seed": seed, "episodes": first, "success_rate": float(np.mean(evaluation["successes"][:first])),
-                  "mean_return": float(np.mean(evaluation["returns"][:first]))}
+    regression = {
+        "seed": seed,
+        "episodes": first,
+        "success_rate": float(np.mean(evaluation["successes"][:first])),
+        "mean_return": float(np.mean(evaluation["returns"][:first])),
+    }
     wall = _wall_at(run, steps)
     record = {
-        "name": out.name, "label": label or _default_label(info),
-        "task": info.task, "robot": info.robot, "coop": info.coop, "gym_id": info.gym_id, "spec": info.spec,
-        "content_hash": info.content_hash, "engine": info.engine, "algorithm": config.algorithm, "demonstrations": False,
-        "config": config.model_dump(exclude_none=True), "trained_steps": steps, "wall_s": wall,
-        "steps_per_s_including_learning": (steps / wall) if wall else None, "versions": info.versions,
-        "export_max_action_difference": worst, "evaluation": evaluation, "regression": regression,
+        "name": out.name,
+        "label": label or _default_label(info),
+        "task": info.task,
+        "robot": info.robot,
+        "coop": info.coop,
+        "gym_id": info.gym_id,
+        "spec": info.spec,
+        "content_hash": info.content_hash,
+        "engine": info.engine,
+        "algorithm": config.algorithm,
+        "demonstrations": False,
+        "config": config.model_dump(exclude_none=True),
+        "trained_steps": steps,
+        "wall_s": wall,
+        "steps_per_s_including_learning": (steps / wall) if wall else None,
+        "versions": info.versions,
+        "export_max_action_difference": worst,
+        "evaluation": evaluation,
+        "regression": regression,
     }
     if out.exists():
         shutil.rmtree(out)

@@ -11,8 +11,12 @@ from __future__ import annotations
 #: Task order and robot columns as the paper prints them.
 TASKS = ("scratch_itch", "bed_bathing", "feeding", "drinking", "dressing", "arm_manipulation")
 TASK_TITLES = {
-    "scratch_itch": "Itch Scratching", "bed_bathing": "Bed Bathing", "feeding": "Feeding",
-    "drinking": "Drinking", "dressing": "Dressing", "arm_manipulation": "Arm Manipulation",
+    "scratch_itch": "Itch Scratching",
+    "bed_bathing": "Bed Bathing",
+    "feeding": "Feeding",
+    "drinking": "Drinking",
+    "dressing": "Dressing",
+    "arm_manipulation": "Arm Manipulation",
 }
 ROBOTS = ("pr2", "jaco", "baxter", "sawyer")
 ROBOT_TITLES = {"pr2": "PR2", "jaco": "Jaco", "baxter": "Baxter", "sawyer": "Sawyer", "panda": "Panda"}
@@ -26,7 +30,14 @@ TABLE_I = {
     "dressing": {"pr2": 11.5, "jaco": -17.0, "baxter": 5.6, "sawyer": -27.6},
     "arm_manipulation": {"pr2": -162.4, "jaco": -177.5, "baxter": -228.1, "sawyer": -210.6},
 }
-TABLE_I_SUCCESS = {"scratch_itch": 54, "bed_bathing": 24, "feeding": 88, "drinking": 72, "dressing": 26, "arm_manipulation": 8}
+TABLE_I_SUCCESS = {
+    "scratch_itch": 54,
+    "bed_bathing": 24,
+    "feeding": 88,
+    "drinking": 72,
+    "dressing": 26,
+    "arm_manipulation": 8,
+}
 
 #: Table II (active person, co-optimisation).
 TABLE_II = {

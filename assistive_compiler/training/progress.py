@@ -41,9 +41,14 @@ class TrainingBar:
             from rich.console import Console
             from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-            self.progress = Progress(TextColumn("train"), BarColumn(), TextColumn("{task.completed:,}/{task.total:,} steps"),
-                                     TextColumn("{task.fields[status]}"), TimeElapsedColumn(),
-                                     console=Console(file=sys.stderr, highlight=False))
+            self.progress = Progress(
+                TextColumn("train"),
+                BarColumn(),
+                TextColumn("{task.completed:,}/{task.total:,} steps"),
+                TextColumn("{task.fields[status]}"),
+                TimeElapsedColumn(),
+                console=Console(file=sys.stderr, highlight=False),
+            )
             self.task = self.progress.add_task("train", total=total_steps, completed=start_steps, status="")
             self.progress.start()
 
@@ -61,7 +66,9 @@ class TrainingBar:
 class Progress:
     """Collects finished episodes and, at each update, writes one curve row and TensorBoard point."""
 
-    def __init__(self, run: RunDir, weights: dict[str, float], total_steps: int, start_steps: int, *, quiet: bool = False):
+    def __init__(
+        self, run: RunDir, weights: dict[str, float], total_steps: int, start_steps: int, *, quiet: bool = False
+    ):
         from torch.utils.tensorboard import SummaryWriter
 
         self.run, self.weights = run, weights
@@ -94,9 +101,13 @@ class Progress:
 
     def episode(self, ret: float, success: bool, term_sums: dict[str, float]) -> None:
         """One finished episode: its return, success and unweighted term sums."""
-        self.pending.append((1, float(ret), float(success), {n: w * term_sums.get(n, 0.0) for n, w in self.weights.items()}))
+        self.pending.append(
+            (1, float(ret), float(success), {n: w * term_sums.get(n, 0.0) for n, w in self.weights.items()})
+        )
 
-    def episodes_summary(self, count: int, mean_return: float, success_rate: float, weighted_term_means: dict[str, float]) -> None:
+    def episodes_summary(
+        self, count: int, mean_return: float, success_rate: float, weighted_term_means: dict[str, float]
+    ) -> None:
         """``count`` finished episodes given by their means (engines that aggregate episodes
         themselves); ``weighted_term_means``: each term's weighted episode sum, averaged."""
         self.pending.append((count, float(mean_return), float(success_rate), dict(weighted_term_means)))
@@ -115,8 +126,16 @@ class Progress:
                 scalars[f"Episode_Reward/{name}"] = mean([t.get(name, 0.0) for _, _, _, t in self.pending])
             self.episodes += int(counts.sum())
             self.last_return = scalars["Episode/return"]
-            self._rows.writerow([steps, round(self.wall_before + elapsed, 3), self.episodes, scalars["Episode/return"],
-                                 scalars["Episode/success_rate"], round(rate, 1)])
+            self._rows.writerow(
+                [
+                    steps,
+                    round(self.wall_before + elapsed, 3),
+                    self.episodes,
+                    scalars["Episode/return"],
+                    scalars["Episode/success_rate"],
+                    round(rate, 1),
+                ]
+            )
             self._csv.flush()
             self.pending.clear()
         for key, value in scalars.items():
@@ -124,7 +143,9 @@ class Progress:
         self.writer.flush()
         status = f"{rate:.0f} steps/s"
         if self.last_return is not None:
-            status += f", return {self.last_return:.1f}, success {scalars.get('Episode/success_rate', float('nan')):.2f}"
+            status += (
+                f", return {self.last_return:.1f}, success {scalars.get('Episode/success_rate', float('nan')):.2f}"
+            )
         self.bar.update(steps, status)
         return scalars
 

@@ -42,17 +42,35 @@ def _row(r: dict, paper: dict, paper_success: dict) -> list[str]:
     paper_s = paper_success.get(r["task"])
     goal = "—" if paper_s is None else ("yes" if 100 * e["success_rate"] >= paper_s else "no")
     return [
-        TASK_TITLES.get(r["task"], r["task"]), ROBOT_TITLES.get(r["robot"], r["robot"]), r["label"] + (" (demonstrations)" if r["demonstrations"] else ""),
-        f"{r['trained_steps']:,}", _hours(r.get("wall_s")),
+        TASK_TITLES.get(r["task"], r["task"]),
+        ROBOT_TITLES.get(r["robot"], r["robot"]),
+        r["label"] + (" (demonstrations)" if r["demonstrations"] else ""),
+        f"{r['trained_steps']:,}",
+        _hours(r.get("wall_s")),
         "—" if not r.get("steps_per_s_including_learning") else f"{r['steps_per_s_including_learning']:.0f}",
-        f"{e['mean_return']:.1f} ± {e['std_return']:.1f}", f"{100 * e['success_rate']:.0f}%",
-        f"{e['mean_force_on_human_n']:.2f}", "—" if paper_return is None else f"{paper_return:.1f}",
-        "—" if paper_s is None else f"{paper_s}%", goal,
+        f"{e['mean_return']:.1f} ± {e['std_return']:.1f}",
+        f"{100 * e['success_rate']:.0f}%",
+        f"{e['mean_force_on_human_n']:.2f}",
+        "—" if paper_return is None else f"{paper_return:.1f}",
+        "—" if paper_s is None else f"{paper_s}%",
+        goal,
     ]
 
 
-HEADER = ["Task", "Robot", "Algorithm", "Env steps", "Wall time", "Env steps/s", "Return ± std", "Success",
-          "Force on person (N)", "Paper return", "Paper success (best robot)", "≥ paper"]
+HEADER = [
+    "Task",
+    "Robot",
+    "Algorithm",
+    "Env steps",
+    "Wall time",
+    "Env steps/s",
+    "Return ± std",
+    "Success",
+    "Force on person (N)",
+    "Paper return",
+    "Paper success (best robot)",
+    "≥ paper",
+]
 
 
 def _order(r: dict) -> tuple:
@@ -62,7 +80,11 @@ def _order(r: dict) -> tuple:
 def _claim_row(coop: dict, records: list[dict]) -> list[str] | None:
     """A co-optimised cell against the static-person cell of the same task, robot and algorithm with
     the nearest budget: success (env steps) each; None when there is no such static cell."""
-    static = [r for r in records if not r["coop"] and (r["task"], r["robot"], r["algorithm"]) == (coop["task"], coop["robot"], coop["algorithm"])]
+    static = [
+        r
+        for r in records
+        if not r["coop"] and (r["task"], r["robot"], r["algorithm"]) == (coop["task"], coop["robot"], coop["algorithm"])
+    ]
     if not static:
         return None
     s = min(static, key=lambda r: abs(r["trained_steps"] - coop["trained_steps"]))
@@ -70,12 +92,22 @@ def _claim_row(coop: dict, records: list[dict]) -> list[str] | None:
     def cell(r: dict) -> str:
         return f"{100 * r['evaluation']['success_rate']:.0f}% ({r['trained_steps']:,} steps)"
 
-    return [TASK_TITLES[coop["task"]], ROBOT_TITLES.get(coop["robot"], coop["robot"]), coop["algorithm"].upper(), cell(s), cell(coop)]
+    return [
+        TASK_TITLES[coop["task"]],
+        ROBOT_TITLES.get(coop["robot"], coop["robot"]),
+        coop["algorithm"].upper(),
+        cell(s),
+        cell(coop),
+    ]
 
 
 def results_block(records: list[dict]) -> str:
     """The generated Markdown between the markers (no pictures are made here)."""
-    parts = [BEGIN, "<!-- written by `assistive-compiler results`; edit the policies or the prose outside the markers -->", ""]
+    parts = [
+        BEGIN,
+        "<!-- written by `assistive-compiler results`; edit the policies or the prose outside the markers -->",
+        "",
+    ]
     for coop in (False, True):
         title, paper, paper_success = PAPER[coop]
         rows = sorted((r for r in records if bool(r["coop"]) == coop), key=_order)
@@ -91,20 +123,31 @@ def results_block(records: list[dict]) -> str:
     claim = [row for row in claim if row]
     parts.append("### The paper's claim (§V-B): an active person raises success\n")
     if claim:
-        parts.append("Each co-optimised cell beside the static-person cell of the same task, robot and algorithm "
-                     "(the nearest budget when several); the same evaluation seeds.\n")
-        parts.append(markdown_table(["Task", "Robot", "Algorithm", "Static person", "Active person (co-optimised)"], claim) + "\n")
+        parts.append(
+            "Each co-optimised cell beside the static-person cell of the same task, robot and algorithm "
+            "(the nearest budget when several); the same evaluation seeds.\n"
+        )
+        parts.append(
+            markdown_table(["Task", "Robot", "Algorithm", "Static person", "Active person (co-optimised)"], claim)
+            + "\n"
+        )
     else:
-        parts.append("Not measured yet: it needs a co-optimised cell beside a static one of the same task, robot and algorithm.\n")
+        parts.append(
+            "Not measured yet: it needs a co-optimised cell beside a static one of the same task, robot and algorithm.\n"
+        )
     parts.append("### Each cell\n")
     for r in sorted(records, key=_order):
         e = r["evaluation"]
-        parts.append(f"#### {TASK_TITLES.get(r['task'], r['task'])} × {ROBOT_TITLES.get(r['robot'], r['robot'])}: {r['label']}\n")
-        parts.append(f"`--policy pretrained:{r['name']}`: {r['trained_steps']:,} env steps "
-                     f"({_hours(r.get('wall_s'))}), evaluated on {e['episodes']} episodes, seeds {e['seed']:,}–"
-                     f"{e['seed'] + e['episodes'] - 1:,} (never used in training), deterministic actions: success "
-                     f"{100 * e['success_rate']:.0f}%, return {e['mean_return']:.1f} ± {e['std_return']:.1f}. "
-                     f"Trained on the compiled task {r['content_hash'][:12]}.\n")
+        parts.append(
+            f"#### {TASK_TITLES.get(r['task'], r['task'])} × {ROBOT_TITLES.get(r['robot'], r['robot'])}: {r['label']}\n"
+        )
+        parts.append(
+            f"`--policy pretrained:{r['name']}`: {r['trained_steps']:,} env steps "
+            f"({_hours(r.get('wall_s'))}), evaluated on {e['episodes']} episodes, seeds {e['seed']:,}–"
+            f"{e['seed'] + e['episodes'] - 1:,} (never used in training), deterministic actions: success "
+            f"{100 * e['success_rate']:.0f}%, return {e['mean_return']:.1f} ± {e['std_return']:.1f}. "
+            f"Trained on the compiled task {r['content_hash'][:12]}.\n"
+        )
         parts.append(f"![{r['name']} learning curve]({PICTURES}/{r['name']}-curve.png)\n")
         parts.append(f"![{r['name']} rollout, seed {e['seed']:,}]({PICTURES}/{r['name']}.png)\n")
     parts.append(END)
@@ -123,7 +166,9 @@ def write_pictures(records: list[dict], doc_dir: Path, progress=None) -> list[Pa
         curve = read_curve(pretrained_dir() / r["name"] / "curve.csv")
         if curve:
             png = out_dir / f"{r['name']}-curve.png"
-            plot_curves({r["label"]: curve}, png, title=f"{r['gym_id'].split('/')[-1]}: {r['label']}, training episodes")
+            plot_curves(
+                {r["label"]: curve}, png, title=f"{r['gym_id'].split('/')[-1]}: {r['label']}, training episodes"
+            )
             written.append(png)
         policy, _ = load_trained(PREFIX + r["name"])  # a co-optimised pair plays both agents
         png = out_dir / f"{r['name']}.png"

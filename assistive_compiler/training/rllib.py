@@ -16,7 +16,6 @@ filter); ``ppo.normalize_*`` are SB3's.
 from __future__ import annotations
 
 import math
-
 import os
 import socket
 import sys
@@ -73,8 +72,10 @@ def check_address(address: str) -> None:
     try:
         socket.create_connection((host, int(port)), timeout=CONNECT_TIMEOUT_S).close()
     except OSError as exc:
-        raise UsageError(f"--address: no Ray cluster reachable at {address} ({exc.strerror or exc}); "
-                                             "start one with `ray start --head` there, or leave out --address to train locally") from None
+        raise UsageError(
+            f"--address: no Ray cluster reachable at {address} ({exc.strerror or exc}); "
+            "start one with `ray start --head` there, or leave out --address to train locally"
+        ) from None
 
 
 def authentication_refused(address: str) -> str | None:
@@ -86,12 +87,16 @@ def authentication_refused(address: str) -> str | None:
     try:
         from ray._raylet import GcsClient
 
-        GcsClient(address=address.split("://", 1)[-1]).internal_kv_get(b"assistive-compiler-probe", None, timeout=CONNECT_TIMEOUT_S)
+        GcsClient(address=address.split("://", 1)[-1]).internal_kv_get(
+            b"assistive-compiler-probe", None, timeout=CONNECT_TIMEOUT_S
+        )
     except AuthenticationError:
-        return (f"--address: the Ray cluster at {address} refused this machine's authentication token "
-                "(~/.ray/auth_token, $RAY_AUTH_TOKEN or $RAY_AUTH_TOKEN_PATH). Ray's remedy: every machine uses the "
-                "cluster's token — print it on the head with `ray get-auth-token` and put it in ~/.ray/auth_token here "
-                "(or export RAY_AUTH_TOKEN); see https://docs.ray.io/en/latest/ray-security/token-auth.html")
+        return (
+            f"--address: the Ray cluster at {address} refused this machine's authentication token "
+            "(~/.ray/auth_token, $RAY_AUTH_TOKEN or $RAY_AUTH_TOKEN_PATH). Ray's remedy: every machine uses the "
+            "cluster's token — print it on the head with `ray get-auth-token` and put it in ~/.ray/auth_token here "
+            "(or export RAY_AUTH_TOKEN); see https://docs.ray.io/en/latest/ray-security/token-auth.html"
+        )
     except Exception:  # noqa: BLE001 — any other failure: not an authentication refusal
         return None
     return None
@@ -116,8 +121,10 @@ def init_ray(address: str | None, envs: int) -> None:
             refused = authentication_refused(address)
             if refused:
                 raise UsageError(refused) from None
-            raise UsageError(f"--address: no Ray cluster at {address} ({str(exc).splitlines()[0]}); "
-                             "start one with `ray start --head` there, or leave out --address to train locally") from None
+            raise UsageError(
+                f"--address: no Ray cluster at {address} ({str(exc).splitlines()[0]}); "
+                "start one with `ray start --head` there, or leave out --address to train locally"
+            ) from None
         finally:
             if previous is None:
                 os.environ.pop(GCS_WAIT_VAR, None)
@@ -147,7 +154,9 @@ def _callbacks_class():
             weights = env_runner.config.env_config["weights"]
             sums = episode.custom_data.get("terms", {})
             metrics_logger.log_value(("task", "episodes"), 1, reduce="sum")
-            metrics_logger.log_value(("task", "return"), sum(w * sums.get(n, 0.0) for n, w in weights.items()), reduce="sum")
+            metrics_logger.log_value(
+                ("task", "return"), sum(w * sums.get(n, 0.0) for n, w in weights.items()), reduce="sum"
+            )
             metrics_logger.log_value(("task", "success"), float(episode.custom_data.get("success", 0)), reduce="sum")
             for name, weight in weights.items():
                 metrics_logger.log_value(("task", "terms", name), weight * sums.get(name, 0.0), reduce="sum")
@@ -181,24 +190,46 @@ def build_sac_config(run: RunDir, config: TrainingConfig, weights: dict[str, flo
 
     s = config.sac
     if s.ent_coef != "auto":
-        raise UsageError(f"sac.ent_coef {s.ent_coef}: the rllib engine learns the entropy temperature; use ent_coef: auto")
+        raise UsageError(
+            f"sac.ent_coef {s.ent_coef}: the rllib engine learns the entropy temperature; use ent_coef: auto"
+        )
     updates_per_step = s.gradient_steps / s.train_freq
     buffer = "MultiAgentEpisodeReplayBuffer" if coop else "EpisodeReplayBuffer"
     cfg = (
         SACConfig()
         .environment(ENV_NAME, env_config=env_config(run, coop, weights))
         .framework("torch")
-        .env_runners(num_env_runners=config.envs if config.envs > 1 else 0, num_envs_per_env_runner=1,
-                     rollout_fragment_length=SAC_FRAGMENT_STEPS, num_cpus_per_env_runner=1)
+        .env_runners(
+            num_env_runners=config.envs if config.envs > 1 else 0,
+            num_envs_per_env_runner=1,
+            rollout_fragment_length=SAC_FRAGMENT_STEPS,
+            num_cpus_per_env_runner=1,
+        )
         .learners(num_learners=0)
-        .training(actor_lr=s.learning_rate, critic_lr=s.learning_rate, alpha_lr=s.learning_rate, gamma=s.gamma, tau=s.tau,
-                  train_batch_size_per_learner=s.batch_size, num_steps_sampled_before_learning_starts=s.learning_starts,
-                  target_entropy=s.target_entropy, n_step=1, twin_q=True,
-                  training_intensity=s.batch_size * updates_per_step,
-                  replay_buffer_config={"type": buffer, "capacity": s.buffer_size})
-        .rl_module(model_config=DefaultModelConfig(fcnet_hiddens=list(config.network.hidden),
-                                                   fcnet_activation=config.network.activation))
-        .reporting(min_sample_timesteps_per_iteration=min(SAC_ITERATION_STEPS, config.total_steps, config.checkpoint_every_steps))
+        .training(
+            actor_lr=s.learning_rate,
+            critic_lr=s.learning_rate,
+            alpha_lr=s.learning_rate,
+            gamma=s.gamma,
+            tau=s.tau,
+            train_batch_size_per_learner=s.batch_size,
+            num_steps_sampled_before_learning_starts=s.learning_starts,
+            target_entropy=s.target_entropy,
+            n_step=1,
+            twin_q=True,
+            training_intensity=s.batch_size * updates_per_step,
+            replay_buffer_config={"type": buffer, "capacity": s.buffer_size},
+        )
+        .rl_module(
+            model_config=DefaultModelConfig(
+                fcnet_hiddens=list(config.network.hidden), fcnet_activation=config.network.activation
+            )
+        )
+        .reporting(
+            min_sample_timesteps_per_iteration=min(
+                SAC_ITERATION_STEPS, config.total_steps, config.checkpoint_every_steps
+            )
+        )
         .callbacks(_callbacks_class())
         .debugging(seed=config.seed, log_level="ERROR")
     )
@@ -221,14 +252,32 @@ def build_config(run: RunDir, config: TrainingConfig, weights: dict[str, float],
         PPOConfig()
         .environment(ENV_NAME, env_config=env_config(run, coop, weights))
         .framework("torch")
-        .env_runners(num_env_runners=config.envs if config.envs > 1 else 0, num_envs_per_env_runner=1,
-                     rollout_fragment_length=p.rollout_steps, num_cpus_per_env_runner=1)
+        .env_runners(
+            num_env_runners=config.envs if config.envs > 1 else 0,
+            num_envs_per_env_runner=1,
+            rollout_fragment_length=p.rollout_steps,
+            num_cpus_per_env_runner=1,
+        )
         .learners(num_learners=0)
-        .training(train_batch_size_per_learner=config.batch_size, minibatch_size=p.minibatch_size, num_epochs=p.epochs,
-                  gamma=p.gamma, lambda_=p.gae_lambda, lr=p.learning_rate, clip_param=p.clip_range,
-                  vf_loss_coeff=p.value_coef, entropy_coeff=p.entropy_coef, grad_clip=p.max_grad_norm)
-        .rl_module(model_config=DefaultModelConfig(fcnet_hiddens=list(config.network.hidden),
-                                                   fcnet_activation=config.network.activation, vf_share_layers=False))
+        .training(
+            train_batch_size_per_learner=config.batch_size,
+            minibatch_size=p.minibatch_size,
+            num_epochs=p.epochs,
+            gamma=p.gamma,
+            lambda_=p.gae_lambda,
+            lr=p.learning_rate,
+            clip_param=p.clip_range,
+            vf_loss_coeff=p.value_coef,
+            entropy_coeff=p.entropy_coef,
+            grad_clip=p.max_grad_norm,
+        )
+        .rl_module(
+            model_config=DefaultModelConfig(
+                fcnet_hiddens=list(config.network.hidden),
+                fcnet_activation=config.network.activation,
+                vf_share_layers=False,
+            )
+        )
         .callbacks(_callbacks_class())
         .debugging(seed=config.seed, log_level="ERROR")
     )
@@ -252,8 +301,17 @@ def save_checkpoint(run: RunDir, algo, steps: int) -> Path:
     return run.end_checkpoint(out, steps, {"engine": "rllib"})
 
 
-def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, coop: bool, resume: bool,
-          address: str | None = None, quiet: bool = False, stop=None) -> dict:
+def train(
+    run: RunDir,
+    config: TrainingConfig,
+    weights: dict[str, float],
+    *,
+    coop: bool,
+    resume: bool,
+    address: str | None = None,
+    quiet: bool = False,
+    stop=None,
+) -> dict:
     """Train (or continue) the run to ``config.total_steps`` env steps; a stop request (``stop``:
     Ctrl-C or SIGTERM, see :func:`.train.stop_on_signals`) ends it after the current iteration,
     with a checkpoint."""
@@ -296,8 +354,13 @@ def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, coo
         algo.stop()
     if not quiet and interrupted and lost is None:
         print("interrupted: checkpoint written", file=sys.stderr)
-    return {"steps": int(steps), "wall_s": wall, "steps_per_s_including_learning": rate, "interrupted": interrupted,
-            **({"stopped_because": lost} if lost is not None else {})}
+    return {
+        "steps": int(steps),
+        "wall_s": wall,
+        "steps_per_s_including_learning": rate,
+        "interrupted": interrupted,
+        **({"stopped_because": lost} if lost is not None else {}),
+    }
 
 
 def env_runners_lost(algo, config: TrainingConfig) -> str | None:
@@ -309,8 +372,10 @@ def env_runners_lost(algo, config: TrainingConfig) -> str | None:
         return None
     if group.num_healthy_remote_env_runners() > 0:
         return None
-    return (f"all {group.num_remote_env_runners()} env runners were lost (the node they ran on died or left the cluster); "
-            "checkpoint written: start a worker node again and run the same command with --resume")
+    return (
+        f"all {group.num_remote_env_runners()} env runners were lost (the node they ran on died or left the cluster); "
+        "checkpoint written: start a worker node again and run the same command with --resume"
+    )
 
 
 # --------------------------------------------------------------------------------------------

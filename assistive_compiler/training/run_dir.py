@@ -46,6 +46,8 @@ def write_atomic(path: Path, text: str) -> None:
         f.flush()
         os.fsync(f.fileno())
     os.replace(tmp, path)
+
+
 PACKAGES = ("assistive-compiler", "pybullet", "gymnasium", "numpy", "torch", "stable-baselines3", "ray", "pettingzoo")
 
 
@@ -102,7 +104,9 @@ class RunDir:
         """The run's ``run.json``; a clear error when ``path`` is not a run directory."""
         file = self.path / RUN_FILE
         if not file.is_file():
-            raise UsageError(f"{display(self.path)}: not a run directory (no {RUN_FILE}); `assistive-compiler train` writes one")
+            raise UsageError(
+                f"{display(self.path)}: not a run directory (no {RUN_FILE}); `assistive-compiler train` writes one"
+            )
         return RunInfo(**json.loads(file.read_text()))
 
     def create(self, info: RunInfo, artifact_src: Path) -> None:
@@ -162,9 +166,16 @@ class RunDir:
 
 def new_run_info(spec: str, manifest, robot: str, coop: bool, engine: str, config: TrainingConfig) -> RunInfo:
     return RunInfo(
-        spec=display(Path(spec)), task=manifest.task, robot=robot, coop=coop, engine=engine,
-        content_hash=manifest.content_hash, gym_id=manifest.gym_id + ("" if not coop else " (Human)"),
-        config=config.model_dump(exclude_none=True), versions=package_versions(), command=sys.argv[:],
+        spec=display(Path(spec)),
+        task=manifest.task,
+        robot=robot,
+        coop=coop,
+        engine=engine,
+        content_hash=manifest.content_hash,
+        gym_id=manifest.gym_id + ("" if not coop else " (Human)"),
+        config=config.model_dump(exclude_none=True),
+        versions=package_versions(),
+        command=sys.argv[:],
         created=time.strftime("%Y-%m-%dT%H:%M:%S"),
     )
 
@@ -190,7 +201,11 @@ def check_resumable(run: RunDir, content_hash: str, robot: str, coop: bool, engi
             f"--resume: this run trained a different compiled task (content hash {info.content_hash[:12]}, spec {info.spec}); "
             f"the spec given compiles to {content_hash[:12]}. Resume with the run's own spec, or start a new run (another --out)",
         )
-    for what, ours, theirs in (("robot", robot, info.robot), ("--coop", coop, info.coop), ("engine", engine, info.engine)):
+    for what, ours, theirs in (
+        ("robot", robot, info.robot),
+        ("--coop", coop, info.coop),
+        ("engine", engine, info.engine),
+    ):
         if ours != theirs:
             raise SpecError.at(where, f"--resume: this run was trained with {what} {theirs!r}, not {ours!r}")
     return info

@@ -15,8 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .config import TrainingConfig
 from ..episode import EpisodeTally
+from .config import TrainingConfig
 from .progress import Progress
 from .run_dir import RunDir
 
@@ -77,8 +77,12 @@ def _normalized(venv, config: TrainingConfig, checkpoint: Path | None):
         return venv
     if checkpoint is not None:
         return VecNormalize.load(str(checkpoint / "vecnormalize.pkl"), venv)
-    return VecNormalize(venv, norm_obs=config.ppo.normalize_observations, norm_reward=config.ppo.normalize_rewards,
-                        gamma=config.ppo.gamma)
+    return VecNormalize(
+        venv,
+        norm_obs=config.ppo.normalize_observations,
+        norm_reward=config.ppo.normalize_rewards,
+        gamma=config.ppo.gamma,
+    )
 
 
 def _new_model(venv, config: TrainingConfig, run: RunDir):
@@ -86,15 +90,45 @@ def _new_model(venv, config: TrainingConfig, run: RunDir):
 
     if config.sac is not None:
         s = config.sac
-        return SAC("MlpPolicy", venv, learning_rate=s.learning_rate, buffer_size=s.buffer_size, learning_starts=s.learning_starts,
-                   batch_size=s.batch_size, tau=s.tau, gamma=s.gamma, train_freq=s.train_freq, gradient_steps=s.gradient_steps,
-                   ent_coef=s.ent_coef, target_entropy=s.target_entropy, policy_kwargs=policy_kwargs(config),
-                   tensorboard_log=str(run.tb), seed=config.seed, device="cpu", verbose=0)
+        return SAC(
+            "MlpPolicy",
+            venv,
+            learning_rate=s.learning_rate,
+            buffer_size=s.buffer_size,
+            learning_starts=s.learning_starts,
+            batch_size=s.batch_size,
+            tau=s.tau,
+            gamma=s.gamma,
+            train_freq=s.train_freq,
+            gradient_steps=s.gradient_steps,
+            ent_coef=s.ent_coef,
+            target_entropy=s.target_entropy,
+            policy_kwargs=policy_kwargs(config),
+            tensorboard_log=str(run.tb),
+            seed=config.seed,
+            device="cpu",
+            verbose=0,
+        )
     p = config.ppo
-    return PPO("MlpPolicy", venv, n_steps=p.rollout_steps, batch_size=p.minibatch_size, n_epochs=p.epochs, gamma=p.gamma,
-               gae_lambda=p.gae_lambda, learning_rate=p.learning_rate, clip_range=p.clip_range, ent_coef=p.entropy_coef,
-               vf_coef=p.value_coef, max_grad_norm=p.max_grad_norm, policy_kwargs=policy_kwargs(config),
-               tensorboard_log=str(run.tb), seed=config.seed, device="cpu", verbose=0)
+    return PPO(
+        "MlpPolicy",
+        venv,
+        n_steps=p.rollout_steps,
+        batch_size=p.minibatch_size,
+        n_epochs=p.epochs,
+        gamma=p.gamma,
+        gae_lambda=p.gae_lambda,
+        learning_rate=p.learning_rate,
+        clip_range=p.clip_range,
+        ent_coef=p.entropy_coef,
+        vf_coef=p.value_coef,
+        max_grad_norm=p.max_grad_norm,
+        policy_kwargs=policy_kwargs(config),
+        tensorboard_log=str(run.tb),
+        seed=config.seed,
+        device="cpu",
+        verbose=0,
+    )
 
 
 def save_checkpoint(run: RunDir, model, steps: int) -> Path:
@@ -160,8 +194,9 @@ def _callback(run: RunDir, progress: Progress, config: TrainingConfig, n_envs: i
     return RunCallback()
 
 
-def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, resume: bool, quiet: bool = False,
-          stop=None) -> dict:
+def train(
+    run: RunDir, config: TrainingConfig, weights: dict[str, float], *, resume: bool, quiet: bool = False, stop=None
+) -> dict:
     """Train (or continue) the run to ``config.total_steps``; returns the session's figures.
 
     A stop request (``stop``, set by Ctrl-C or SIGTERM: :func:`.train.stop_on_signals`) ends
@@ -175,7 +210,9 @@ def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, res
     if latest and config.sac is not None and not (latest[1] / REPLAY_BUFFER).is_file():
         from ..errors import UsageError
 
-        raise UsageError(f"{latest[1] / REPLAY_BUFFER}: --resume of a SAC run needs the newest checkpoint's replay buffer, which is missing")
+        raise UsageError(
+            f"{latest[1] / REPLAY_BUFFER}: --resume of a SAC run needs the newest checkpoint's replay buffer, which is missing"
+        )
     venv = make_vec_env(run.artifact, config.envs, config.seed + start_steps)
     venv = _normalized(venv, config, latest[1] if latest else None)
     if latest:
@@ -190,8 +227,12 @@ def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, res
     try:
         remaining = max(0, config.total_steps - model.num_timesteps)
         if remaining:
-            model.learn(remaining, callback=_callback(run, progress, config, config.envs, stop), reset_num_timesteps=not latest,
-                        tb_log_name="sb3")
+            model.learn(
+                remaining,
+                callback=_callback(run, progress, config, config.envs, stop),
+                reset_num_timesteps=not latest,
+                tb_log_name="sb3",
+            )
         interrupted = bool(stop)
     except KeyboardInterrupt:  # a second Ctrl-C: stop at once
         interrupted = True
@@ -202,7 +243,12 @@ def train(run: RunDir, config: TrainingConfig, weights: dict[str, float], *, res
         session_rate = (steps - start_steps) / max(1e-9, wall - progress.wall_before)
         progress.close()
         venv.close()
-    return {"steps": int(steps), "wall_s": wall, "steps_per_s_including_learning": session_rate, "interrupted": interrupted}
+    return {
+        "steps": int(steps),
+        "wall_s": wall,
+        "steps_per_s_including_learning": session_rate,
+        "interrupted": interrupted,
+    }
 
 
 # --------------------------------------------------------------------------------------------
@@ -214,8 +260,9 @@ class SB3Policy:
 
     def __init__(self, checkpoint: Path, algorithm: str = "ppo"):
         self.algorithm = algorithm
-        self.model = algorithm_class(algorithm).load(str(checkpoint / "model.zip"), device="cpu",
-                                                     custom_objects={"replay_buffer_class": None})
+        self.model = algorithm_class(algorithm).load(
+            str(checkpoint / "model.zip"), device="cpu", custom_objects={"replay_buffer_class": None}
+        )
         self.obs_rms = None
         stats = checkpoint / "vecnormalize.pkl"
         if stats.is_file():

@@ -63,14 +63,25 @@ def table_rows(best: dict, coop: bool) -> tuple[list[str], list[list[str]], list
             paper_value = paper.get(task, {}).get(robot)
             mine = ours[robot]
             cells.append(f"{_fmt(mine['mean_return'] if mine else None)} ({_fmt(paper_value)})")
-            records.append({"table": "II" if coop else "I", "task": task, "robot": robot,
-                            "mean_return": mine["mean_return"] if mine else None, "std_return": mine["std_return"] if mine else None,
-                            "success_rate": mine["success_rate"] if mine else None, "episodes": mine["episodes"] if mine else None,
-                            "trained_steps": mine["trained_steps"] if mine else None, "run": mine["run"] if mine else None,
-                            "paper_mean_return": paper_value})
+            records.append(
+                {
+                    "table": "II" if coop else "I",
+                    "task": task,
+                    "robot": robot,
+                    "mean_return": mine["mean_return"] if mine else None,
+                    "std_return": mine["std_return"] if mine else None,
+                    "success_rate": mine["success_rate"] if mine else None,
+                    "episodes": mine["episodes"] if mine else None,
+                    "trained_steps": mine["trained_steps"] if mine else None,
+                    "run": mine["run"] if mine else None,
+                    "paper_mean_return": paper_value,
+                }
+            )
         evaluated = {r: v for r, v in ours.items() if v is not None}
         top = max(evaluated.values(), key=lambda v: v["mean_return"]) if evaluated else None
-        ours_success = f"{100 * top['success_rate']:.0f}% {ROBOT_TITLES.get(top['robot'], top['robot'])}" if top else "—"
+        ours_success = (
+            f"{100 * top['success_rate']:.0f}% {ROBOT_TITLES.get(top['robot'], top['robot'])}" if top else "—"
+        )
         paper_s = paper_success.get(task)
         cells.append(f"{ours_success} ({'—' if paper_s is None else f'{paper_s}%'})")
         rows.append(cells)
@@ -96,10 +107,16 @@ def make_tables(run_dirs: list[str], out: str | None = None, episodes: int | Non
         title = PAPER[coop][0]
         header, rows, recs = table_rows(best, coop)
         records += recs
-        parts.append(f"### {title}\n\nMean return over the evaluation episodes, ours (paper, §V); "
-                     f"Success: the best robot's success rate, ours (paper).\n\n{markdown_table(header, rows)}\n")
+        parts.append(
+            f"### {title}\n\nMean return over the evaluation episodes, ours (paper, §V); "
+            f"Success: the best robot's success rate, ours (paper).\n\n{markdown_table(header, rows)}\n"
+        )
     used = sorted({(r["run"], r["episodes"], r["trained_steps"], r["seed"]) for r in best.values()})
-    parts.append("Runs: " + "; ".join(f"`{run}` ({steps:,} steps, {n} episodes from seed {s})" for run, n, steps, s in used) + "\n")
+    parts.append(
+        "Runs: "
+        + "; ".join(f"`{run}` ({steps:,} steps, {n} episodes from seed {s})" for run, n, steps, s in used)
+        + "\n"
+    )
     text = "\n".join(parts)
     if out:
         out_md = Path(out)

@@ -13,7 +13,7 @@ import sys
 import threading
 from pathlib import Path
 
-from ..errors import SpecError, UsageError
+from ..errors import UsageError
 from ..paths import display
 from .config import TrainingConfig, load_training_config
 from .run_dir import RunDir, check_resumable, new_run_info
@@ -25,7 +25,9 @@ def choose_engine(engine: str, coop: bool, address: str | None) -> str:
     from ..errors import did_you_mean, one_of
 
     if engine not in ENGINES:
-        raise UsageError(f"--engine: unknown engine '{engine}'; expected one of {one_of(ENGINES)}{did_you_mean(engine, ENGINES)}")
+        raise UsageError(
+            f"--engine: unknown engine '{engine}'; expected one of {one_of(ENGINES)}{did_you_mean(engine, ENGINES)}"
+        )
     if engine == "auto":
         return "rllib" if coop or address else "sb3"
     if engine == "sb3" and coop:
@@ -60,9 +62,21 @@ def default_run_dir(task: str, robot: str, coop: bool, seed: int) -> Path:
     return Path("runs") / f"{task}-{robot}{'-coop' if coop else ''}-s{seed}"
 
 
-def train(spec: str, *, robot: str | None, config_path: str, coop: bool = False, engine: str = "auto",
-          steps: int | None = None, seed: int | None = None, envs: int | None = None, out: str | None = None,
-          resume: bool = False, address: str | None = None, quiet: bool = False) -> dict:
+def train(
+    spec: str,
+    *,
+    robot: str | None,
+    config_path: str,
+    coop: bool = False,
+    engine: str = "auto",
+    steps: int | None = None,
+    seed: int | None = None,
+    envs: int | None = None,
+    out: str | None = None,
+    resume: bool = False,
+    address: str | None = None,
+    quiet: bool = False,
+) -> dict:
     """Train a policy for ``spec`` and ``robot`` as ``config_path`` says; returns the run's summary."""
     engine = choose_engine(engine, coop, address)
     config: TrainingConfig = load_training_config(config_path).with_overrides(steps=steps, seed=seed, envs=envs)
@@ -78,18 +92,25 @@ def train(spec: str, *, robot: str | None, config_path: str, coop: bool = False,
         resumed = info.training_config
         for flag, given, kept in (("--seed", seed, resumed.seed), ("--envs", envs, resumed.envs)):
             if given is not None and given != kept:
-                raise UsageError(f"{flag} {given}: --resume continues the run with its own config ({flag} {kept}); only --steps may change")
+                raise UsageError(
+                    f"{flag} {given}: --resume continues the run with its own config ({flag} {kept}); only --steps may change"
+                )
         config = resumed.with_overrides(steps=steps)
     elif run.exists():
-        raise UsageError(f"{display(run.path)}: the run directory already holds a run; pass --resume to continue it, or choose another --out")
+        raise UsageError(
+            f"{display(run.path)}: the run directory already holds a run; pass --resume to continue it, or choose another --out"
+        )
     else:
         run.create(new_run_info(spec, manifest, robot, coop, engine, config), result.out_dir)
     weights = reward_weights(manifest)
     if not quiet:
         from .progress import print_reward_table
 
-        print(f"{manifest.label}{' + human (co-optimisation)' if coop else ''}: {engine} {config.algorithm.upper()}, {config.envs} envs, "
-              f"{config.total_steps:,} steps -> {display(run.path)}", file=sys.stderr)
+        print(
+            f"{manifest.label}{' + human (co-optimisation)' if coop else ''}: {engine} {config.algorithm.upper()}, {config.envs} envs, "
+            f"{config.total_steps:,} steps -> {display(run.path)}",
+            file=sys.stderr,
+        )
         print_reward_table(weights, manifest.task)
     with stop_on_signals() as stop:
         if engine == "sb3":
@@ -99,7 +120,9 @@ def train(spec: str, *, robot: str | None, config_path: str, coop: bool = False,
         else:
             from . import rllib
 
-            figures = rllib.train(run, config, weights, coop=coop, resume=resume, address=address, quiet=quiet, stop=stop)
+            figures = rllib.train(
+                run, config, weights, coop=coop, resume=resume, address=address, quiet=quiet, stop=stop
+            )
     return finish(run, manifest, engine, config, figures)
 
 
@@ -146,8 +169,11 @@ def finish(run: RunDir, manifest, engine: str, config: TrainingConfig, figures: 
     curve = read_curve(run.curve_csv)
     tail = curve[-5:]
     summary = {
-        "gym_id": manifest.gym_id, "engine": engine, **figures,
-        "total_steps_configured": config.total_steps, "envs": config.envs,
+        "gym_id": manifest.gym_id,
+        "engine": engine,
+        **figures,
+        "total_steps_configured": config.total_steps,
+        "envs": config.envs,
         "episodes": curve[-1]["episodes"] if curve else 0,
         "final_mean_return": sum(r["mean_return"] for r in tail) / len(tail) if tail else None,
         "final_success_rate": sum(r["success_rate"] for r in tail) / len(tail) if tail else None,

@@ -12,8 +12,14 @@ from pathlib import Path
 __all__ = ["episode_for_view", "view"]
 
 
-def episode_for_view(spec: str, robot: str | None = None, policy: str | None = None, replay: str | None = None, seed: int = 0,
-                     out: str | None = None):
+def episode_for_view(
+    spec: str,
+    robot: str | None = None,
+    policy: str | None = None,
+    replay: str | None = None,
+    seed: int = 0,
+    out: str | None = None,
+):
     """(artifact dir, recording, player): the compiled task, the episode to show — ``replay`` (a
     recording of this very artifact) or one played headless by ``policy`` (default scripted) from
     ``seed`` — and the player that plays more (None for a replay)."""
@@ -29,9 +35,12 @@ def episode_for_view(spec: str, robot: str | None = None, policy: str | None = N
             raise SpecError.at(replay, str(exc).split(": ", 1)[1]) from None
         want, got = result.manifest.content_hash, recording.header["content_hash"]
         if got != want:
-            raise SpecError.at(replay, f"recorded from artifact {got[:12]} ({recording.header['task']}, {recording.header['robot']}), "
-                                       f"but {spec} for {result.manifest.robot_name} compiles to {want[:12]}; view it with the spec "
-                                       "and robot it was recorded from")
+            raise SpecError.at(
+                replay,
+                f"recorded from artifact {got[:12]} ({recording.header['task']}, {recording.header['robot']}), "
+                f"but {spec} for {result.manifest.robot_name} compiles to {want[:12]}; view it with the spec "
+                "and robot it was recorded from",
+            )
         return result.out_dir, recording, None
     from ..runtime.env import AssistiveEnv
     from .app import EpisodePlayer
@@ -40,8 +49,19 @@ def episode_for_view(spec: str, robot: str | None = None, policy: str | None = N
     return result.out_dir, player.play(seed), player
 
 
-def view(spec: str, robot: str | None = None, policy: str | None = None, replay: str | None = None, seed: int = 0,
-         out: str | None = None, host: str = "127.0.0.1", port: int = 8080, gui: bool = False, speed: float = 1.0, on_ready=None) -> int:
+def view(
+    spec: str,
+    robot: str | None = None,
+    policy: str | None = None,
+    replay: str | None = None,
+    seed: int = 0,
+    out: str | None = None,
+    host: str = "127.0.0.1",
+    port: int = 8080,
+    gui: bool = False,
+    speed: float = 1.0,
+    on_ready=None,
+) -> int:
     """Show an episode of ``spec`` for ``robot`` until Ctrl-C: in the browser (``host:port``) or,
     with ``gui``, in pybullet's GUI. Returns the exit status."""
     artifact_dir, recording, player = episode_for_view(spec, robot, policy, replay, seed, out)

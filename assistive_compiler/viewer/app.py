@@ -40,7 +40,9 @@ class EpisodePlayer:
         from ..record import record_episode
 
         options = {"person_variant": variant} if variant else None
-        return record_episode(self.env, self.policy, seed, self._dir.name, policy_name=self.policy_name, options=options)
+        return record_episode(
+            self.env, self.policy, seed, self._dir.name, policy_name=self.policy_name, options=options
+        )
 
 
 class ViewerApp:
@@ -81,8 +83,10 @@ class ViewerApp:
             self.scene = RecordingScene(self.server, self.dir, rec)
             h = rec.header
             self.title.content = f"**{h['task']}** · {h['robot']} · artifact `{h['content_hash'][:12]}`"
-            self.summary.content = (f"seed {h['seed']} · person {h['person_variant']} · policy {h['policy']}  \n"
-                                    f"return {h['return']:.2f} · success {'yes' if h['success'] else 'no'} · {h['steps']} steps of {h['dt']:g} s")
+            self.summary.content = (
+                f"seed {h['seed']} · person {h['person_variant']} · policy {h['policy']}  \n"
+                f"return {h['return']:.2f} · success {'yes' if h['success'] else 'no'} · {h['steps']} steps of {h['dt']:g} s"
+            )
             self.bodies.content = self._bodies_markdown(h)
             self._plot(rec)
             self.slider.max = max(1, rec.steps)
@@ -92,8 +96,15 @@ class ViewerApp:
 
     @staticmethod
     def _bodies_markdown(h: dict) -> str:
-        lines = [f"- **{b['name']}** ({b['kind']}, {len(b['links'])} links)" + (" — hidden: not this episode's person" if
-                 b["kind"] == "person" and b["name"] != h["person_body"] else "") for b in h["bodies"]]
+        lines = [
+            f"- **{b['name']}** ({b['kind']}, {len(b['links'])} links)"
+            + (
+                " — hidden: not this episode's person"
+                if b["kind"] == "person" and b["name"] != h["person_body"]
+                else ""
+            )
+            for b in h["bodies"]
+        ]
         lines += [f"- target **{t}**" for t in h["targets"]]
         lines += [f"- particles **{p['name']}** ({p['count']})" for p in h["particles"]]
         lines += [f"- markers **{m['name']}** ({m['count']})" for m in h["markers"]]
@@ -104,12 +115,19 @@ class ViewerApp:
         h = rec.header
         x = np.arange(1, rec.steps + 1, dtype=np.float64)
         ys = tuple(h["term_weights"][name] * rec.term(name) for name in h["terms"])
-        series = ({"label": "step"},) + tuple({"label": name, "stroke": PALETTE[k % len(PALETTE)], "width": 1.5}
-                                              for k, name in enumerate(h["terms"]))
+        series = ({"label": "step"},) + tuple(
+            {"label": name, "stroke": PALETTE[k % len(PALETTE)], "width": 1.5} for k, name in enumerate(h["terms"])
+        )
         if self.plot is not None:
             self.plot.remove()
-        self.plot = self.server.gui.add_uplot((x, *ys), series, title="Reward terms (weight × value) per step",
-                                            scales={"x": {"time": False}}, aspect=1.2, order=2)
+        self.plot = self.server.gui.add_uplot(
+            (x, *ys),
+            series,
+            title="Reward terms (weight × value) per step",
+            scales={"x": {"time": False}},
+            aspect=1.2,
+            order=2,
+        )
 
     def _describe_step(self) -> None:
         rec, k = self.recording, int(self.slider.value)
@@ -117,10 +135,14 @@ class ViewerApp:
             self.step_text.content = "state after reset"
             return
         h = rec.header
-        terms = sorted(((h["term_weights"][n] * rec.term(n)[k - 1], n) for n in h["terms"]), key=lambda t: -abs(t[0]))[:3]
+        terms = sorted(((h["term_weights"][n] * rec.term(n)[k - 1], n) for n in h["terms"]), key=lambda t: -abs(t[0]))[
+            :3
+        ]
         shown = ", ".join(f"{n} {v:+.2f}" for v, n in terms)
-        self.step_text.content = (f"t = {k * h['dt']:.1f} s · reward {rec.arrays['rewards'][k - 1]:+.2f} · "
-                                  f"success {int(rec.arrays['task_success'][k - 1])}  \n{shown}")
+        self.step_text.content = (
+            f"t = {k * h['dt']:.1f} s · reward {rec.arrays['rewards'][k - 1]:+.2f} · "
+            f"success {int(rec.arrays['task_success'][k - 1])}  \n{shown}"
+        )
 
     # -- controls --------------------------------------------------------------------------------
     def _toggle(self) -> None:
@@ -149,15 +171,24 @@ class ViewerApp:
         self.slider.value = int(self.slider.value) + 1
 
 
-def serve(artifact_dir: str | Path, recording: Recording, player: EpisodePlayer | None = None, host: str = "127.0.0.1",
-          port: int = 8080, speed: float = 1.0, on_ready=None) -> int:
+def serve(
+    artifact_dir: str | Path,
+    recording: Recording,
+    player: EpisodePlayer | None = None,
+    host: str = "127.0.0.1",
+    port: int = 8080,
+    speed: float = 1.0,
+    on_ready=None,
+) -> int:
     """Serve the page until SIGINT (Ctrl-C); returns 0 after stopping the server cleanly.
     ``on_ready(url)`` is called once the page can be loaded."""
     import viser
 
     from ..artifact import Manifest
 
-    if threading.current_thread() is threading.main_thread():  # Ctrl-C stops the server even if the shell ignored SIGINT (a background job)
+    if (
+        threading.current_thread() is threading.main_thread()
+    ):  # Ctrl-C stops the server even if the shell ignored SIGINT (a background job)
         signal.signal(signal.SIGINT, signal.default_int_handler)
     server = viser.ViserServer(host=host, port=port, label="assistive-compiler", verbose=False)
     try:

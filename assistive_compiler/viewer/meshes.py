@@ -47,7 +47,9 @@ def link_visuals(urdf_path: str | Path) -> dict[str, list[VisualMesh]]:
     import yourdfpy
 
     urdf_path = Path(urdf_path)
-    model = yourdfpy.URDF.load(str(urdf_path), build_scene_graph=False, load_meshes=False, build_collision_scene_graph=False)
+    model = yourdfpy.URDF.load(
+        str(urdf_path), build_scene_graph=False, load_meshes=False, build_collision_scene_graph=False
+    )
     named = {m.name: tuple(m.color.rgba) for m in model.robot.materials if m.color is not None}
     out: dict[str, list[VisualMesh]] = {}
     for link in model.robot.links:
@@ -61,9 +63,16 @@ def link_visuals(urdf_path: str | Path) -> dict[str, list[VisualMesh]]:
             material = visual.material
             rgba = DEFAULT_RGBA
             if material is not None:
-                rgba = tuple(material.color.rgba) if material.color is not None else named.get(material.name, DEFAULT_RGBA)
-            visuals.append(VisualMesh(np.asarray(mesh.vertices, dtype=np.float32), np.asarray(mesh.faces, dtype=np.uint32),
-                                      tuple(float(x) for x in rgba)))
+                rgba = (
+                    tuple(material.color.rgba) if material.color is not None else named.get(material.name, DEFAULT_RGBA)
+                )
+            visuals.append(
+                VisualMesh(
+                    np.asarray(mesh.vertices, dtype=np.float32),
+                    np.asarray(mesh.faces, dtype=np.uint32),
+                    tuple(float(x) for x in rgba),
+                )
+            )
         out[link.name] = visuals
     return out
 

@@ -43,11 +43,21 @@ class RecordingScene:
                 frame = scene.add_frame(f"/bodies/{body['name']}/{link}", show_axes=False)
                 self.frames.append((header["links"].index([body["name"], link]), frame))
                 for k, v in enumerate(visuals.get(link, [])):
-                    scene.add_mesh_simple(f"/bodies/{body['name']}/{link}/visual_{k}", v.vertices, v.faces,
-                                          color=_rgb255(v.rgba), opacity=None if v.rgba[3] >= 1 else v.rgba[3])
+                    scene.add_mesh_simple(
+                        f"/bodies/{body['name']}/{link}/visual_{k}",
+                        v.vertices,
+                        v.faces,
+                        color=_rgb255(v.rgba),
+                        opacity=None if v.rgba[3] >= 1 else v.rgba[3],
+                    )
         self.person_bodies = [b["name"] for b in header["bodies"] if b["kind"] == "person"]
-        self.targets = [scene.add_icosphere(f"/targets/{name}", radius=0.015, color=_rgb255(TARGET_RGBA)) for name in header["targets"]]
-        self.particles = {p["name"]: (np.asarray(p["colors"])[:, :3] * 255).astype(np.uint8) for p in header["particles"]}
+        self.targets = [
+            scene.add_icosphere(f"/targets/{name}", radius=0.015, color=_rgb255(TARGET_RGBA))
+            for name in header["targets"]
+        ]
+        self.particles = {
+            p["name"]: (np.asarray(p["colors"])[:, :3] * 255).astype(np.uint8) for p in header["particles"]
+        }
         self.particle_size = {p["name"]: 2.0 * p["radius"] for p in header["particles"]}
         self.marker_rgb = {m["name"]: _rgb255(m["rgba"] or (0.2, 0.4, 1.0, 1.0)) for m in header["markers"]}
         self.garments = {}
@@ -55,8 +65,9 @@ class RecordingScene:
             if body["kind"] == "garment":
                 faces = garment_faces(self.dir / body["urdf"])
                 nodes = recording.arrays[f"garment/{body['name']}"][0]
-                self.garments[body["name"]] = scene.add_mesh_simple(f"/garments/{body['name']}", nodes.astype(np.float32), faces,
-                                                                    color=(120, 160, 220), side="double")
+                self.garments[body["name"]] = scene.add_mesh_simple(
+                    f"/garments/{body['name']}", nodes.astype(np.float32), faces, color=(120, 160, 220), side="double"
+                )
         self.recording = recording
 
     def show(self, k: int) -> None:
@@ -76,12 +87,22 @@ class RecordingScene:
                 node.position = p
             for name, colors in self.particles.items():
                 shown = a[f"particles_active/{name}"][k]
-                scene.add_point_cloud(f"/particles/{name}", a[f"particles/{name}"][k][shown].astype(np.float32), colors[shown],
-                                      point_size=self.particle_size[name], point_shape="circle")
+                scene.add_point_cloud(
+                    f"/particles/{name}",
+                    a[f"particles/{name}"][k][shown].astype(np.float32),
+                    colors[shown],
+                    point_size=self.particle_size[name],
+                    point_shape="circle",
+                )
             for name, rgb in self.marker_rgb.items():
                 left = a[f"markers_remaining/{name}"][k]
-                scene.add_point_cloud(f"/markers/{name}", a[f"markers/{name}"][k][left].astype(np.float32), rgb, point_size=0.016,
-                                      point_shape="circle")
+                scene.add_point_cloud(
+                    f"/markers/{name}",
+                    a[f"markers/{name}"][k][left].astype(np.float32),
+                    rgb,
+                    point_size=0.016,
+                    point_shape="circle",
+                )
             for name, mesh in self.garments.items():
                 mesh.vertices = a[f"garment/{name}"][k].astype(np.float32)
 

@@ -91,8 +91,6 @@ def check_urdf_or_raise(
     require_collision: Callable[[str], bool] | None = None,
 ) -> None:
     """`lint_urdf`, raising `LintError` (one problem per line) when anything is found."""
-    problems = lint_urdf(
-        urdf_xml, template=template, base_dir=base_dir, require_collision=require_collision
-    )
+    problems = lint_urdf(urdf_xml, template=template, base_dir=base_dir, require_collision=require_collision)
     if problems:
         raise LintError(problems)

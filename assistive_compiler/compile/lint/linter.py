@@ -21,10 +21,7 @@ MOVABLE_LIMITED = ("revolute", "prismatic")
 ALLOWED_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed")
 KNOWN_JOINT_TYPES = ALLOWED_JOINT_TYPES + ("floating", "planar")
 ALLOWED_GEOMETRY = ("box", "cylinder", "sphere", "mesh")
-CAPSULE_HINT = (
-    "write a capsule as a cylinder plus two spheres "
-    "(capsule_shapes in templates/common/shapes.xacro)"
-)
+CAPSULE_HINT = "write a capsule as a cylinder plus two spheres (capsule_shapes in templates/common/shapes.xacro)"
 AXIS_TOLERANCE = 1e-6
 TRIANGLE_TOLERANCE = 1e-9
 INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
@@ -92,7 +89,7 @@ class Linter:
         links = root.findall("link")
         joints = root.findall("joint")
         children = {c.get("link") for j in joints for c in j.findall("child")}
-        self.roots = {l.get("name") for l in links} - children
+        self.roots = {link.get("name") for link in links} - children
         for index, link in enumerate(links, start=1):
             self.lint_link(link, self.label("link", link, index))
         for index, joint in enumerate(joints, start=1):
@@ -159,8 +156,7 @@ class Linter:
         if inertial is None:
             self.add(
                 owner,
-                "has no <inertial>; expected an <inertial> with a positive <mass value> "
-                "and an <inertia>",
+                "has no <inertial>; expected an <inertial> with a positive <mass value> and an <inertia>",
             )
             return
 
@@ -183,8 +179,7 @@ class Linter:
         if missing:
             self.add(
                 owner,
-                f"<inertia> lacks {', '.join(missing)}; expected all of "
-                f"{', '.join(INERTIA_KEYS)}",
+                f"<inertia> lacks {', '.join(missing)}; expected all of {', '.join(INERTIA_KEYS)}",
             )
             return
         values = {key: number(inertia_elem, key) for key in INERTIA_KEYS}
@@ -229,8 +224,7 @@ class Linter:
             found = ", ".join(f"<{k.tag}>" for k in kinds) or "nothing"
             self.add(
                 owner,
-                f"{where}<geometry> holds {found}; expected exactly one of "
-                f"{', '.join(ALLOWED_GEOMETRY)}",
+                f"{where}<geometry> holds {found}; expected exactly one of {', '.join(ALLOWED_GEOMETRY)}",
             )
             return
         geom = kinds[0]
@@ -240,8 +234,7 @@ class Linter:
         if geom.tag not in ALLOWED_GEOMETRY:
             self.add(
                 owner,
-                f"{where}geometry <{geom.tag}> is not supported; expected one of "
-                f"{', '.join(ALLOWED_GEOMETRY)}",
+                f"{where}geometry <{geom.tag}> is not supported; expected one of {', '.join(ALLOWED_GEOMETRY)}",
             )
             return
         if geom.tag == "box":
@@ -293,15 +286,14 @@ class Linter:
                 f"resolve; expected an absolute path (or one relative to the URDF's folder)",
             )
             return
-        path_text = filename[len("file://"):] if filename.startswith("file://") else filename
+        path_text = filename[len("file://") :] if filename.startswith("file://") else filename
         path = Path(path_text)
         if not path.is_absolute():
             path = (self.base_dir if self.base_dir is not None else Path.cwd()) / path
         if not path.is_file():
             self.add(
                 owner,
-                f"{where}mesh file {filename!r} does not exist (looked for {path}); "
-                f"expected an existing mesh file",
+                f"{where}mesh file {filename!r} does not exist (looked for {path}); expected an existing mesh file",
             )
 
     # -- joints -------------------------------------------------------------------------
@@ -318,8 +310,7 @@ class Linter:
         if joint_type not in KNOWN_JOINT_TYPES:
             self.add(
                 owner,
-                f"type {joint_type!r} is not a URDF joint type; expected one of "
-                f"{', '.join(ALLOWED_JOINT_TYPES)}",
+                f"type {joint_type!r} is not a URDF joint type; expected one of {', '.join(ALLOWED_JOINT_TYPES)}",
             )
             return
         if joint_type not in ALLOWED_JOINT_TYPES:
@@ -338,10 +329,7 @@ class Linter:
         limit = joint.find("limit")
         if limit is None:
             if joint_type in MOVABLE_LIMITED:
-                expected = (
-                    "<limit lower upper effort velocity> with lower < upper, "
-                    "effort > 0 and velocity > 0"
-                )
+                expected = "<limit lower upper effort velocity> with lower < upper, effort > 0 and velocity > 0"
             else:
                 expected = "<limit effort velocity> with effort > 0 and velocity > 0"
             self.add(owner, f"{joint_type} joint has no <limit>; expected {expected}")
@@ -352,8 +340,7 @@ class Linter:
                 if limit.get(attr) is None:
                     self.add(
                         owner,
-                        f"<limit> has no {attr}; expected finite lower < upper for a "
-                        f"{joint_type} joint",
+                        f"<limit> has no {attr}; expected finite lower < upper for a {joint_type} joint",
                     )
                 else:
                     bounds[attr] = number(limit, attr)
@@ -361,8 +348,7 @@ class Linter:
             if lower is not None and upper is not None and not lower < upper:
                 self.add(
                     owner,
-                    f"lower limit {fmt(lower)} is not below upper limit {fmt(upper)}; "
-                    f"expected lower < upper",
+                    f"lower limit {fmt(lower)} is not below upper limit {fmt(upper)}; expected lower < upper",
                 )
         for attr in ("effort", "velocity"):
             if limit.get(attr) is None:
@@ -389,6 +375,5 @@ class Linter:
         elif abs(length - 1.0) >= AXIS_TOLERANCE:
             self.add(
                 owner,
-                f"axis {vec(axis)} has length {fmt_derived(length)}; expected a unit vector "
-                "(length 1 within 1e-6)",
+                f"axis {vec(axis)} has length {fmt_derived(length)}; expected a unit vector (length 1 within 1e-6)",
             )

@@ -25,8 +25,7 @@ def lint_tree(linter, root: ET.Element, links: list[ET.Element], joints: list[ET
             listed = ", ".join(repr(j) for j in joints_in)
             linter.add(
                 f"link '{name}'",
-                f"is the child of {len(joints_in)} joints ({listed}); expected at most one "
-                f"parent joint",
+                f"is the child of {len(joints_in)} joints ({listed}); expected at most one parent joint",
                 crash_prone=True,
             )
     roots = [name for name in dict.fromkeys(link_names) if name not in parents_of]
@@ -41,8 +40,7 @@ def lint_tree(linter, root: ET.Element, links: list[ET.Element], joints: list[ET
         listed = ", ".join(repr(r) for r in roots)
         linter.add(
             robot,
-            f"has {len(roots)} root links ({listed}); expected exactly one root link "
-            f"(connect the others with joints)",
+            f"has {len(roots)} root links ({listed}); expected exactly one root link (connect the others with joints)",
             crash_prone=True,
         )
         return
@@ -86,8 +84,7 @@ def _joint_ends(linter, joints: list[ET.Element], known: set[str]) -> tuple[dict
             elif name not in known:
                 linter.add(
                     owner,
-                    f"{role} link {name!r} does not exist; expected the name of a link "
-                    f"in this document",
+                    f"{role} link {name!r} does not exist; expected the name of a link in this document",
                 )
             else:
                 ends[role] = name

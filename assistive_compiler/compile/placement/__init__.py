@@ -39,13 +39,36 @@ def precompute(rt: ResolvedTask, emitted: EmittedScene, out_tmp: Path) -> Manife
         arms = arm_chains(rt, pc, scene)
         _, start, tool_orn = arms[0]
         placed = {variant: place_for_variant(rt, pc, scene, arms, variant) for variant in spec.person.variants}
-        variants = [person_variant(rt, v, emitted.written[f"person_{v}"], emitted.measurements[v], emitted.postures[v],
-                                   emitted.movable, starts) for v, (starts, _) in placed.items()]
+        variants = [
+            person_variant(
+                rt,
+                v,
+                emitted.written[f"person_{v}"],
+                emitted.measurements[v],
+                emitted.postures[v],
+                emitted.movable,
+                starts,
+            )
+            for v, (starts, _) in placed.items()
+        ]
         robot = pose_at_first_start(rt, pc, scene, arms, variants[0].starts[0])
         particles = [settle_particles(rt, pc, name, ps, scene, start, tool_orn) for name, ps in spec.particles.items()]
-        garments = [settle_garment(rt, name, g, out_tmp, scene.garment_grips[name], tool_orn) for name, g in spec.garments.items()]
+        garments = [
+            settle_garment(rt, name, g, out_tmp, scene.garment_grips[name], tool_orn)
+            for name, g in spec.garments.items()
+        ]
     finally:
         pc.close()
-    return build_manifest(rt, bodies=[robot, *scene.bodies], variants=variants, tools=scene.attachments, particles=particles,
-                          garments=garments, arm_joints=scene.arm_joints, lower=scene.lower, upper=scene.upper,
-                          placements={v: placement for v, (_, placement) in placed.items()}, welded=emitted.welded)
+    return build_manifest(
+        rt,
+        bodies=[robot, *scene.bodies],
+        variants=variants,
+        tools=scene.attachments,
+        particles=particles,
+        garments=garments,
+        arm_joints=scene.arm_joints,
+        lower=scene.lower,
+        upper=scene.upper,
+        placements={v: placement for v, (_, placement) in placed.items()},
+        welded=emitted.welded,
+    )

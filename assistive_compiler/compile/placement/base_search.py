@@ -13,8 +13,8 @@ from collections import Counter
 
 import numpy as np
 
-from ...rotation import quat_from_rpy
 from ...resolve import ResolvedTask
+from ...rotation import quat_from_rpy
 from ..task import fail
 
 
@@ -45,7 +45,9 @@ def reach_goals(rt: ResolvedTask, pc, scene, arms: list, variant: str) -> list[t
         where = np.asarray(_point_world(pc, rt, g["point"], scene, variant)) + g["offset_m"]
         k = rt.sides.index(g["arm"]) if g["arm"] in rt.sides else 0
         kin, _, side_orn = arms[k]
-        goals.append((tuple(where), side_orn if g["oriented"] else None, g["required"], _describe_point(g["point"]), kin, False))
+        goals.append(
+            (tuple(where), side_orn if g["oriented"] else None, g["required"], _describe_point(g["point"]), kin, False)
+        )
     return goals
 
 
@@ -82,7 +84,9 @@ def search_base(rt: ResolvedTask, arms: list, goals, offset, rng, carry: Carried
     misses: list[list] = [[] for _ in goals]  # per goal: why IK missed it, per sample
     for _ in range(search.attempts):
         xy = anchor + [rng.uniform(*search.x_range_m), rng.uniform(*search.y_range_m)]
-        yaw = math.radians(search.yaw_deg + rt.robot.part.facing_yaw_deg + rng.uniform(-search.yaw_noise_deg, search.yaw_noise_deg))
+        yaw = math.radians(
+            search.yaw_deg + rt.robot.part.facing_yaw_deg + rng.uniform(-search.yaw_noise_deg, search.yaw_noise_deg)
+        )
         pos, orn = (float(xy[0]), float(xy[1]), float(z)), quat_from_rpy((0.0, 0.0, yaw))
         touched = _base_blocked_by(arms, pos, orn, carry)
         if touched is not None:
@@ -108,10 +112,18 @@ def search_base(rt: ResolvedTask, arms: list, goals, offset, rng, carry: Carried
     if not found:
         worst = int(np.argmax(required_misses))
         own = rt.spec.robot.per_robot.get(rt.robot_name)
-        in_force = ("robot", "per_robot", rt.robot_name, "base_search") if own is not None and own.base_search is not None else ("robot", "base_search")
-        raise fail(rt, in_force, f"robot '{rt.robot_name}' reaches {goals[worst][3]} from none of {search.attempts} sampled base poses: "
-                                 f"{_why(blocked, misses[worst], search.attempts)}; set robot.per_robot.{rt.robot_name}.base_offset_m "
-                                 f"or widen {'.'.join(in_force)} (x_range_m, y_range_m, yaw_noise_deg)")
+        in_force = (
+            ("robot", "per_robot", rt.robot_name, "base_search")
+            if own is not None and own.base_search is not None
+            else ("robot", "base_search")
+        )
+        raise fail(
+            rt,
+            in_force,
+            f"robot '{rt.robot_name}' reaches {goals[worst][3]} from none of {search.attempts} sampled base poses: "
+            f"{_why(blocked, misses[worst], search.attempts)}; set robot.per_robot.{rt.robot_name}.base_offset_m "
+            f"or widen {'.'.join(in_force)} (x_range_m, y_range_m, yaw_noise_deg)",
+        )
     found.sort(key=lambda f: (-f[1], -f[2]))
     return found[: search.keep]
 
@@ -125,12 +137,18 @@ def _why(blocked: Counter, misses: list, attempts: int) -> str:
     kinds = Counter(m.kind for m in misses if m is not None)
     if kinds["out of reach"]:
         closest = min(m.distance_m for m in misses if m is not None and m.kind == "out of reach")
-        parts.append(f"{kinds['out of reach']} left it out of reach (the closest the end effector came was {closest:.2f} m away)")
+        parts.append(
+            f"{kinds['out of reach']} left it out of reach (the closest the end effector came was {closest:.2f} m away)"
+        )
     if kinds["orientation"]:
         best = min(m.angle_deg for m in misses if m is not None and m.kind == "orientation")
-        parts.append(f"{kinds['orientation']} reached it only at the wrong orientation (at best {best:.0f}° off, 3° allowed)")
+        parts.append(
+            f"{kinds['orientation']} reached it only at the wrong orientation (at best {best:.0f}° off, 3° allowed)"
+        )
     if kinds["collision"]:
-        parts.append(f"{kinds['collision']} reached it only in collision with {_names(Counter(m.body for m in misses if m is not None and m.kind == 'collision'))}")
+        parts.append(
+            f"{kinds['collision']} reached it only in collision with {_names(Counter(m.body for m in misses if m is not None and m.kind == 'collision'))}"
+        )
     others = attempts - sum(blocked.values()) - len(misses)
     if others > 0:
         parts.append(f"{others} missed another goal")

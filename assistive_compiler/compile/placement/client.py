@@ -55,7 +55,10 @@ class PlacementClient:
 
     def joint_index(self, body: int) -> dict[str, int]:
         p, c = self.p, self.client
-        return {p.getJointInfo(body, j, physicsClientId=c)[1].decode(): j for j in range(p.getNumJoints(body, physicsClientId=c))}
+        return {
+            p.getJointInfo(body, j, physicsClientId=c)[1].decode(): j
+            for j in range(p.getNumJoints(body, physicsClientId=c))
+        }
 
     def place(self, body: int, pos, orn) -> None:
         """Put a body's URDF base frame (not its centre of mass) at (pos, orn)."""

@@ -13,8 +13,8 @@ import math
 import numpy as np
 
 from ...ik_options import ik_damping, ik_limits
-from ...rotation import quat_angle, quat_from_rpy_deg
 from ...resolve import ResolvedTask
+from ...rotation import quat_angle, quat_from_rpy_deg
 from ..task import start_for
 from .client import PlacementClient
 
@@ -31,8 +31,21 @@ class Miss:
 class ArmKinematics:
     """IK, collision checks and JLWKI for one arm in the compile-time world."""
 
-    def __init__(self, pc, robot, ee_link, arm_idx, lower, upper, tool_from_ee, tool_ids, obstacles, rest,
-                 followers: dict[int, int] | None = None, frozen: list[int] | None = None):
+    def __init__(
+        self,
+        pc,
+        robot,
+        ee_link,
+        arm_idx,
+        lower,
+        upper,
+        tool_from_ee,
+        tool_ids,
+        obstacles,
+        rest,
+        followers: dict[int, int] | None = None,
+        frozen: list[int] | None = None,
+    ):
         """``followers``: follower joint index -> its leader's position in ``arm_idx`` (set to the
         leader's value); ``frozen``: joint indices IK must not move (a mobile base's drive)."""
         p, c = pc.p, pc.client
@@ -42,13 +55,20 @@ class ArmKinematics:
         self.tool_ids, self.obstacles = tool_ids, obstacles
         self.person: int | None = None
         self.rest = rest or [0.0] * len(arm_idx)
-        self.movable = [j for j in range(p.getNumJoints(robot, physicsClientId=c)) if p.getJointInfo(robot, j, physicsClientId=c)[2] != p.JOINT_FIXED]
+        self.movable = [
+            j
+            for j in range(p.getNumJoints(robot, physicsClientId=c))
+            if p.getJointInfo(robot, j, physicsClientId=c)[2] != p.JOINT_FIXED
+        ]
         self.lo_all = [p.getJointInfo(robot, j, physicsClientId=c)[8] for j in self.movable]
         self.hi_all = [p.getJointInfo(robot, j, physicsClientId=c)[9] for j in self.movable]
-        self.ranges = [max(h - l, 1e-3) for l, h in zip(self.lo_all, self.hi_all)]
+        self.ranges = [max(h - link, 1e-3) for link, h in zip(self.lo_all, self.hi_all)]
         self.cols = [self.movable.index(i) for i in arm_idx]
         self.followers = followers or {}
-        self.groups = [[self.cols[k]] + [self.movable.index(f) for f, lead in self.followers.items() if lead == k] for k in range(len(arm_idx))]
+        self.groups = [
+            [self.cols[k]] + [self.movable.index(f) for f, lead in self.followers.items() if lead == k]
+            for k in range(len(arm_idx))
+        ]
         self.frozen = frozen or []
         self.damping = ik_damping(self.movable, self.frozen)
         self.miss: Miss | None = None
@@ -79,9 +99,15 @@ class ArmKinematics:
             q = arm_rest
             for _ in range(4):  # refine from the last solution
                 kwargs = ik_limits(self, rest) | dict(maxNumIterations=100, residualThreshold=1e-6, physicsClientId=c)
-                sol = (p.calculateInverseKinematics(self.robot, self.ee_link, ee_pos, ee_orn, **kwargs) if tool_orn is not None
-                       else p.calculateInverseKinematics(self.robot, self.ee_link, ee_pos, **kwargs))
-                q = [min(max(float(np.mean([sol[k] for k in group])), l), u) for group, l, u in zip(self.groups, self.lower, self.upper)]
+                sol = (
+                    p.calculateInverseKinematics(self.robot, self.ee_link, ee_pos, ee_orn, **kwargs)
+                    if tool_orn is not None
+                    else p.calculateInverseKinematics(self.robot, self.ee_link, ee_pos, **kwargs)
+                )
+                q = [
+                    min(max(float(np.mean([sol[k] for k in group])), link), u)
+                    for group, link, u in zip(self.groups, self.lower, self.upper)
+                ]
                 self.set_arm(q)
             got_pos, got_orn = self.pc.link_pose(self.robot, self.ee_link)
             distance = float(np.linalg.norm(np.subtract(got_pos, ee_pos)))
@@ -99,12 +125,16 @@ class ArmKinematics:
             return q
         return None
 
-    def _note(self, miss: "Miss") -> None:
+    def _note(self, miss: Miss) -> None:
         """Keep the most telling reason of one ``reach`` call: a collision or a wrong orientation
         (the tool got there) over out of reach, and the closest of the misses by distance."""
         rank = {"collision": 0, "orientation": 1, "out of reach": 2}
         old = self.miss
-        if old is None or rank[miss.kind] < rank[old.kind] or (miss.kind == old.kind == "out of reach" and miss.distance_m < old.distance_m):
+        if (
+            old is None
+            or rank[miss.kind] < rank[old.kind]
+            or (miss.kind == old.kind == "out of reach" and miss.distance_m < old.distance_m)
+        ):
             self.miss = miss
 
     def drive_to(self, base_pos, base_orn, tool_pos, tool_orn) -> tuple[tuple, tuple]:
@@ -117,8 +147,16 @@ class ArmKinematics:
         ee_pos, ee_orn = p.multiplyTransforms(tool_pos, tool_orn, *self.tool_inv)
         damping = [0.1] * len(self.movable)
         for _ in range(4):
-            sol = p.calculateInverseKinematics(self.robot, self.ee_link, ee_pos, ee_orn, jointDamping=damping, maxNumIterations=100,
-                                               residualThreshold=1e-6, physicsClientId=c)
+            sol = p.calculateInverseKinematics(
+                self.robot,
+                self.ee_link,
+                ee_pos,
+                ee_orn,
+                jointDamping=damping,
+                maxNumIterations=100,
+                residualThreshold=1e-6,
+                physicsClientId=c,
+            )
             for j, v in zip(self.movable, sol):
                 p.resetJointState(self.robot, j, v, physicsClientId=c)
         x, y, yaw = (sol[self.movable.index(j)] for j in self.frozen)
@@ -151,9 +189,9 @@ class ArmKinematics:
         lin, ang = p.calculateJacobian(self.robot, self.ee_link, [0, 0, 0], all_q, zeros, zeros, physicsClientId=c)
         J = np.vstack([np.asarray(lin)[:, self.cols], np.asarray(ang)[:, self.cols]])
         w = []
-        for qi, l, u in zip(q, self.lower, self.upper):
-            qr = (u - l) / 2
-            w.append(max(0.001, 1 - 0.5 ** ((qr - abs(qr - qi + l)) / (0.05 * qr) + 1)))
+        for qi, link, u in zip(q, self.lower, self.upper):
+            qr = (u - link) / 2
+            w.append(max(0.001, 1 - 0.5 ** ((qr - abs(qr - qi + link)) / (0.05 * qr) + 1)))
         M = J @ np.diag(w) @ J.T
         # Isotropy over the directions the arm can move in: with n = min(6, joints) it is the
         # geometric over the arithmetic mean of M's n largest eigenvalues (det^(1/6) / (trace/6) for
@@ -177,7 +215,11 @@ def arm_chains(rt: ResolvedTask, pc: PlacementClient, scene) -> list[tuple[ArmKi
         side_start = start_for(rt, side)
         side_orn = quat_from_rpy_deg(side_start.tool_rpy_deg)
         held = [k for k, (name, use) in enumerate(rt.tool_uses.items()) if robot_part.arm_for(use.hand)[0] == real_side]
-        held_garments = [scene.garment_grips[gname][1:] for gname, g in rt.spec.garments.items() if robot_part.arm_for(g.held.hand)[0] == real_side]
+        held_garments = [
+            scene.garment_grips[gname][1:]
+            for gname, g in rt.spec.garments.items()
+            if robot_part.arm_for(g.held.hand)[0] == real_side
+        ]
         if held:
             att = scene.attachments[held[0]]
             inv = pc.p.invertTransform(att.position, att.orientation)
@@ -187,11 +229,20 @@ def arm_chains(rt: ResolvedTask, pc: PlacementClient, scene) -> list[tuple[ArmKi
         else:
             inv, side_tools = ((0, 0, 0), (0, 0, 0, 1)), {}
         drive = robot_part.base_drive
-        kin = ArmKinematics(pc, scene.robot, pc.link_index(scene.robot, arm.tool_mount), [scene.robot_joints[j] for j in arm.joints],
-                            scene.lower[offset_in_action:offset_in_action + n], scene.upper[offset_in_action:offset_in_action + n],
-                            inv, side_tools, list(scene.furniture.values()), rest,
-                            followers={scene.robot_joints[f]: arm.joints.index(lead) for f, lead in arm.follow.items()},
-                            frozen=[scene.robot_joints[j] for j in drive.joints] if drive else None)
+        kin = ArmKinematics(
+            pc,
+            scene.robot,
+            pc.link_index(scene.robot, arm.tool_mount),
+            [scene.robot_joints[j] for j in arm.joints],
+            scene.lower[offset_in_action : offset_in_action + n],
+            scene.upper[offset_in_action : offset_in_action + n],
+            inv,
+            side_tools,
+            list(scene.furniture.values()),
+            rest,
+            followers={scene.robot_joints[f]: arm.joints.index(lead) for f, lead in arm.follow.items()},
+            frozen=[scene.robot_joints[j] for j in drive.joints] if drive else None,
+        )
         arms.append((kin, side_start, side_orn))
         offset_in_action += n
     return arms

@@ -15,8 +15,8 @@ from pathlib import Path
 from typing import Any
 
 from ...artifact import Body, ToolAttachment
-from ...rotation import quat_from_rpy, quat_from_rpy_deg
 from ...resolve import ResolvedTask
+from ...rotation import quat_from_rpy, quat_from_rpy_deg
 from ..emit import EmittedScene
 from ..task import mounted_on, present_furniture, rounded, seat_links
 from .base_search import Carried
@@ -62,15 +62,42 @@ def load_scene(rt: ResolvedTask, pc: PlacementClient, emitted: EmittedScene, out
     offset = per_robot.base_offset_m if per_robot and per_robot.base_offset_m else (0.0, 0.0, 0.0)
     mount_pose, carry = _mount(rt, pc, furniture, offset)
     tools, attachments, tool_bodies = _load_tools(rt, pc, emitted, out_tmp)
-    person_bodies = [Body(name=f"person_{v}", kind="person", urdf=str(emitted.written[f"person_{v}"].relative_to(out_tmp)),
-                          position=person_pos[v], orientation=rounded(person_orns[v]), fixed_base=True,
-                          gravity=spec.person.gravity_mps2) for v in spec.person.variants]
-    return PlacedScene(furniture, people, person_pos, person_orns, robot, str(emitted.written["robot"].relative_to(out_tmp)),
-                       robot_joints, arm_joints, [infos[j][8] for j in arm_joints], [infos[j][9] for j in arm_joints], offset,
-                       mount_pose, carry, tools, attachments, bodies + tool_bodies + person_bodies, _garment_grips(rt))
+    person_bodies = [
+        Body(
+            name=f"person_{v}",
+            kind="person",
+            urdf=str(emitted.written[f"person_{v}"].relative_to(out_tmp)),
+            position=person_pos[v],
+            orientation=rounded(person_orns[v]),
+            fixed_base=True,
+            gravity=spec.person.gravity_mps2,
+        )
+        for v in spec.person.variants
+    ]
+    return PlacedScene(
+        furniture,
+        people,
+        person_pos,
+        person_orns,
+        robot,
+        str(emitted.written["robot"].relative_to(out_tmp)),
+        robot_joints,
+        arm_joints,
+        [infos[j][8] for j in arm_joints],
+        [infos[j][9] for j in arm_joints],
+        offset,
+        mount_pose,
+        carry,
+        tools,
+        attachments,
+        bodies + tool_bodies + person_bodies,
+        _garment_grips(rt),
+    )
 
 
-def _load_furniture(rt: ResolvedTask, pc: PlacementClient, emitted: EmittedScene, out_tmp: Path) -> tuple[dict[str, int], list[Body]]:
+def _load_furniture(
+    rt: ResolvedTask, pc: PlacementClient, emitted: EmittedScene, out_tmp: Path
+) -> tuple[dict[str, int], list[Body]]:
     """Furniture at its nominal pose, and its manifest entries."""
     ids: dict[str, int] = {}
     bodies: list[Body] = []
@@ -80,10 +107,19 @@ def _load_furniture(rt: ResolvedTask, pc: PlacementClient, emitted: EmittedScene
         static = part.static if use.static is None else use.static
         path = emitted.written[name]
         ids[name] = pc.load(path, use.position_m, orn, True)
-        bodies.append(Body(name=name, kind="furniture", urdf=str(path.relative_to(out_tmp)), position=rounded(use.position_m),
-                           orientation=rounded(orn), fixed_base=static, gravity=None,
-                           friction=use.friction if use.friction is not None else part.friction,
-                           position_noise=rounded(use.position_noise_m)))
+        bodies.append(
+            Body(
+                name=name,
+                kind="furniture",
+                urdf=str(path.relative_to(out_tmp)),
+                position=rounded(use.position_m),
+                orientation=rounded(orn),
+                fixed_base=static,
+                gravity=None,
+                friction=use.friction if use.friction is not None else part.friction,
+                position_noise=rounded(use.position_noise_m),
+            )
+        )
     return ids, bodies
 
 
@@ -117,14 +153,18 @@ def _load_people(rt: ResolvedTask, pc: PlacementClient, emitted: EmittedScene, f
     return ids, positions, orns
 
 
-def _mount(rt: ResolvedTask, pc: PlacementClient, furniture: dict[str, int], offset) -> tuple[tuple | None, Carried | None]:
+def _mount(
+    rt: ResolvedTask, pc: PlacementClient, furniture: dict[str, int], offset
+) -> tuple[tuple | None, Carried | None]:
     """A mounted robot's base: the mount link's pose (plus the offset), or — with a searched base —
     the furniture to carry under it. (None, None) for a robot on the floor."""
     mount = mounted_on(rt)
     if not mount:
         return None, None
     mpos, morn = pc.named_link_pose(furniture[mount], rt.furniture[mount].part.mount_link)
-    if rt.spec.robot.mount_base == "search":  # loaded at the origin: the mount link's pose is its pose in the furniture frame
+    if (
+        rt.spec.robot.mount_base == "search"
+    ):  # loaded at the origin: the mount link's pose is its pose in the furniture frame
         return None, Carried(pc, furniture[mount], tuple(mpos), tuple(morn))
     return (tuple(a + b for a, b in zip(mpos, offset)), tuple(morn)), None
 
@@ -140,11 +180,26 @@ def _load_tools(rt: ResolvedTask, pc: PlacementClient, emitted: EmittedScene, ou
         grip = robot_part.grips[use.grip or tpart.name]
         _, hand = robot_part.arm_for(use.hand)
         ids[name] = pc.load(emitted.written[name], (0, 0, -10), (0, 0, 0, 1), True)
-        attachments.append(ToolAttachment(body=name, parent_link=hand.tool_mount, position=rounded(grip.position_m),
-                                          orientation=rounded(quat_from_rpy(grip.rpy_rad)),
-                                          links=dict(tpart.links) | {"base": tpart.base_link}))
-        bodies.append(Body(name=name, kind="tool", urdf=str(emitted.written[name].relative_to(out_tmp)), position=(0.0, 0.0, 0.0),
-                           orientation=(0.0, 0.0, 0.0, 1.0), fixed_base=False, gravity=use.gravity_mps2))
+        attachments.append(
+            ToolAttachment(
+                body=name,
+                parent_link=hand.tool_mount,
+                position=rounded(grip.position_m),
+                orientation=rounded(quat_from_rpy(grip.rpy_rad)),
+                links=dict(tpart.links) | {"base": tpart.base_link},
+            )
+        )
+        bodies.append(
+            Body(
+                name=name,
+                kind="tool",
+                urdf=str(emitted.written[name].relative_to(out_tmp)),
+                position=(0.0, 0.0, 0.0),
+                orientation=(0.0, 0.0, 0.0, 1.0),
+                fixed_base=False,
+                gravity=use.gravity_mps2,
+            )
+        )
     return ids, attachments, bodies
 
 
@@ -154,5 +209,9 @@ def _garment_grips(rt: ResolvedTask) -> dict[str, tuple[str, Any, Any]]:
     grips = {}
     for gname, g in rt.spec.garments.items():
         grip = robot_part.grips[g.held.grip]
-        grips[gname] = (robot_part.arm_for(g.held.hand)[1].tool_mount, rounded(tuple(grip.position_m)), rounded(quat_from_rpy(grip.rpy_rad)))
+        grips[gname] = (
+            robot_part.arm_for(g.held.hand)[1].tool_mount,
+            rounded(tuple(grip.position_m)),
+            rounded(quat_from_rpy(grip.rpy_rad)),
+        )
     return grips

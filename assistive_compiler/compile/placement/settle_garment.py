@@ -14,8 +14,8 @@ import numpy as np
 
 from ...artifact import Garment
 from ...bullet import connect
-from ...rotation import quat_from_rpy_deg
 from ...resolve import ResolvedTask
+from ...rotation import quat_from_rpy_deg
 from ..task import fail, rounded
 
 
@@ -45,21 +45,52 @@ def settle_garment(rt: ResolvedTask, name: str, g, out_tmp: Path, grip, held_orn
         pb.setPhysicsEngineParameter(numSubSteps=spec.sim.solver.sub_steps, physicsClientId=c)
         pb.setGravity(0, 0, g.settle.gravity_mps2, physicsClientId=c)
         held_pos = (0.0, 0.0, 2.0 + shape.length_m)
-        sb, anchor = load_garment(pb, c, obj, held_pos, held_orn, phys.mass_kg, phys.collision_margin_m, phys.elastic_stiffness,
-                                  phys.damping_stiffness, phys.bending_stiffness, phys.friction, anchored)
+        sb, anchor = load_garment(
+            pb,
+            c,
+            obj,
+            held_pos,
+            held_orn,
+            phys.mass_kg,
+            phys.collision_margin_m,
+            phys.elastic_stiffness,
+            phys.damping_stiffness,
+            phys.bending_stiffness,
+            phys.friction,
+            anchored,
+        )
         for _ in range(g.settle.steps):
             pb.stepSimulation(physicsClientId=c)
-        world = np.asarray(pb.getMeshData(sb, -1, flags=pb.MESH_DATA_SIMULATION_MESH, physicsClientId=c)[1], dtype=float)
+        world = np.asarray(
+            pb.getMeshData(sb, -1, flags=pb.MESH_DATA_SIMULATION_MESH, physicsClientId=c)[1], dtype=float
+        )
     finally:
         pb.disconnect(c)
     inv_rot = np.asarray(pb.getMatrixFromQuaternion(held_orn)).reshape(3, 3).T
     local = (world - np.asarray(held_pos)) @ inv_rot.T
     if not np.all(np.isfinite(local)) or np.abs(local).max() > 5 * (shape.length_m + shape.radius_open_m):
-        raise fail(rt, ("garments", name, "physics"), f"garment '{name}' blew up while settling (nodes left the scene): the springs are "
-                   f"integrated explicitly, so raise sim.solver.sub_steps (now {spec.sim.solver.sub_steps}) or lower physics.elastic_stiffness")
+        raise fail(
+            rt,
+            ("garments", name, "physics"),
+            f"garment '{name}' blew up while settling (nodes left the scene): the springs are "
+            f"integrated explicitly, so raise sim.solver.sub_steps (now {spec.sim.solver.sub_steps}) or lower physics.elastic_stiffness",
+        )
     parent, gpos, gorn = grip
-    return Garment(name=name, obj=str(obj.relative_to(out_tmp)), parent_link=parent, grip_position=gpos, grip_orientation=gorn,
-                   anchored=anchored, node_sets=sets, nodes_in_held=[rounded(tuple(v)) for v in local], mass=phys.mass_kg,
-                   collision_margin=phys.collision_margin_m, elastic_stiffness=phys.elastic_stiffness, damping_stiffness=phys.damping_stiffness,
-                   bending_stiffness=phys.bending_stiffness, friction=phys.friction,
-                   collides_with=list(g.collides_with) if g.collides_with is not None else None, rgba=tuple(g.rgba))
+    return Garment(
+        name=name,
+        obj=str(obj.relative_to(out_tmp)),
+        parent_link=parent,
+        grip_position=gpos,
+        grip_orientation=gorn,
+        anchored=anchored,
+        node_sets=sets,
+        nodes_in_held=[rounded(tuple(v)) for v in local],
+        mass=phys.mass_kg,
+        collision_margin=phys.collision_margin_m,
+        elastic_stiffness=phys.elastic_stiffness,
+        damping_stiffness=phys.damping_stiffness,
+        bending_stiffness=phys.bending_stiffness,
+        friction=phys.friction,
+        collides_with=list(g.collides_with) if g.collides_with is not None else None,
+        rgba=tuple(g.rgba),
+    )

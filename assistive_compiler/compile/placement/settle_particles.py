@@ -38,19 +38,36 @@ def settle_particles(rt: ResolvedTask, pc: PlacementClient, name: str, ps, scene
         lost_link = part.base_link
         anchor = _inside_point(pc, scene.tools.get(body, scene.furniture.get(body)), lost_link)
     colors = [tuple(ps.colors_rgba[i % len(ps.colors_rgba)]) for i in range(ps.count)]
-    return ParticleSet(name=name, count=ps.count, radius=ps.radius_m, mass=ps.mass_kg, attach=ps.attach, attach_link=attach_link,
-                       start_positions=positions, colors=colors,
-                       consumed_target=ps.consumed_at.target if ps.consumed_at else None,
-                       consumed_radius=ps.consumed_at.radius_m if ps.consumed_at else 0.0,
-                       lost_body=ps.lost_beyond.body if ps.lost_beyond else None, lost_link=lost_link,
-                       lost_distance=ps.lost_beyond.distance_m if ps.lost_beyond else 0.0, lost_anchor=rounded(anchor),
-                       hit_body=ps.hit_body, outside_of=_container(rt, ps.consumed_at.outside_of if ps.consumed_at else None),
-                       rest=None if ps.rest is None else ParticleRest(
-                           container=_container(rt, ps.rest.container), max_tilt=math.radians(ps.rest.max_tilt_deg),
-                           max_turn=math.radians(ps.rest.max_turn_deg), max_speed=ps.rest.max_speed_mps, still_steps=ps.rest.still_steps,
-                           carry_at_reset=ps.rest.carry_at_reset,
-                           near_body=ps.rest.simulated_near.body if ps.rest.simulated_near else None,
-                           near_distance=ps.rest.simulated_near.distance_m if ps.rest.simulated_near else 0.0))
+    return ParticleSet(
+        name=name,
+        count=ps.count,
+        radius=ps.radius_m,
+        mass=ps.mass_kg,
+        attach=ps.attach,
+        attach_link=attach_link,
+        start_positions=positions,
+        colors=colors,
+        consumed_target=ps.consumed_at.target if ps.consumed_at else None,
+        consumed_radius=ps.consumed_at.radius_m if ps.consumed_at else 0.0,
+        lost_body=ps.lost_beyond.body if ps.lost_beyond else None,
+        lost_link=lost_link,
+        lost_distance=ps.lost_beyond.distance_m if ps.lost_beyond else 0.0,
+        lost_anchor=rounded(anchor),
+        hit_body=ps.hit_body,
+        outside_of=_container(rt, ps.consumed_at.outside_of if ps.consumed_at else None),
+        rest=None
+        if ps.rest is None
+        else ParticleRest(
+            container=_container(rt, ps.rest.container),
+            max_tilt=math.radians(ps.rest.max_tilt_deg),
+            max_turn=math.radians(ps.rest.max_turn_deg),
+            max_speed=ps.rest.max_speed_mps,
+            still_steps=ps.rest.still_steps,
+            carry_at_reset=ps.rest.carry_at_reset,
+            near_body=ps.rest.simulated_near.body if ps.rest.simulated_near else None,
+            near_distance=ps.rest.simulated_near.distance_m if ps.rest.simulated_near else 0.0,
+        ),
+    )
 
 
 def _drop_grid(pc: PlacementClient, ps, frame_pos, frame_orn) -> list[tuple]:

@@ -14,10 +14,10 @@ import numpy as np
 
 from ...library import PERSON_TEMPLATE_RELPATH
 from ...paths import templates_dir
-from ...rotation import quat_from_rpy_deg
 from ...resolve import ResolvedTask
-from ..emit import EmittedScene, person_xacro_args
+from ...rotation import quat_from_rpy_deg
 from ...templates import expand_template
+from ..emit import EmittedScene, person_xacro_args
 from ..task import fail, group_joints, present_furniture, rounded, seed
 from .client import PlacementClient
 
@@ -42,8 +42,12 @@ def settle_person(rt: ResolvedTask, scene: EmittedScene, variant: str) -> tuple[
     try:
         p.setTimeStep(spec.sim.time_step_s, physicsClientId=c)
         p.setGravity(0, 0, settle.gravity_mps2, physicsClientId=c)
-        p.setPhysicsEngineParameter(numSolverIterations=spec.sim.solver.iterations, numSubSteps=spec.sim.solver.sub_steps,
-                                    deterministicOverlappingPairs=1, physicsClientId=c)
+        p.setPhysicsEngineParameter(
+            numSolverIterations=spec.sim.solver.iterations,
+            numSubSteps=spec.sim.solver.sub_steps,
+            deterministicOverlappingPairs=1,
+            physicsClientId=c,
+        )
         p.createMultiBody(0, p.createCollisionShape(p.GEOM_PLANE, physicsClientId=c), physicsClientId=c)
         for name, use in present_furniture(rt, placed_only=True).items():
             fid = pc.load(scene.written[name], use.position_m, quat_from_rpy_deg(use.rpy_deg), True)
@@ -55,7 +59,9 @@ def settle_person(rt: ResolvedTask, scene: EmittedScene, variant: str) -> tuple[
         names = [j for j in rt.person_urdf.movable_joints]
         for name in names:
             info = rt.person_urdf.movable_joints[name]
-            q = math.radians(spec.person.joints_deg.get(name, 0.0)) + rng.uniform(-settle.joint_noise_rad, settle.joint_noise_rad)
+            q = math.radians(spec.person.joints_deg.get(name, 0.0)) + rng.uniform(
+                -settle.joint_noise_rad, settle.joint_noise_rad
+            )
             p.resetJointState(body, joints[name], min(max(q, info.lower), info.upper), physicsClientId=c)
         idx = [joints[n] for n in names]
         p.setJointMotorControlArray(body, idx, p.VELOCITY_CONTROL, forces=[0.0] * len(idx), physicsClientId=c)
@@ -66,7 +72,11 @@ def settle_person(rt: ResolvedTask, scene: EmittedScene, variant: str) -> tuple[
         if settle.then is not None:
             angles = _settle_stage(rt, pc, body, joints, names, angles)
         if not all(math.isfinite(v) for v in [*pos, *orn, *angles.values()]) or abs(pos[2]) > 10:
-            raise fail(rt, ("person", "placement", "settle"), f"person '{variant}' did not settle (the body left the scene); check placement.position_m")
+            raise fail(
+                rt,
+                ("person", "placement", "settle"),
+                f"person '{variant}' did not settle (the body left the scene); check placement.position_m",
+            )
         return rounded(tuple(pos)), rounded(tuple(orn)), {n: rounded(a) for n, a in angles.items()}
     finally:
         pc.close()
@@ -85,8 +95,9 @@ def _load_limp(rt: ResolvedTask, pc: PlacementClient, scene: EmittedScene, varia
     return body
 
 
-def _settle_stage(rt: ResolvedTask, pc: PlacementClient, body: int, joints: dict[str, int], names: list[str],
-                  angles: dict[str, float]) -> dict[str, float]:
+def _settle_stage(
+    rt: ResolvedTask, pc: PlacementClient, body: int, joints: dict[str, int], names: list[str], angles: dict[str, float]
+) -> dict[str, float]:
     """The settle's second stage (``placement.settle.then``): the settled base is fixed where it lies
     and every joint held stiffly at its settled angle, except the stage's dynamic joint groups,
     which are set to the stage's ``joints_deg`` and then move under the stage's gravity and weak
@@ -97,17 +108,31 @@ def _settle_stage(rt: ResolvedTask, pc: PlacementClient, body: int, joints: dict
     dynamic = group_joints(rt, stage.dynamic)
     start = dict(angles) | {j: math.radians(a) for j, a in stage.joints_deg.items()}
     com_pos, com_orn = p.getBasePositionAndOrientation(body, physicsClientId=c)
-    p.createConstraint(body, -1, -1, -1, p.JOINT_FIXED, (0, 0, 0), (0, 0, 0), com_pos, (0, 0, 0, 1), com_orn, physicsClientId=c)
+    p.createConstraint(
+        body, -1, -1, -1, p.JOINT_FIXED, (0, 0, 0), (0, 0, 0), com_pos, (0, 0, 0, 1), com_orn, physicsClientId=c
+    )
     p.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0), physicsClientId=c)
     for n in names:
         p.resetJointState(body, joints[n], start[n], 0.0, physicsClientId=c)
     held = [n for n in names if n not in dynamic]
-    p.setJointMotorControlArray(body, [joints[n] for n in held], p.POSITION_CONTROL, targetPositions=[start[n] for n in held],
-                                forces=[1e4] * len(held), physicsClientId=c)
+    p.setJointMotorControlArray(
+        body,
+        [joints[n] for n in held],
+        p.POSITION_CONTROL,
+        targetPositions=[start[n] for n in held],
+        forces=[1e4] * len(held),
+        physicsClientId=c,
+    )
     if stage.hold is not None and dynamic:
-        p.setJointMotorControlArray(body, [joints[n] for n in dynamic], p.POSITION_CONTROL, targetPositions=[start[n] for n in dynamic],
-                                    positionGains=[stage.hold.position_gain] * len(dynamic), forces=[stage.hold.max_force_nm] * len(dynamic),
-                                    physicsClientId=c)
+        p.setJointMotorControlArray(
+            body,
+            [joints[n] for n in dynamic],
+            p.POSITION_CONTROL,
+            targetPositions=[start[n] for n in dynamic],
+            positionGains=[stage.hold.position_gain] * len(dynamic),
+            forces=[stage.hold.max_force_nm] * len(dynamic),
+            physicsClientId=c,
+        )
     if stage.friction is not None:
         for bid in range(p.getNumBodies(physicsClientId=c)):
             if bid != body:

@@ -17,15 +17,17 @@ from typing import Any
 import numpy as np
 
 from ...artifact import Body, StartState
-from ...rotation import quat_yaw
 from ...resolve import ResolvedTask
+from ...rotation import quat_yaw
 from ..task import fail, mounted_on, rounded, seed
 from .base_search import reach_goals, search_base
 from .client import PlacementClient
 from .scene import PlacedScene
 
 
-def place_for_variant(rt: ResolvedTask, pc: PlacementClient, scene: PlacedScene, arms: list, variant: str) -> tuple[list[StartState], dict[str, Any]]:
+def place_for_variant(
+    rt: ResolvedTask, pc: PlacementClient, scene: PlacedScene, arms: list, variant: str
+) -> tuple[list[StartState], dict[str, Any]]:
     """(start states, placement record) for ``variant``; raises when no start is reachable."""
     for other, pid in scene.people.items():  # only this variant in the scene
         pc.place(pid, scene.person_pos[other] if other == variant else (0, 0, -20), scene.person_orns[other])
@@ -36,15 +38,32 @@ def place_for_variant(rt: ResolvedTask, pc: PlacementClient, scene: PlacedScene,
         placement: dict[str, Any] = {"mounted_on": mounted_on(rt)}
     else:
         bases = search_base(rt, [a[0] for a in arms], goals, scene.offset, rng, scene.carry)
-        placement = {"base_poses": [{"position": list(rounded(b[0][0])), "yaw_rad": rounded(quat_yaw(b[0][1])),
-                                     "goals_reached": b[1], "goals": len(goals), "jlwki": rounded(b[2])} for b in bases]}
+        placement = {
+            "base_poses": [
+                {
+                    "position": list(rounded(b[0][0])),
+                    "yaw_rad": rounded(quat_yaw(b[0][1])),
+                    "goals_reached": b[1],
+                    "goals": len(goals),
+                    "jlwki": rounded(b[2]),
+                }
+                for b in bases
+            ]
+        }
     starts = _sample_starts(scene, arms, bases, rng)
     if not starts:
         start = arms[0][1]
         own = rt.spec.robot.per_robot.get(rt.robot_name)
-        where = ("robot", "per_robot", rt.robot_name, "start", "tool_position_m") if own is not None and own.start is not None else ("robot", "start", "tool_position_m")
-        raise fail(rt, where,
-                   f"robot '{rt.robot_name}' cannot reach the start pose {tuple(start.tool_position_m)} (tool rpy {tuple(start.tool_rpy_deg)}°) without collision for person '{variant}'")
+        where = (
+            ("robot", "per_robot", rt.robot_name, "start", "tool_position_m")
+            if own is not None and own.start is not None
+            else ("robot", "start", "tool_position_m")
+        )
+        raise fail(
+            rt,
+            where,
+            f"robot '{rt.robot_name}' cannot reach the start pose {tuple(start.tool_position_m)} (tool rpy {tuple(start.tool_rpy_deg)}°) without collision for person '{variant}'",
+        )
     return starts, placement
 
 
@@ -71,11 +90,20 @@ def _sample_starts(scene: PlacedScene, arms: list, bases: list, rng) -> list[Sta
                 qs += list(q)
                 first_goal = first_goal or goal
             else:
-                starts.append(StartState(base_position=rounded(base_pos), base_orientation=rounded(base_orn), joints=rounded(qs), tool_position=rounded(first_goal)))
+                starts.append(
+                    StartState(
+                        base_position=rounded(base_pos),
+                        base_orientation=rounded(base_orn),
+                        joints=rounded(qs),
+                        tool_position=rounded(first_goal),
+                    )
+                )
     return starts
 
 
-def pose_at_first_start(rt: ResolvedTask, pc: PlacementClient, scene: PlacedScene, arms: list, first: StartState) -> Body:
+def pose_at_first_start(
+    rt: ResolvedTask, pc: PlacementClient, scene: PlacedScene, arms: list, first: StartState
+) -> Body:
     """Put the robot at ``first`` (and carried furniture under it, updating its manifest entry:
     ``reset()`` carries it under each start's base); returns the robot's manifest entry."""
     base_pos, base_orn = first.base_position, first.base_orientation
@@ -84,11 +112,23 @@ def pose_at_first_start(rt: ResolvedTask, pc: PlacementClient, scene: PlacedScen
     if carry is not None:  # the manifest's pose: under the first start's base; reset() carries it under each start's
         pos, orn = carry.place(base_pos, base_orn)
         k = next(i for i, b in enumerate(scene.bodies) if b.name == mounted_on(rt))
-        scene.bodies[k] = scene.bodies[k].model_copy(update={"position": rounded(pos), "orientation": rounded(orn),
-                                                             "carried_by_robot": (rounded(carry.inv_pos), rounded(carry.inv_orn))})
+        scene.bodies[k] = scene.bodies[k].model_copy(
+            update={
+                "position": rounded(pos),
+                "orientation": rounded(orn),
+                "carried_by_robot": (rounded(carry.inv_pos), rounded(carry.inv_orn)),
+            }
+        )
     at = 0
     for kin, _, _ in arms:  # each arm (and the joints following it) at its part of the first start
-        kin.set_arm(first.joints[at:at + len(kin.arm_idx)])
+        kin.set_arm(first.joints[at : at + len(kin.arm_idx)])
         at += len(kin.arm_idx)
-    return Body(name="robot", kind="robot", urdf=str(scene.robot_urdf), position=rounded(base_pos), orientation=rounded(base_orn),
-                fixed_base=True, gravity=rt.spec.robot.gravity_mps2)
+    return Body(
+        name="robot",
+        kind="robot",
+        urdf=str(scene.robot_urdf),
+        position=rounded(base_pos),
+        orientation=rounded(base_orn),
+        fixed_base=True,
+        gravity=rt.spec.robot.gravity_mps2,
+    )

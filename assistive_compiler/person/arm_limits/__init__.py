@@ -33,10 +33,10 @@ One module per concept: :mod:`.convention` (sides, joints, input encoding, the p
 
 from __future__ import annotations
 
-from .convention import Side, SIDES, ARM_LIMIT_JOINTS, ArmLimitModel, arm_box, mirror_pose, reference_input
 from .analytic import AnalyticArmLimits
-from .mlp import MLPArmLimits
+from .convention import ARM_LIMIT_JOINTS, SIDES, ArmLimitModel, Side, arm_box, mirror_pose, reference_input
 from .guard import ArmLimitGuard
+from .mlp import MLPArmLimits
 
 __all__ = [
     "Side",

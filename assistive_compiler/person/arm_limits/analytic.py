@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import bisect
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
-from .convention import Side, _MIRROR, _TWO_PI, _as_poses, _check_side, arm_box
-
+from .convention import _MIRROR, _TWO_PI, Side, _as_poses, _check_side, arm_box
 
 #: Joint sinus of the humerus: the largest humeral elevation (angle from hanging straight down)
 #: for each plane of elevation (azimuth of the humerus about the vertical, 0 = pure abduction,
@@ -219,8 +218,10 @@ class AnalyticArmLimits:
         py = np.concatenate([dy[:, None] * ua, ey[:, None] + vy[:, None] * fa], axis=1)
         pz = np.concatenate([dz[:, None] * ua, ez[:, None] + vz[:, None] * fa], axis=1)
         inside = (
-            (px / TRUNK_CORE_HALF_WIDTH_M) ** 2 + (py / TRUNK_CORE_HALF_DEPTH_M) ** 2 < 1.0
-        ) & (pz < TRUNK_CORE_TOP_M) & (pz > TRUNK_CORE_BOTTOM_M)
+            ((px / TRUNK_CORE_HALF_WIDTH_M) ** 2 + (py / TRUNK_CORE_HALF_DEPTH_M) ** 2 < 1.0)
+            & (pz < TRUNK_CORE_TOP_M)
+            & (pz > TRUNK_CORE_BOTTOM_M)
+        )
         ok &= ~np.any(inside, axis=1)
         return ok
 
@@ -228,8 +229,7 @@ class AnalyticArmLimits:
         """Scalar (math-module) twin of :meth:`_valid_right` for one pose: the per-physics-step
         path, several times faster than NumPy on a single row. Tests keep the two identical."""
         lo, hi = self._lo_t, self._hi_t
-        if not (lo[0] <= qx <= hi[0] and lo[1] <= qy <= hi[1] and lo[2] <= qz <= hi[2]
-                and lo[3] <= qe <= hi[3]):
+        if not (lo[0] <= qx <= hi[0] and lo[1] <= qy <= hi[1] and lo[2] <= qz <= hi[2] and lo[3] <= qe <= hi[3]):
             return False
         cx, sx = math.cos(qx), math.sin(qx)
         cy, sy = math.cos(qy), math.sin(qy)
@@ -243,8 +243,10 @@ class AnalyticArmLimits:
             return False
         k = 1.0 / max(1.0 - dz, 1e-9)
         w0x, w0y, w0z = dx * dy * k, -1.0 + dy * dy * k, -dy
-        psi_c = -math.atan2(dx * (w0y * wz - w0z * wy) + dy * (w0z * wx - w0x * wz)
-                            + dz * (w0x * wy - w0y * wx), w0x * wx + w0y * wy + w0z * wz)
+        psi_c = -math.atan2(
+            dx * (w0y * wz - w0z * wy) + dy * (w0z * wx - w0x * wz) + dz * (w0x * wy - w0y * wx),
+            w0x * wx + w0y * wy + w0z * wz,
+        )
         psi = (psi_c - phi * (1.0 + dz) + math.pi) % _TWO_PI - math.pi
         ir = _interp1(theta, self._axial_theta_t, self._axial_ir_t)
         er = _interp1(theta, self._axial_theta_t, self._axial_er_t)
@@ -252,13 +254,13 @@ class AnalyticArmLimits:
             return False
         ce, se = math.cos(qe), math.sin(qe)
         vx, vy, vz = ce * dx - se * wx, ce * dy - se * wy, ce * dz - se * wz
-        a2, b2 = TRUNK_CORE_HALF_WIDTH_M ** 2, TRUNK_CORE_HALF_DEPTH_M ** 2
+        a2, b2 = TRUNK_CORE_HALF_WIDTH_M**2, TRUNK_CORE_HALF_DEPTH_M**2
         points = [(dx * t, dy * t, dz * t) for t in self._ua_t]
         ex, ey, ez = UPPER_ARM_M * dx, UPPER_ARM_M * dy, UPPER_ARM_M * dz
         points += [(ex + vx * t, ey + vy * t, ez + vz * t) for t in self._fa_t]
         for px, py, pz in points:
             px -= SHOULDER_LATERAL_M
-            if (px * px / a2 + py * py / b2 < 1.0 and TRUNK_CORE_BOTTOM_M < pz < TRUNK_CORE_TOP_M):
+            if px * px / a2 + py * py / b2 < 1.0 and TRUNK_CORE_BOTTOM_M < pz < TRUNK_CORE_TOP_M:
                 return False
         return True
 

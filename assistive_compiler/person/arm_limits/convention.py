@@ -4,20 +4,19 @@ the reference's input encoding and mirroring, and the :class:`ArmLimitModel` pro
 from __future__ import annotations
 
 import math
-from typing import Literal, Protocol, Sequence, runtime_checkable
+from collections.abc import Sequence
+from typing import Literal, Protocol, runtime_checkable
 
 import numpy as np
 
 from ..body import JOINT_LIMITS_DEG
-
 
 Side = Literal["right", "left"]
 SIDES: tuple[Side, Side] = ("right", "left")
 
 #: The four joints a limit model sees, per arm, in input order.
 ARM_LIMIT_JOINTS: dict[str, tuple[str, str, str, str]] = {
-    side: (f"{side}_shoulder_x", f"{side}_shoulder_y", f"{side}_shoulder_z", f"{side}_elbow")
-    for side in SIDES
+    side: (f"{side}_shoulder_x", f"{side}_shoulder_y", f"{side}_shoulder_z", f"{side}_elbow") for side in SIDES
 }
 
 _TWO_PI = 2.0 * math.pi

@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
 from .convention import Side, _as_poses, reference_input
-
 
 _ACTIVATIONS = {
     "tanh": np.tanh,
@@ -49,17 +48,19 @@ class MLPArmLimits:
             if b.shape != (w.shape[1],):
                 raise ValueError(
                     f"{source}: shape mismatch: b{i} has shape {b.shape}, "
-                    f"expected ({w.shape[1]},) to match W{i} {w.shape}")
+                    f"expected ({w.shape[1]},) to match W{i} {w.shape}"
+                )
             if i > 0 and w.shape[0] != ws[i - 1].shape[1]:
                 raise ValueError(
                     f"{source}: shape mismatch between layers: W{i - 1} outputs {ws[i - 1].shape[1]} "
-                    f"but W{i} takes {w.shape[0]} inputs")
+                    f"but W{i} takes {w.shape[0]} inputs"
+                )
             if not (np.all(np.isfinite(w)) and np.all(np.isfinite(b))):
                 raise ValueError(f"{source}: W{i}/b{i} contain non-finite values")
         if ws[0].shape[0] != 4:
             raise ValueError(
-                f"{source}: input size must be 4 (shoulder_x, shoulder_y, shoulder_z, elbow), "
-                f"W0 takes {ws[0].shape[0]}")
+                f"{source}: input size must be 4 (shoulder_x, shoulder_y, shoulder_z, elbow), W0 takes {ws[0].shape[0]}"
+            )
         if ws[-1].shape[1] != 1:
             raise ValueError(f"{source}: output size must be 1, W{n - 1} gives {ws[-1].shape[1]}")
         if activations is None:
@@ -70,8 +71,7 @@ class MLPArmLimits:
                 raise ValueError(f"{source}: 'activations' has {len(acts)} entries for {n} layers")
             bad = sorted({a for a in acts if a not in _ACTIVATIONS})
             if bad:
-                raise ValueError(
-                    f"{source}: unknown activation(s) {bad}; known: {sorted(_ACTIVATIONS)}")
+                raise ValueError(f"{source}: unknown activation(s) {bad}; known: {sorted(_ACTIVATIONS)}")
         self.weights = ws
         self.biases = bs
         self.activations = tuple(acts)
@@ -79,7 +79,7 @@ class MLPArmLimits:
         self.threshold = float(threshold)
 
     @classmethod
-    def from_npz(cls, path: str | Path, *, threshold: float = 0.5) -> "MLPArmLimits":
+    def from_npz(cls, path: str | Path, *, threshold: float = 0.5) -> MLPArmLimits:
         """Load ``W0, b0, W1, b1, ...`` (Dense kernels of shape (in, out) and biases) and an
         optional ``activations`` string array (default: tanh hidden layers, sigmoid output).
         Raises ``ValueError`` naming the file and the problem."""

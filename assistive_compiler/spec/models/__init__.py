@@ -23,15 +23,52 @@ garments), :mod:`.terms` (observations, reward, preferences, success), :mod:`.sc
 
 from __future__ import annotations
 
-from .common import Name, Ref, Vec3, Rgba, Strict, Uniform, Scalar, describe, scalar_bounds
-from .sim import Solver, Ground, Sim
+from .bodies import (
+    ClearedBy,
+    ConsumedAt,
+    Garment,
+    GarmentHold,
+    GarmentSettle,
+    LostBeyond,
+    Markers,
+    Particles,
+    RestInContainer,
+    SimulatedNear,
+    SleeveShape,
+    SoftBodyPhysics,
+    Target,
+)
+from .common import Name, Ref, Rgba, Scalar, Strict, Uniform, Vec3, describe, scalar_bounds
+from .person import (
+    CompliantHold,
+    Impairment,
+    Impairments,
+    LimitedRange,
+    NoImpairment,
+    Person,
+    PersonControl,
+    Placement,
+    Settle,
+    SettleStage,
+    StageHold,
+    Tremor,
+    Weakness,
+)
+from .robot import BaseSearch, Goal, PerRobot, RobotControl, RobotRole, StartGoal, ToolUse
 from .scene import FurnitureUse, Scene
-from .person import Tremor, Weakness, LimitedRange, NoImpairment, Impairment, Impairments, CompliantHold, PersonControl, Settle, StageHold, SettleStage, Placement, Person
-from .robot import RobotControl, StartGoal, Goal, BaseSearch, PerRobot, RobotRole, ToolUse
-from .bodies import Target, ClearedBy, Markers, ConsumedAt, LostBeyond, SimulatedNear, RestInContainer, Particles, SleeveShape, SoftBodyPhysics, GarmentHold, GarmentSettle, Garment
-from .terms import TermUse, RewardTerm, Observations, PREFERENCE_NAMES, PAPER_PREFERENCE_WEIGHTS, Preference, Preferences, Success
-from .scripted import Waypoint, SegmentUse, WaypointItem, ScriptedArm, ScriptedRobot, Scripted
-from .task import CameraView, Camera, TaskSpec
+from .scripted import Scripted, ScriptedArm, ScriptedRobot, SegmentUse, Waypoint, WaypointItem
+from .sim import Ground, Sim, Solver
+from .task import Camera, CameraView, TaskSpec
+from .terms import (
+    PAPER_PREFERENCE_WEIGHTS,
+    PREFERENCE_NAMES,
+    Observations,
+    Preference,
+    Preferences,
+    RewardTerm,
+    Success,
+    TermUse,
+)
 
 __all__ = [
     "Name",

@@ -16,22 +16,27 @@ class Region(Strict):
     person's left, -y their front, +z up at the zero pose; limbs hang along -z)."""
 
     near: Ref | None = Field(
-        None, description="A point on the covered link (a landmark such as person.mouth, a target on it, or the link "
-        "itself): keep the surface within radius_m of it, straight-line distance."
+        None,
+        description="A point on the covered link (a landmark such as person.mouth, a target on it, or the link "
+        "itself): keep the surface within radius_m of it, straight-line distance.",
     )
     radius_m: float | None = Field(None, gt=0, le=1, description="Radius around near, metres.")
     facing: Vec3 | None = Field(
-        None, description="Keep the surface whose outward normal is within max_angle_deg of this direction (link frame; "
-        "e.g. [0, -1, 0]: the side facing the person's front at the zero pose)."
+        None,
+        description="Keep the surface whose outward normal is within max_angle_deg of this direction (link frame; "
+        "e.g. [0, -1, 0]: the side facing the person's front at the zero pose).",
     )
-    max_angle_deg: float = Field(60.0, gt=0, le=180, description="Largest angle between the outward normal and facing, degrees.")
+    max_angle_deg: float = Field(
+        60.0, gt=0, le=180, description="Largest angle between the outward normal and facing, degrees."
+    )
     along: tuple[float, float] | None = Field(
-        None, description="On a limb's capsule: keep the part between these fractions of its length from the joint end "
-        "(e.g. [0.5, 1.0]: the half away from the joint; the shin's lower half)."
+        None,
+        description="On a limb's capsule: keep the part between these fractions of its length from the joint end "
+        "(e.g. [0.5, 1.0]: the half away from the joint; the shin's lower half).",
     )
 
     @model_validator(mode="after")
-    def _criteria(self) -> "Region":
+    def _criteria(self) -> Region:
         if (self.near is None) != (self.radius_m is None):
             raise ValueError("give 'near' and 'radius_m' together (the surface within radius_m of the point near)")
         if self.near is None and self.facing is None and self.along is None:
@@ -63,9 +68,11 @@ class Target(Strict):
     show_rgba: Rgba | None = Field(None, description="Draw a small sphere there in renders (no collision).")
 
     @model_validator(mode="after")
-    def _one_place(self) -> "Target":
+    def _one_place(self) -> Target:
         if (self.link is None) == (not self.surface_of):
-            raise ValueError("give exactly one of 'link' (a fixed point) or 'surface_of' (a point drawn on limbs at every reset)")
+            raise ValueError(
+                "give exactly one of 'link' (a fixed point) or 'surface_of' (a point drawn on limbs at every reset)"
+            )
         if self.surface_of and (self.offset_m != (0.0, 0.0, 0.0) or self.offset_by_variant):
             raise ValueError("@surface_of: a target drawn on a surface takes no offset_m or offset_by_variant")
         if self.region is not None and not self.surface_of:
@@ -87,10 +94,13 @@ class Markers(Strict):
     ``spacing_m`` apart all over it; optionally only in a region."""
 
     surface_of: list[Ref] = Field(
-        min_length=1, description="Person links with a collision shape to cover, e.g. person.right_shoulder, person.head."
+        min_length=1,
+        description="Person links with a collision shape to cover, e.g. person.right_shoulder, person.head.",
     )
     region: Region | None = Field(None, description="Only this part of the surface (e.g. around the mouth).")
-    spacing_m: float = Field(0.03, gt=0.005, le=0.5, description="Distance between markers (between rings and along a ring), metres.")
+    spacing_m: float = Field(
+        0.03, gt=0.005, le=0.5, description="Distance between markers (between rings and along a ring), metres."
+    )
     cleared_by: ClearedBy = Field(description="What clears a marker.")
     show_rgba: Rgba | None = Field(None, description="Draw the markers not yet cleared as small spheres in renders.")
 
@@ -117,7 +127,11 @@ class SimulatedNear(Strict):
     close to a body they could touch or be consumed at (e.g. food in the spoon at the person)."""
 
     body: Ref = Field(description="The body, e.g. person.")
-    distance_m: float = Field(gt=0, le=1, description="Gap between the container's link and the body (metres) below which the particles are simulated.")
+    distance_m: float = Field(
+        gt=0,
+        le=1,
+        description="Gap between the container's link and the body (metres) below which the particles are simulated.",
+    )
 
 
 class RestInContainer(Strict):
@@ -140,26 +154,37 @@ class RestInContainer(Strict):
 
     container: Ref = Field(description="A tool with a container (e.g. the cup) that carries the resting particles.")
     max_tilt_deg: float = Field(
-        45.0, gt=0, le=90, description="Effective tilt (degrees) above which particles are never carried; keep a heap "
-        "resting at this tilt, turned by max_turn_deg more, well below the container's rim."
+        45.0,
+        gt=0,
+        le=90,
+        description="Effective tilt (degrees) above which particles are never carried; keep a heap "
+        "resting at this tilt, turned by max_turn_deg more, well below the container's rim.",
     )
     max_turn_deg: float = Field(
-        20.0, gt=0, le=60, description="Turn of the apparent up (degrees, in the container's frame) since the particles "
-        "came to rest above which they are simulated again."
+        20.0,
+        gt=0,
+        le=60,
+        description="Turn of the apparent up (degrees, in the container's frame) since the particles "
+        "came to rest above which they are simulated again.",
     )
     max_speed_mps: float = Field(
-        0.02, gt=0, le=1, description="Mean speed relative to the container (m/s) at most which simulated particles are still."
+        0.02,
+        gt=0,
+        le=1,
+        description="Mean speed relative to the container (m/s) at most which simulated particles are still.",
     )
     still_steps: int = Field(
         2, ge=1, le=100, description="Env steps in a row the particles must be still before they are carried."
     )
     carry_at_reset: bool = Field(
-        True, description="Carry the settled start positions from the reset on (false: simulate the particles from the "
+        True,
+        description="Carry the settled start positions from the reset on (false: simulate the particles from the "
         "reset until they come to rest, for a heap settled in a balance the motion would soon upset, such as the "
-        "spoon's stacked food)."
+        "spoon's stacked food).",
     )
     simulated_near: SimulatedNear | None = Field(
-        None, description="Simulate them, resting or not, while the container is near this body (None: wherever they rest)."
+        None,
+        description="Simulate them, resting or not, while the container is near this body (None: wherever they rest).",
     )
 
 
@@ -182,7 +207,8 @@ class Particles(Strict):
         None, description="Body whose first contact with an active particle counts as a hit (food on the person)."
     )
     rest: RestInContainer | None = Field(
-        None, description="Carry particles at rest in a container with it instead of simulating them (a speed-up; see RestInContainer)."
+        None,
+        description="Carry particles at rest in a container with it instead of simulating them (a speed-up; see RestInContainer).",
     )
 
     @field_validator("grid")
@@ -212,7 +238,9 @@ class SleeveShape(Strict):
     kind: Literal["sleeve"] = Field(description="Generated shape kind.")
     length_m: float = Field(gt=0.02, le=2.0, description="Tube length, metres.")
     radius_open_m: float = Field(gt=0.005, le=0.5, description="Radius of the opening ring, metres.")
-    radius_end_m: float | None = Field(None, gt=0.005, le=0.5, description="Radius of the cuff ring, metres (None: the opening's).")
+    radius_end_m: float | None = Field(
+        None, gt=0.005, le=0.5, description="Radius of the cuff ring, metres (None: the opening's)."
+    )
     rings: int = Field(8, ge=2, le=64, description="Rings of nodes along the tube (including both ends).")
     segments: int = Field(10, ge=3, le=64, description="Nodes around each ring.")
 
@@ -227,7 +255,10 @@ class SoftBodyPhysics(Strict):
     collision_margin_m: float = Field(0.01, gt=0, le=0.1, description="Collision margin of the cloth, metres.")
     elastic_stiffness: float = Field(10.0, gt=0, le=10_000, description="springElasticStiffness, N/m.")
     damping_stiffness: float = Field(
-        0.002, ge=0, le=10, description="springDampingStiffness, N·s/m, damping all directions (≈ air drag per node; 0.1 freezes the cloth)."
+        0.002,
+        ge=0,
+        le=10,
+        description="springDampingStiffness, N·s/m, damping all directions (≈ air drag per node; 0.1 freezes the cloth).",
     )
     bending_stiffness: float = Field(0.1, ge=0, le=10_000, description="springBendingStiffness, N/m.")
     friction: float = Field(0.5, ge=0, le=5, description="Friction coefficient of the cloth.")
@@ -237,15 +268,21 @@ class GarmentHold(Strict):
     """How the robot holds the garment: a node set pinned to the robot's hand (the pinned nodes
     follow the hand exactly; the rest of the cloth hangs and slides freely)."""
 
-    hand: Literal["right", "left"] = Field(description="Which robot hand holds it (single-arm robots: their only hand).")
+    hand: Literal["right", "left"] = Field(
+        description="Which robot hand holds it (single-arm robots: their only hand)."
+    )
     grip: Name = Field(
         "garment",
         description="The robot part's grip (grips: in specs/robots/<robot>.yaml) giving the held frame in the hand's "
         "tool-mount frame; the robot's start pose (robot.start.tool_*) is this frame's pose.",
     )
-    nodes: Name = Field("opening", description="Node set pinned to the held frame (e.g. opening: a hoop grip; opening_top: a pinch).")
+    nodes: Name = Field(
+        "opening", description="Node set pinned to the held frame (e.g. opening: a hoop grip; opening_top: a pinch)."
+    )
     offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Garment frame origin in the held frame, metres.")
-    rpy_deg: Vec3 = Field((0.0, 0.0, 0.0), description="Garment frame orientation in the held frame (roll, pitch, yaw), degrees.")
+    rpy_deg: Vec3 = Field(
+        (0.0, 0.0, 0.0), description="Garment frame orientation in the held frame (roll, pitch, yaw), degrees."
+    )
 
 
 class GarmentSettle(Strict):

@@ -3,10 +3,9 @@ model and random quantities (a number, or ``{uniform: [lo, hi]}`` drawn per rese
 
 from __future__ import annotations
 
-from typing import Annotated, Union
+from typing import Annotated
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
-
 
 Name = Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]*$", max_length=64)]
 Ref = Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]*(\.[a-z][a-z0-9_]*)?$", max_length=129)]
@@ -35,14 +34,14 @@ class Uniform(Strict):
     uniform: tuple[float, float] = Field(description="Bounds [low, high] of a uniform draw; low ≤ high.")
 
     @model_validator(mode="after")
-    def _ordered(self) -> "Uniform":
+    def _ordered(self) -> Uniform:
         low, high = self.uniform
         if low > high:
             raise ValueError(f"@uniform: bounds are reversed: low {low:g} > high {high:g}; write [low, high]")
         return self
 
 
-Scalar = Union[float, Uniform]
+Scalar = float | Uniform
 """A fixed number or ``{uniform: [low, high]}`` re-drawn at every reset."""
 
 

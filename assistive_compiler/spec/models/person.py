@@ -3,11 +3,11 @@ holds), impairments (tremor, weakness, limited range) and placement (seated, set
 
 from __future__ import annotations
 
-from typing import Annotated, Literal, Union
+from typing import Annotated, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from .common import describe, Name, Ref, Scalar, scalar_bounds, Strict, Uniform, Vec3
+from .common import Name, Ref, Scalar, Strict, Uniform, Vec3, describe, scalar_bounds
 
 
 def _in_unit_interval(value: Scalar, name: str) -> Scalar:
@@ -51,7 +51,8 @@ class LimitedRange(Strict):
         description="Range scale γ ∈ (0, 1] applied to joint limits (paper: U(0.5, 1)).",
     )
     joints: list[Ref] = Field(
-        default_factory=lambda: ["person.right_arm", "person.left_arm", "person.head"], description="Joint groups affected."
+        default_factory=lambda: ["person.right_arm", "person.left_arm", "person.head"],
+        description="Joint groups affected.",
     )
 
     _range = field_validator("scale")(lambda v: _in_unit_interval(v, "scale"))
@@ -63,7 +64,7 @@ class NoImpairment(Strict):
     kind: Literal["none"] = Field(description="Impairment kind.")
 
 
-Impairment = Annotated[Union[NoImpairment, Tremor, Weakness, LimitedRange], Field(discriminator="kind")]
+Impairment = Annotated[NoImpairment | Tremor | Weakness | LimitedRange, Field(discriminator="kind")]
 
 
 class Impairments(Strict):
@@ -94,7 +95,10 @@ class PersonControl(Strict):
     position_gain: float = Field(0.05, gt=0, le=1, description="Position gain of policy-controlled joints.")
     max_force_nm: float = Field(1.0, gt=0, description="Force limit of policy-controlled joints, N·m.")
     action_scale_rad: float = Field(
-        0.05, gt=0, le=1, description="Policy-joint target change per unit human action per physics step, radians (the reference: 0.05)."
+        0.05,
+        gt=0,
+        le=1,
+        description="Policy-joint target change per unit human action per physics step, radians (the reference: 0.05).",
     )
     arm_limits: str = Field(
         "analytic",
@@ -110,7 +114,9 @@ class PersonControl(Strict):
             return v
         from ...errors import did_you_mean
 
-        raise ValueError(f"must be 'analytic', 'none' or the path of a .npz file, got '{v}'{did_you_mean(v, ['analytic', 'none'])}")
+        raise ValueError(
+            f"must be 'analytic', 'none' or the path of a .npz file, got '{v}'{did_you_mean(v, ['analytic', 'none'])}"
+        )
 
 
 class Settle(Strict):
@@ -121,17 +127,24 @@ class Settle(Strict):
 
     steps: int = Field(100, ge=1, le=5000, description="Physics steps to settle (the reference: 100 = 2 s).")
     gravity_mps2: float = Field(-1.0, ge=-20, lt=0, description="Gravity while settling, m/s² (the reference: −1).")
-    joint_noise_rad: float = Field(0.1, ge=0, le=1, description="Half-width of the uniform noise on every joint angle, rad.")
-    friction: float | None = Field(None, ge=0, description="Friction of the furniture while settling (the reference: 5); None keeps it.")
-    then: "SettleStage | None" = Field(
-        None, description="A second compile-time stage after settling (e.g. an arm dropped to hang off the bed, paper §III-B)."
+    joint_noise_rad: float = Field(
+        0.1, ge=0, le=1, description="Half-width of the uniform noise on every joint angle, rad."
+    )
+    friction: float | None = Field(
+        None, ge=0, description="Friction of the furniture while settling (the reference: 5); None keeps it."
+    )
+    then: SettleStage | None = Field(
+        None,
+        description="A second compile-time stage after settling (e.g. an arm dropped to hang off the bed, paper §III-B).",
     )
 
 
 class StageHold(Strict):
     """The weak position hold of a settle stage's dynamic joints (towards the stage's start angles)."""
 
-    max_force_nm: float = Field(gt=0, description="Motor force limit, N·m (the reference's arm manipulation: 0.01 × strength 1).")
+    max_force_nm: float = Field(
+        gt=0, description="Motor force limit, N·m (the reference's arm manipulation: 0.01 × strength 1)."
+    )
     position_gain: float = Field(gt=0, le=1, description="Position gain (the reference: 0.05).")
 
 
@@ -141,12 +154,20 @@ class SettleStage(Strict):
     others keep theirs) and then move freely under ``gravity_mps2`` and a weak ``hold`` for
     ``steps`` physics steps. The resulting angles are stored like the settled ones."""
 
-    joints_deg: dict[Name, float] = Field(default_factory=dict, description="Joint angles set before the stage, degrees by joint name.")
-    dynamic: list[Ref] = Field(min_length=1, description="Person joint groups left free during the stage, e.g. person.right_arm.")
+    joints_deg: dict[Name, float] = Field(
+        default_factory=dict, description="Joint angles set before the stage, degrees by joint name."
+    )
+    dynamic: list[Ref] = Field(
+        min_length=1, description="Person joint groups left free during the stage, e.g. person.right_arm."
+    )
     hold: StageHold | None = Field(None, description="Weak hold of the dynamic joints (None: limp).")
     gravity_mps2: float = Field(-9.81, ge=-20, lt=0, description="Gravity during the stage, m/s².")
     steps: int = Field(100, ge=1, le=5000, description="Physics steps of the stage (the reference: 100).")
-    friction: float | None = Field(None, ge=0, description="Friction of the furniture during the stage (the reference: 0.3); None keeps the settle's.")
+    friction: float | None = Field(
+        None,
+        ge=0,
+        description="Friction of the furniture during the stage (the reference: 0.3); None keeps the settle's.",
+    )
 
 
 class Placement(Strict):
@@ -158,12 +179,13 @@ class Placement(Strict):
     position_m: Vec3 | None = Field(None, description="Explicit chest position in the world, metres.")
     rpy_deg: Vec3 = Field((0.0, 0.0, 0.0), description="Chest orientation (roll, pitch, yaw) in degrees.")
     offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Added to the seat-derived position, metres.")
-    settle: "Settle | None" = Field(
-        None, description="Let the limp body fall onto the furniture at compile time and keep the settled pose (supine people)."
+    settle: Settle | None = Field(
+        None,
+        description="Let the limp body fall onto the furniture at compile time and keep the settled pose (supine people).",
     )
 
     @model_validator(mode="after")
-    def _one_way(self) -> "Placement":
+    def _one_way(self) -> Placement:
         if (self.seated_on is None) == (self.position_m is None):
             raise ValueError("give exactly one of 'seated_on' (a furniture name) or 'position_m'")
         return self

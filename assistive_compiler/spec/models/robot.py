@@ -44,8 +44,9 @@ class Goal(Strict):
     oriented: bool = Field(False, description="Also reach the tool's start orientation (else position only).")
     required: bool = Field(False, description="A base pose that cannot reach this goal is discarded.")
     arm: Literal["right", "left"] | None = Field(
-        None, description="Which arm reaches it when the robot acts with both arms (robot.arm: both); None: the right "
-        "(acting) arm. A one-arm robot reaches every goal with its arm."
+        None,
+        description="Which arm reaches it when the robot acts with both arms (robot.arm: both); None: the right "
+        "(acting) arm. A one-arm robot reaches every goal with its arm.",
     )
 
 
@@ -55,7 +56,9 @@ class BaseSearch(Strict):
     ties broken by joint-limit-weighted kinematic isotropy (JLWKI). The start pose is always a
     required, oriented goal. Deterministic and bounded: exactly ``attempts`` samples."""
 
-    origin_m: Vec3 = Field((-0.85, -0.4, 0.0), description="Anchor of the sampling box in the world (x, y), m; z is ignored.")
+    origin_m: Vec3 = Field(
+        (-0.85, -0.4, 0.0), description="Anchor of the sampling box in the world (x, y), m; z is ignored."
+    )
     x_range_m: tuple[float, float] = Field((-0.5, 0.0), description="Uniform x offset from the anchor, m.")
     y_range_m: tuple[float, float] = Field((-0.5, 0.5), description="Uniform y offset from the anchor, m.")
     yaw_deg: float = Field(0.0, ge=-360, le=360, description="Base yaw before noise, degrees.")
@@ -68,16 +71,24 @@ class BaseSearch(Strict):
 class PerRobot(Strict):
     """Task settings that differ per robot (the reference's per-task robot tables)."""
 
-    base_offset_m: Vec3 | None = Field(None, description="Base position offset from the mount or the search anchor, m (the reference's toc_base_pos_offset).")
-    start: StartGoal | None = Field(None, description="This robot's start pose, replacing robot.start (e.g. a one-arm robot's single start in a two-arm task).")
+    base_offset_m: Vec3 | None = Field(
+        None,
+        description="Base position offset from the mount or the search anchor, m (the reference's toc_base_pos_offset).",
+    )
+    start: StartGoal | None = Field(
+        None,
+        description="This robot's start pose, replacing robot.start (e.g. a one-arm robot's single start in a two-arm task).",
+    )
     base_search: BaseSearch | None = Field(
-        None, description="This robot's base search, replacing robot.base_search (e.g. a robot that reaches a goal only "
-        "part of the time, where the task requires it of the others)."
+        None,
+        description="This robot's base search, replacing robot.base_search (e.g. a robot that reaches a goal only "
+        "part of the time, where the task requires it of the others).",
     )
     arm_rest_rad: list[float] | None = Field(
-        None, description="The acting arm's configuration (rad or m, in the arm's joint order) that the compile-time IK "
+        None,
+        description="The acting arm's configuration (rad or m, in the arm's joint order) that the compile-time IK "
         "(base search, start states) starts from, replacing the robot part's rest_rad in this task (e.g. Panda's default "
-        "all-zero rest, a straight-up arm on joint 4's limit, led its bed-bathing starts into configurations at the limits)."
+        "all-zero rest, a straight-up arm on joint 4's limit, led its bed-bathing starts into configurations at the limits).",
     )
 
 
@@ -101,10 +112,13 @@ class RobotRole(Strict):
     control: RobotControl = Field(default_factory=RobotControl, description="Arm control.")
     start: StartGoal = Field(description="Start pose of the tool of the acting arm (the right arm when arm is 'both').")
     start_left: StartGoal | None = Field(
-        None, description="Start pose of the left arm's tool when arm is 'both' and the robot has two arms (one-arm robots "
-        "use start, or per_robot.<robot>.start)."
+        None,
+        description="Start pose of the left arm's tool when arm is 'both' and the robot has two arms (one-arm robots "
+        "use start, or per_robot.<robot>.start).",
     )
-    base_search: BaseSearch = Field(default_factory=BaseSearch, description="Base placement of robots that are not mounted.")
+    base_search: BaseSearch = Field(
+        default_factory=BaseSearch, description="Base placement of robots that are not mounted."
+    )
     per_robot: dict[Name, PerRobot] = Field(default_factory=dict, description="Per-robot settings by robot name.")
 
     def search_for(self, robot: str) -> BaseSearch:
@@ -119,13 +133,17 @@ class RobotRole(Strict):
         return own.arm_rest_rad if own is not None else None
 
     @model_validator(mode="after")
-    def _default_supported(self) -> "RobotRole":
+    def _default_supported(self) -> RobotRole:
         if self.default not in self.supported:
             from ...errors import did_you_mean
 
-            raise ValueError(f"@default: default robot '{self.default}' is not in supported {self.supported}{did_you_mean(self.default, self.supported)}")
+            raise ValueError(
+                f"@default: default robot '{self.default}' is not in supported {self.supported}{did_you_mean(self.default, self.supported)}"
+            )
         if self.start_left is not None and self.arm != "both":
-            raise ValueError(f"@start_left: start_left is the left arm's start in a task acting with both arms, but this task's arm is '{self.arm}'; remove it or set arm: both")
+            raise ValueError(
+                f"@start_left: start_left is the left arm's start in a task acting with both arms, but this task's arm is '{self.arm}'; remove it or set arm: both"
+            )
         return self
 
 
@@ -137,11 +155,13 @@ class ToolUse(Strict):
     gravity_mps2: float | None = Field(0.0, ge=-20, le=0, description="Gravity on the tool (0: weightless).")
     mass_kg: float | None = Field(None, gt=0, description="Mass override in kg (None: the part's mass).")
     grip: Name | None = Field(
-        None, description="Which of the robot part's grips (grips: in specs/robots/<robot>.yaml) holds this tool; default "
+        None,
+        description="Which of the robot part's grips (grips: in specs/robots/<robot>.yaml) holds this tool; default "
         "the tool's part name. A new tool shaped like a shipped one can reuse its grip (e.g. grip: scratcher).",
     )
     one_arm_same_as: Name | None = Field(
-        None, description="On a robot acting with one arm (which serves as both hands), this tool is the named tool, held "
+        None,
+        description="On a robot acting with one arm (which serves as both hands), this tool is the named tool, held "
         "in the other hand: one body that both names refer to (the reference's single-arm arm manipulation, paper §III-B). "
         "Two-arm robots acting with both arms hold both tools.",
     )

@@ -7,7 +7,8 @@ so scripts that share lanes write them once. ``repeat_from`` counts the spliced 
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Iterator, Union
+from collections.abc import Iterator
+from typing import Annotated, Any
 
 from pydantic import Discriminator, Field, Tag, model_validator
 
@@ -21,44 +22,63 @@ class Waypoint(Strict):
     offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Goal offset from that point, world frame, metres.")
     tolerance_m: float = Field(0.02, ge=0, le=1, description="Distance at which the next waypoint starts, metres.")
     normal_offset_m: float = Field(
-        0.0, ge=-0.5, le=0.5, description="Offset along the target's outward surface normal (targets drawn on a surface), metres."
+        0.0,
+        ge=-0.5,
+        le=0.5,
+        description="Offset along the target's outward surface normal (targets drawn on a surface), metres.",
     )
     axis_offset_m: float = Field(
-        0.0, ge=-0.5, le=0.5, description="Offset along the limb's axis, away from its joint (targets drawn on a surface), metres."
+        0.0,
+        ge=-0.5,
+        le=0.5,
+        description="Offset along the limb's axis, away from its joint (targets drawn on a surface), metres.",
     )
     rpy_deg: Vec3 | None = Field(
-        None, description="Orientation of the moved point's link at this waypoint (roll, pitch, yaw; world, degrees), e.g. "
-        "to tilt a cup; None keeps the tool's start orientation."
+        None,
+        description="Orientation of the moved point's link at this waypoint (roll, pitch, yaw; world, degrees), e.g. "
+        "to tilt a cup; None keeps the tool's start orientation.",
     )
     face_normal_within_deg: float | None = Field(
-        None, ge=0, le=180, description="Turn the tool, by the smallest rotation from its start orientation, until its "
+        None,
+        ge=0,
+        le=180,
+        description="Turn the tool, by the smallest rotation from its start orientation, until its "
         "pointing axis (from the end effector to the moved point) lies within this angle of the target's inward surface "
         "normal (targets drawn on a surface), so the tool meets the surface tip first instead of lying across the limb; "
-        "degrees. None keeps the start orientation (or rpy_deg's)."
+        "degrees. None keeps the start orientation (or rpy_deg's).",
     )
     face_normal_level: bool = Field(
-        False, description="With face_normal_within_deg: turn the tool about the vertical only, towards the inward normal's "
+        False,
+        description="With face_normal_within_deg: turn the tool about the vertical only, towards the inward normal's "
         "horizontal part, so it stays level (a wrist that only yaws, e.g. Stretch's); a spot facing more up or down than "
-        "sideways (its normal over 45 degrees from the horizontal) is left unturned, since no yaw meets it tip first."
+        "sideways (its normal over 45 degrees from the horizontal) is left unturned, since no yaw meets it tip first.",
     )
     step_m: float | None = Field(
-        None, gt=0, le=0.5, description="Largest distance, metres, between the moved point and the goal handed to IK while heading "
+        None,
+        gt=0,
+        le=0.5,
+        description="Largest distance, metres, between the moved point and the goal handed to IK while heading "
         "for this waypoint: the point then follows the straight line from where it is (e.g. wiping along a limb) instead of the "
-        "joint-space path one IK jump takes. None: IK aims at the waypoint itself."
+        "joint-space path one IK jump takes. None: IK aims at the waypoint itself.",
     )
     turn_step_deg: float | None = Field(
-        None, gt=0, le=180, description="Pour speed: the orientation handed to IK while heading for this waypoint turns "
+        None,
+        gt=0,
+        le=180,
+        description="Pour speed: the orientation handed to IK while heading for this waypoint turns "
         "at most this many degrees per step, from the moved point's orientation when the waypoint begins towards rpy_deg's "
         "(or the kept one), so the tool turns at about that rate (e.g. a cup tipped slowly enough to reach the lips before "
-        "its water runs out) instead of as fast as the joints follow one IK jump. None: IK aims at the waypoint's orientation itself."
+        "its water runs out) instead of as fast as the joints follow one IK jump. None: IK aims at the waypoint's orientation itself.",
     )
 
 
 class SegmentUse(Strict):
     """``{segment: NAME}`` in a waypoint list: the waypoints of ``scripted.segments.NAME``, in order, in its place."""
 
-    segment: Name = Field(description="The name of a segment under scripted.segments, e.g. side_lanes; its waypoints "
-                          "go here, in order, as if written here.")
+    segment: Name = Field(
+        description="The name of a segment under scripted.segments, e.g. side_lanes; its waypoints "
+        "go here, in order, as if written here."
+    )
 
 
 def _item_kind(value: Any) -> str:
@@ -69,7 +89,7 @@ def _item_kind(value: Any) -> str:
 
 
 WaypointItem = Annotated[
-    Union[Annotated[Waypoint, Tag("Waypoint")], Annotated[SegmentUse, Tag("SegmentUse")]], Discriminator(_item_kind)
+    Annotated[Waypoint, Tag("Waypoint")] | Annotated[SegmentUse, Tag("SegmentUse")], Discriminator(_item_kind)
 ]
 """An item of a waypoint list: a waypoint, or ``{segment: NAME}`` splicing a named segment in."""
 
@@ -78,9 +98,14 @@ class ScriptedArm(Strict):
     """The left arm's part of a scripted baseline when the robot acts with both arms."""
 
     move: Ref = Field(description="The point the left arm moves, e.g. scooper_left.blade.")
-    waypoints: list[WaypointItem] = Field(min_length=1, description="Goals in order, each a waypoint or {segment: NAME} (that "
-                                          "segment's waypoints); the last is held unless repeat_from is given.")
-    repeat_from: int | None = Field(None, ge=0, description="After the last waypoint, go on from this index; None holds the last.")
+    waypoints: list[WaypointItem] = Field(
+        min_length=1,
+        description="Goals in order, each a waypoint or {segment: NAME} (that "
+        "segment's waypoints); the last is held unless repeat_from is given.",
+    )
+    repeat_from: int | None = Field(
+        None, ge=0, description="After the last waypoint, go on from this index; None holds the last."
+    )
 
 
 class ScriptedRobot(Strict):
@@ -88,20 +113,31 @@ class ScriptedRobot(Strict):
     reach and in the wrist orientations they can hold, so one set of waypoints rarely suits all)."""
 
     move: Ref | None = Field(None, description="The point moved; None: the task's scripted.move.")
-    waypoints: list[WaypointItem] = Field(min_length=1, description="Goals in order, each a waypoint or {segment: NAME} (that "
-                                          "segment's waypoints), replacing scripted.waypoints for this robot; the last is held "
-                                          "unless repeat_from is given.")
-    repeat_from: int | None = Field(None, ge=0, description="After the last waypoint, go on from this index (replacing scripted.repeat_from); None holds the last.")
+    waypoints: list[WaypointItem] = Field(
+        min_length=1,
+        description="Goals in order, each a waypoint or {segment: NAME} (that "
+        "segment's waypoints), replacing scripted.waypoints for this robot; the last is held "
+        "unless repeat_from is given.",
+    )
+    repeat_from: int | None = Field(
+        None,
+        ge=0,
+        description="After the last waypoint, go on from this index (replacing scripted.repeat_from); None holds the last.",
+    )
     step_m: float | None = Field(
-        None, gt=0, le=0.5, description="Replaces the step_m of each of these waypoints that has one (those spliced in from "
+        None,
+        gt=0,
+        le=0.5,
+        description="Replaces the step_m of each of these waypoints that has one (those spliced in from "
         "segments too): how far ahead of the moved point IK aims along a straight line, metres (robots differ in how far their "
-        "tool lags behind that goal, so two robots can share waypoints and differ in this). None: each waypoint's own."
+        "tool lags behind that goal, so two robots can share waypoints and differ in this). None: each waypoint's own.",
     )
     ik_damping: dict[Name, Annotated[float, Field(gt=0)]] = Field(
-        default_factory=dict, description="pybullet IK damping of some of this robot's arm joints by joint name (the others "
+        default_factory=dict,
+        description="pybullet IK damping of some of this robot's arm joints by joint name (the others "
         "keep pybullet's 0.1; the IK is then damped least squares): a joint damped more moves less in each IK step, so the "
         "script leans on the other joints, e.g. an arm whose shoulder turns much more slowly than its elbow and wrist. Empty: "
-        "pybullet's null-space IK towards the current pose."
+        "pybullet's null-space IK towards the current pose.",
     )
 
 
@@ -112,36 +148,48 @@ class Scripted(Strict):
 
     move: Ref = Field(description="The point moved, e.g. spoon (its reference link) or spoon.tip.")
     segments: dict[Name, list[WaypointItem]] = Field(
-        default_factory=dict, description="Named runs of waypoints (e.g. one lane along a limb), written once and spliced into "
+        default_factory=dict,
+        description="Named runs of waypoints (e.g. one lane along a limb), written once and spliced into "
         "any waypoint list of this section (waypoints, left, right, per_robot.<robot>) by the item {segment: NAME}, so scripts "
         "that share lanes do not copy them. A segment holds at least one waypoint and no {segment: ...} of its own, and each "
-        "segment a spec file defines is used."
+        "segment a spec file defines is used.",
     )
-    waypoints: list[WaypointItem] = Field(min_length=1, description="Goals in order, each a waypoint or {segment: NAME} (that "
-                                          "segment's waypoints); the last is held unless repeat_from is given.")
+    waypoints: list[WaypointItem] = Field(
+        min_length=1,
+        description="Goals in order, each a waypoint or {segment: NAME} (that "
+        "segment's waypoints); the last is held unless repeat_from is given.",
+    )
     repeat_from: int | None = Field(
-        None, ge=0, description="After the last waypoint, go on from this index (e.g. to rub back and forth); None holds the last."
+        None,
+        ge=0,
+        description="After the last waypoint, go on from this index (e.g. to rub back and forth); None holds the last.",
     )
     step_m: float | None = Field(
-        None, gt=0, le=0.5, description="Replaces the step_m of each of these waypoints that has one (those spliced in from "
+        None,
+        gt=0,
+        le=0.5,
+        description="Replaces the step_m of each of these waypoints that has one (those spliced in from "
         "segments too): how far ahead of the moved point IK aims along a straight line, metres. A robot's own script "
-        "(per_robot.<robot>) uses its own step_m instead. None: each waypoint's own."
+        "(per_robot.<robot>) uses its own step_m instead. None: each waypoint's own.",
     )
     left: ScriptedArm | None = Field(
-        None, description="The left arm's waypoints when the robot acts with both arms (robot.arm: both, a two-arm robot); "
-        "move/waypoints then drive the right arm. Ignored on one-arm robots."
+        None,
+        description="The left arm's waypoints when the robot acts with both arms (robot.arm: both, a two-arm robot); "
+        "move/waypoints then drive the right arm. Ignored on one-arm robots.",
     )
     right: ScriptedArm | None = Field(
-        None, description="The right arm's part when the robot acts with both arms (robot.arm: both, a two-arm robot): it "
+        None,
+        description="The right arm's part when the robot acts with both arms (robot.arm: both, a two-arm robot): it "
         "replaces move/waypoints/repeat_from there, so that a two-arm script (e.g. lift with both hands) can differ from the "
-        "one-arm script that move/waypoints give. Ignored on one-arm robots."
+        "one-arm script that move/waypoints give. Ignored on one-arm robots.",
     )
     per_robot: dict[Name, ScriptedRobot] = Field(
-        default_factory=dict, description="Scripts by robot name: the named robot follows its own move/waypoints/repeat_from "
-        "instead of the ones above (left/right still apply to two-arm robots acting with both arms)."
+        default_factory=dict,
+        description="Scripts by robot name: the named robot follows its own move/waypoints/repeat_from "
+        "instead of the ones above (left/right still apply to two-arm robots acting with both arms).",
     )
 
-    def scripts(self) -> Iterator[tuple[tuple[str, ...], "Scripted | ScriptedArm | ScriptedRobot"]]:
+    def scripts(self) -> Iterator[tuple[tuple[str, ...], Scripted | ScriptedArm | ScriptedRobot]]:
         """Every waypoint script of this section with its path below ``scripted`` (``()`` for this one)."""
         yield (), self
         for side in ("left", "right"):
@@ -161,13 +209,18 @@ class Scripted(Strict):
                 out.append((item, path + (i,)))
             elif item.segment in self.segments:
                 where = ("scripted", "segments", item.segment)
-                out.extend((w, where + (j,)) for j, w in enumerate(self.segments[item.segment]) if isinstance(w, Waypoint))
+                out.extend(
+                    (w, where + (j,)) for j, w in enumerate(self.segments[item.segment]) if isinstance(w, Waypoint)
+                )
         return out
 
     @model_validator(mode="after")
-    def _repeat_in_range(self) -> "Scripted":
+    def _repeat_in_range(self) -> Scripted:
         """Each script's repeat_from is an index of its waypoints, segments spliced in."""
-        def plain(name: str) -> bool:  # a segment to count: known, not empty, no segment use in it (resolve reports the others)
+
+        def plain(
+            name: str,
+        ) -> bool:  # a segment to count: known, not empty, no segment use in it (resolve reports the others)
             return bool(self.segments.get(name)) and all(isinstance(w, Waypoint) for w in self.segments[name])
 
         for where, script in self.scripts():

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pydantic import Field, field_validator
 
-from .common import Scalar, scalar_bounds, Strict, Uniform
+from .common import Scalar, Strict, Uniform, scalar_bounds
 
 
 class Solver(Strict):
@@ -15,12 +15,15 @@ class Solver(Strict):
     sub_steps: int = Field(0, ge=0, le=64, description="numSubSteps: extra sub-steps per physics step (0 = none).")
     iterations: int = Field(50, ge=1, le=1000, description="numSolverIterations per physics step.")
     contact_breaking_threshold_m: float = Field(
-        0.02, gt=0, le=0.1,
+        0.02,
+        gt=0,
+        le=0.1,
         description="Distance (m) a cached contact point may drift before Bullet drops it (Bullet's default 0.02). "
-                    "Small rolling particles pile up stale copies of their one contact under the default, each a "
-                    "solver row: 0.002 cuts Feeding's physics by 14% and Drinking's by 21%, but changes how deep "
-                    "particles sink, and stale points widen where a contact is reported (Bed Bathing's wiping counts "
-                    "them); the shipped tasks keep the default, as the reference does (docs/physics.md).")
+        "Small rolling particles pile up stale copies of their one contact under the default, each a "
+        "solver row: 0.002 cuts Feeding's physics by 14% and Drinking's by 21%, but changes how deep "
+        "particles sink, and stale points widen where a contact is reported (Bed Bathing's wiping counts "
+        "them); the shipped tasks keep the default, as the reference does (docs/physics.md).",
+    )
 
 
 class Ground(Strict):
@@ -45,6 +48,8 @@ class Sim(Strict):
     time_step_s: float = Field(0.02, gt=0, le=0.1, description="Physics time step in seconds.")
     frame_skip: int = Field(5, ge=1, le=100, description="Physics steps per environment step (action).")
     episode_steps: int = Field(200, ge=1, le=100_000, description="Environment steps per episode (then truncated).")
-    gravity_mps2: float = Field(-9.81, ge=-20, le=0, description="World gravity along +Z in m/s² (negative: downwards).")
+    gravity_mps2: float = Field(
+        -9.81, ge=-20, le=0, description="World gravity along +Z in m/s² (negative: downwards)."
+    )
     solver: Solver = Field(default_factory=Solver, description="Constraint-solver settings.")
     ground: Ground = Field(default_factory=Ground, description="The floor.")

@@ -22,8 +22,9 @@ class RewardTerm(TermUse):
     name: Name = Field(description="Name of this term in info and logs.")
     weight: float = Field(description="Multiplier of the term's value (negative to penalise).")
     arms: Literal[1, 2] | None = Field(
-        None, description="Only for robots acting with this many arms (2: a two-arm robot in a task with arm 'both'); "
-        "None: every robot. E.g. the reference's single-arm arm manipulation doubles a distance term."
+        None,
+        description="Only for robots acting with this many arms (2: a two-arm robot in a task with arm 'both'); "
+        "None: every robot. E.g. the reference's single-arm arm manipulation doubles a distance term.",
     )
 
 
@@ -74,7 +75,9 @@ class Success(Strict):
     )
 
     @model_validator(mode="after")
-    def _fraction(self) -> "Success":
+    def _fraction(self) -> Success:
         if self.relative_to is not None and not (0 < self.threshold <= 1):
-            raise ValueError(f"@threshold: threshold {self.threshold:g} is a fraction of '{self.relative_to}' and must lie in (0, 1]")
+            raise ValueError(
+                f"@threshold: threshold {self.threshold:g} is a fraction of '{self.relative_to}' and must lie in (0, 1]"
+            )
         return self
