@@ -334,7 +334,9 @@ def train(
                 if lost is None:
                     raise
                 break
-            steps += int(result["env_runners"]["num_env_steps_sampled"])
+            sampled = result["env_runners"].get("num_env_steps_sampled", 0)
+            # NaN when no env runner reported this iteration (all lost under it): nothing sampled.
+            steps += int(sampled) if sampled == sampled else 0
             lost = env_runners_lost(algo, config)
             if lost is not None:  # none left to sample with: stop here, resumable, rather than wait for a node
                 break
