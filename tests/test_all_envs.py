@@ -1,10 +1,15 @@
-"""Every shipped Gymnasium id compiles, builds and passes Gymnasium's env checker (real compiles,
-real pybullet). Slow (each id compiles once, base searches included); run in CI."""
+"""Every shipped Gymnasium id compiles, builds, passes Gymnasium's env checker and starts its seeded
+episodes exactly as recorded (real compiles, real pybullet). Slow (each id compiles once per test
+session, base searches included); run in CI."""
 
 from __future__ import annotations
 
+import json
+
 import gymnasium as gym
 import pytest
+from episode_digests import STORE, digests, first_difference
+from filelock import FileLock
 from gymnasium.utils.env_checker import check_env
 
 import assistive_compiler  # noqa: F401  (registers the ids)
@@ -24,11 +29,21 @@ def test_shipped_task_robot_pairs_are_registered():
     assert tasks == expected and len(IDS) == 36
 
 
+@pytest.fixture
+def shared_cache(tmp_path_factory, monkeypatch):
+    """One artifact cache for the whole test session (every xdist worker), so each id compiles
+    once; returns a lock to hold while making an env (the first maker compiles, the others wait)."""
+    cache = tmp_path_factory.getbasetemp().parent / "shipped-ids-cache"
+    cache.mkdir(exist_ok=True)
+    monkeypatch.setenv("ASSISTIVE_COMPILER_CACHE", str(cache))
+    return lambda env_id: FileLock(cache / f"{env_id.replace('/', '_')}.lock")
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("env_id", IDS)
-def test_check_env(env_id, tmp_path_factory, monkeypatch):
-    monkeypatch.setenv("ASSISTIVE_COMPILER_CACHE", str(tmp_path_factory.getbasetemp() / "cache"))
-    env = gym.make(env_id)
+def test_check_env(env_id, shared_cache):
+    with shared_cache(env_id):
+        env = gym.make(env_id)
     try:
         check_env(env.unwrapped, skip_render_check=True)
         obs, info = env.reset(seed=0)
@@ -75,3 +90,19 @@ def assert_the_camera_shows_person_arm_and_tools(env, width: int = 160, height: 
     shown |= {att.body: int((body == w.bodies[att.body].id).sum()) for att in m.tools}
     hidden = [name for name, pixels in shown.items() if pixels < MIN_PIXELS.get(name, MIN_PIXELS["tool"])]
     assert not hidden, f"{m.gym_id}: {hidden} hardly visible from the task camera ({shown} pixels of {width}x{height})"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("env_id", IDS)
+def test_seeded_episodes_are_unchanged(env_id, shared_cache):
+    """The scripted and the random-action episode from a seeded reset give the recorded
+    observations, rewards, term values, success and force, step by step (tests/episode_digests.py):
+    a refactor of the compiler or runtime changes no episode unless it means to."""
+    expected = json.loads(STORE.read_text())[env_id]
+    with shared_cache(env_id):
+        gym.make(env_id).unwrapped.close()  # compile under the lock
+    changed = first_difference(expected, digests(env_id))
+    assert changed is None, (
+        f"{env_id}: {changed}; if the change is meant to change episodes, "
+        "regenerate with `python -m tests.episode_digests --write` and say so in the commit"
+    )

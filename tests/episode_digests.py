@@ -1,0 +1,112 @@
+"""Digests of one seeded episode start per shipped id, to show a refactor changes no episode.
+
+For each of the 36 Gymnasium ids, two rollouts from a seeded reset: the scripted baseline
+(``SCRIPTED_SEED``) and seeded random actions (``RANDOM_SEED``), ``STEPS`` env steps each. Every
+step's observation, reward and unweighted term values (and the success flag and force on the
+person) are rounded to ``DECIMALS`` places and hashed, one short digest per step and field, so a
+mismatch names the first step and the field that changed.
+
+Regenerate the stored digests (only after a change that is meant to change episodes, and say so in
+the commit)::
+
+    python -m tests.episode_digests --write
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+STORE = Path(__file__).parent / "data" / "episode_digests.json"
+STEPS = 25
+SCRIPTED_SEED = 0
+RANDOM_SEED = 1
+DECIMALS = 7
+"""Rounding before hashing: far below any physical effect, far above the last bit a numpy build or
+CPU may differ in."""
+
+
+def _digest(*arrays, names: str = "") -> str:
+    h = hashlib.sha256(names.encode())
+    for a in arrays:
+        h.update(np.round(np.asarray(a, dtype=np.float64), DECIMALS).tobytes())
+    return h.hexdigest()[:10]
+
+
+def episode(env, policy_name: str, seed: int) -> dict[str, list[str]]:
+    """Per-step digests of ``policy_name`` (scripted or random) from ``env.reset(seed=seed)``."""
+    from assistive_compiler.policies import make_policy
+
+    obs, _ = env.reset(seed=seed)
+    policy = make_policy(policy_name, env, seed=seed)
+    out: dict[str, list[str]] = {"obs": [_digest(obs)], "reward": [], "terms": [], "outcome": []}
+    for _ in range(STEPS):
+        obs, reward, terminated, truncated, info = env.step(policy(obs))
+        terms = info["terms"]
+        out["obs"].append(_digest(obs))
+        out["reward"].append(_digest(reward))
+        out["terms"].append(_digest([terms[k] for k in terms], names=",".join(terms)))
+        out["outcome"].append(_digest(float(info["task_success"]), info["total_force_on_human"]))
+        if terminated or truncated:
+            break
+    return out
+
+
+def digests(env_id: str) -> dict[str, dict[str, list[str]]]:
+    """Both rollouts of ``env_id``: {"scripted": ..., "random": ...}."""
+    import gymnasium as gym
+
+    import assistive_compiler  # noqa: F401  (registers the ids)
+
+    env = gym.make(env_id).unwrapped
+    try:
+        return {"scripted": episode(env, "scripted", SCRIPTED_SEED), "random": episode(env, "random", RANDOM_SEED)}
+    finally:
+        env.close()
+
+
+def first_difference(expected: dict, got: dict) -> str | None:
+    """Where two ``digests`` results first differ ('random rollout, step 3: obs, reward'), or None."""
+    for rollout in ("scripted", "random"):
+        e, g = expected[rollout], got[rollout]
+        for step in range(max(len(e["obs"]), len(g["obs"]))):
+            fields = [f for f in ("obs", "reward", "terms", "outcome") if _at(e[f], f, step) != _at(g[f], f, step)]
+            if fields:
+                return f"{rollout} rollout, step {step}: {', '.join(fields)} changed"
+    return None
+
+
+def _at(values: list[str], field: str, step: int) -> str | None:
+    index = step if field == "obs" else step - 1  # obs[0] is the reset's observation
+    return values[index] if 0 <= index < len(values) else None
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--write", action="store_true", help=f"write {STORE.name} (else compare with it)")
+    parser.add_argument("ids", nargs="*", help="only these ids (default all shipped)")
+    args = parser.parse_args(argv)
+    from assistive_compiler.registration import shipped_ids
+
+    ids = args.ids or sorted(shipped_ids())
+    stored = json.loads(STORE.read_text()) if STORE.is_file() else {}
+    changed = 0
+    for env_id in ids:
+        got = digests(env_id)
+        where = first_difference(stored[env_id], got) if env_id in stored else "not stored"
+        print(f"{env_id}: {where or 'same'}", flush=True)
+        changed += where is not None
+        stored[env_id] = got
+    if args.write:
+        STORE.write_text(json.dumps(dict(sorted(stored.items())), indent=1) + "\n")
+        print(f"wrote {STORE}")
+    return 1 if changed and not args.write else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
