@@ -23,7 +23,9 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_serializer
+from pydantic import BaseModel, ConfigDict, Field, SerializerFunctionWrapHandler, model_serializer
+
+from .references import JointGroup, ParamValue
 
 FORMAT_VERSION = 1
 
@@ -118,10 +120,10 @@ class PersonVariant(_Model):
     starts: list[StartState] = Field(description="Robot starts for this variant; reset() draws one.")
 
     @model_serializer(mode="wrap")
-    def _without_empty_additions(self, handler):
+    def _without_empty_additions(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
         """``surface_points`` came after artifacts were first written: left out while empty, so an
         artifact compiled before it still matches its content hash (runs keep their artifact)."""
-        data = handler(self)
+        data: dict[str, Any] = handler(self)
         if not data.get("surface_points"):
             data.pop("surface_points", None)
         return data
@@ -206,8 +208,8 @@ class Robot(_Model):
     drive: Drive | None = Field(None, description="The mobile base's drive (None: a fixed base).")
 
     @model_serializer(mode="wrap")
-    def _drop_unset_mobility(self, handler):
-        data = handler(self)
+    def _drop_unset_mobility(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        data: dict[str, Any] = handler(self)
         for key in ("action_multipliers", "followers", "drive"):
             if data.get(key) is None:
                 data.pop(key, None)
@@ -293,10 +295,10 @@ class ParticleRest(_Model):
     )
 
     @model_serializer(mode="wrap")
-    def _without_unset_additions(self, handler):
+    def _without_unset_additions(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
         """``carry_at_reset`` and ``near_body`` came after artifacts were first written: left out
         while at their defaults, so an artifact compiled before them still matches its content hash."""
-        data = handler(self)
+        data: dict[str, Any] = handler(self)
         if data.get("carry_at_reset", True):
             data.pop("carry_at_reset", None)
         if data.get("near_body") is None:
@@ -361,7 +363,9 @@ class TermUse(_Model):
     term: str = Field(description="Registered term kind.")
     category: Literal["reward", "observation", "preference"] = Field(description="Registry category.")
     weight: float = Field(description="Weight (1 for observations).")
-    params: dict[str, Any] = Field(description="Parameters with normalised references.")
+    params: dict[str, ParamValue] = Field(
+        description="Parameters: references resolved to reference models (assistive_compiler.references), other values as written."
+    )
     size: int = Field(1, description="Number of floats it produces (observations).")
 
 
@@ -423,7 +427,9 @@ class Manifest(_Model):
     targets: dict[str, Target]
     particles: list[ParticleSet]
     markers: list[MarkerSet] = Field(default_factory=list, description="Marker sets on the person.")
-    joint_groups: dict[str, dict[str, Any]] = Field(description="Joint groups by reference name.")
+    joint_groups: dict[str, JointGroup] = Field(
+        description="Joint groups by reference name (``robot.arm``, ``person.head``)."
+    )
     observations: dict[str, list[TermUse]] = Field(description="Observation features per agent, in order.")
     reward: list[TermUse] = Field(description="Reward terms including preference costs.")
     success: Success
@@ -433,7 +439,7 @@ class Manifest(_Model):
     scripted: dict[str, Any] | None = Field(
         None, description="Scripted baseline: point moved and waypoints (normalised)."
     )
-    camera: Camera = Field(default_factory=Camera, description="The task's camera for this robot (renders).")
+    camera: Camera = Field(default_factory=lambda: Camera(), description="The task's camera for this robot (renders).")
 
     @property
     def label(self) -> str:

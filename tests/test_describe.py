@@ -10,6 +10,7 @@ from conftest import FEEDING
 
 from assistive_compiler.cli import main
 from assistive_compiler.describe import axis_direction
+from assistive_compiler.references import TargetPoint
 from assistive_compiler.runtime.env import AssistiveEnv
 
 
@@ -71,10 +72,10 @@ def test_render_frames_draws_labelled_axes_and_changes_nothing_else(artifact):
         names = [label for label, _, _ in labelled_frames(env)]
         assert names == ["robot.j2s7s300_end_effector", "spoon.bowl", "spoon.handle_end", "spoon.tip", "mouth"]
         plain = render_rgb(env)
-        obs_before = env.snap.position(env.snap.point({"target": "mouth"})).copy()
+        obs_before = env.snap.position(env.snap.point(TargetPoint(target="mouth"))).copy()
         env.show_frames = True
         framed = render_rgb(env)
-        assert np.array_equal(env.snap.position(env.snap.point({"target": "mouth"})), obs_before)
+        assert np.array_equal(env.snap.position(env.snap.point(TargetPoint(target="mouth"))), obs_before)
         changed = np.any(framed != plain, axis=2)
         assert 200 < changed.sum() < 0.05 * changed.size  # lines and labels, not a repaint
         for colour in AXIS_COLOURS:

@@ -15,6 +15,7 @@ from helpers import compiled_env
 from assistive_compiler.cli import main
 from assistive_compiler.garment import ring_encloses_segment, sleeve_node_sets, sleeve_progress
 from assistive_compiler.paths import specs_dir
+from assistive_compiler.references import LinkPoint
 
 DRESSING = specs_dir() / "tasks" / "dressing.yaml"
 
@@ -209,7 +210,7 @@ def test_scripted_policy_pulls_the_sleeve_onto_the_upper_arm(env):
     assert max(forces) > 0.0  # the cloth touches the arm, gently
     assert max(forces) < 20.0
     # no node strayed: the whole sleeve stays within a metre of the person's shoulder
-    shoulder = env.snap.position(env.snap.point({"body": "person", "link": "left_shoulder"}))
+    shoulder = env.snap.position(env.snap.point(LinkPoint(body="person", link="left_shoulder")))
     assert np.linalg.norm(_nodes(env) - shoulder, axis=1).max() < 1.0
 
 

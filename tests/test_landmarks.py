@@ -12,6 +12,7 @@ from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.errors import SpecError
 from assistive_compiler.library import Library
 from assistive_compiler.person.landmarks import LANDMARKS, landmark_offsets
+from assistive_compiler.references import TargetPoint
 from assistive_compiler.rotation import quat_rotate
 from assistive_compiler.runtime.env import AssistiveEnv
 
@@ -61,7 +62,7 @@ def test_a_landmark_is_a_point_and_a_target_link_in_a_compiled_task(tmp_path):
             )
             # The nose, which an observation term reads, where the variant's head has it.
             nose = np.asarray(state[4]) + quat_rotate(np.asarray(state[5]), np.asarray(offsets(variant)["nose"][1]))
-            got = env.snap.position(env.snap.point({"target": "person.nose"}))
+            got = env.snap.position(env.snap.point(TargetPoint(target="person.nose")))
             assert np.allclose(got, nose, atol=1e-4), (variant, got, nose)
         # A target on a landmark: the landmark's offset plus its own, per variant.
         for v in m.person.variants:

@@ -10,6 +10,7 @@ import pytest
 
 from assistive_compiler.policies import make_policy
 from assistive_compiler.record import RecordEpisodes, RecordingError, episode_files, load_recording, record_episode
+from assistive_compiler.references import TargetPoint
 from assistive_compiler.runtime.env import AssistiveEnv
 
 
@@ -68,7 +69,7 @@ def test_replay_reproduces_poses_and_terms(env, recorded):
         assert np.array_equal(rec.arrays["observations"][k], obs)
         assert np.allclose(
             rec.arrays["target_pos"][k, h["targets"].index("mouth")],
-            env.snap.position(env.snap.point({"target": "mouth"})),
+            env.snap.position(env.snap.point(TargetPoint(target="mouth"))),
             atol=1e-12,
         )
         assert np.array_equal(rec.arrays["particles_active/food"][k], env.particles.active["food"])

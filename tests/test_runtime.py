@@ -23,6 +23,7 @@ import numpy as np
 import pybullet as pb
 import pytest
 
+from assistive_compiler.references import LinkPoint, TargetPoint
 from assistive_compiler.runtime.env import AssistiveEnv
 
 REPO = Path(__file__).resolve().parents[1]
@@ -201,7 +202,7 @@ def test_reset_reuses_the_world(env):
 def test_gravity_compensation_holds_the_arm_and_spoon_still(make_env):
     env = make_env()
     env.reset(seed=0)
-    spoon = env.snap.point({"body": "spoon", "link": "spoon"})
+    spoon = env.snap.point(LinkPoint(body="spoon", link="spoon"))
     ee0, spoon0 = where(env, env.tool_point), where(env, spoon)
     remove_food(env)  # no load on the spoon: only gravity acts
     for _ in range(50):
@@ -287,11 +288,11 @@ def test_env_step_equals_frame_skip_physics_steps(make_env):
 def test_binding_a_new_point_keeps_what_the_snapshot_read(make_env):
     env = make_env()
     env.reset(seed=0)
-    spoon = env.snap.point({"body": "spoon", "link": "spoon"})
+    spoon = env.snap.point(LinkPoint(body="spoon", link="spoon"))
     before = where(env, spoon)
     assert np.linalg.norm(before) > 0.5
     bowl_link = next(iter(env.world.bodies["bowl"].links))
-    env.snap.point({"body": "bowl", "link": bowl_link})  # a point the task does not use
+    env.snap.point(LinkPoint(body="bowl", link=bowl_link))  # a point the task does not use
     np.testing.assert_array_equal(where(env, spoon), before)
 
 
@@ -320,7 +321,7 @@ def test_pooled_contacts_follow_the_world(make_env):
 
 def test_food_starts_in_the_spoon_and_stays_while_still(env):
     env.reset(seed=0)
-    bowl = env.snap.point({"body": "spoon", "link": env.manifest.tools[0].links["bowl"]})
+    bowl = env.snap.point(LinkPoint(body="spoon", link=env.manifest.tools[0].links["bowl"]))
     pos = particle_positions(env)
     assert pos.shape == (8, 3)
     assert np.all(np.linalg.norm(pos - where(env, bowl), axis=1) < 0.03)
@@ -359,7 +360,7 @@ def test_food_at_the_mouth_is_eaten_and_rewarded(env):
     """
     env.reset(seed=0)
     w, c, m = env.world, env.world.client, env.manifest
-    mouth = where(env, env.snap.point({"target": "mouth"}))
+    mouth = where(env, env.snap.point(TargetPoint(target="mouth")))
     pid = w.particles["food"][0]
     n, dt = m.sim.frame_skip, m.sim.time_step
     v0 = 9.81 * dt * (n + 1) / 2

@@ -15,6 +15,7 @@ from assistive_compiler.library import Library
 from assistive_compiler.paths import specs_dir
 from assistive_compiler.person.landmarks import landmark_offsets
 from assistive_compiler.person.surface import Region, link_surface
+from assistive_compiler.references import TargetPoint
 from assistive_compiler.runtime.env import AssistiveEnv
 
 HANDOVER = specs_dir() / "examples" / "handover.yaml"
@@ -178,7 +179,7 @@ def test_a_surface_target_on_the_head_is_drawn_in_its_region_anew_each_episode(t
             offset = np.asarray(env.snap.target_offsets["spot"])
             assert env.manifest.targets["spot"].link == "head"
             assert np.linalg.norm(offset - nose) <= 0.04 + 1e-4
-            spots.append(env.snap.position(env.snap.point({"target": "spot"})).copy())
+            spots.append(env.snap.position(env.snap.point(TargetPoint(target="spot"))).copy())
         assert not np.allclose(spots[0], spots[1]) and not np.allclose(spots[1], spots[2])
         assert np.allclose(spots[0], spots[3])  # same seed, same spot
     finally:

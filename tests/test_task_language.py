@@ -16,6 +16,7 @@ from helpers import compiled_env
 from assistive_compiler.cli import main
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.paths import specs_dir
+from assistive_compiler.references import TargetPoint
 from assistive_compiler.rotation import quat_angle, quat_rotate, vec_angle
 from assistive_compiler.runtime.env import AssistiveEnv
 from assistive_compiler.terms.registry import terms
@@ -51,7 +52,7 @@ def test_itch_is_drawn_on_the_arm_capsules_every_reset(scratch):
     """Facts §2.1: upper arm or forearm with probability ½, distance from the joint U(r, L), azimuth
     U(0, 2π); the point lies on the capsule surface and rides with the limb."""
     snap = scratch.snap
-    itch = snap.point({"target": "itch"})
+    itch = snap.point(TargetPoint(target="itch"))
     links, normals = [], []
     for seed in range(300):
         scratch.reset(seed=seed) if seed == 0 else scratch.reset()
@@ -340,7 +341,7 @@ def test_scripted_tool_turns_no_further_than_needed_to_face_the_itch(scratch):
     from assistive_compiler.policies.scripted import ScriptedPolicy
 
     policy = ScriptedPolicy(scratch)
-    itch = scratch.snap.point({"target": "itch"})
+    itch = scratch.snap.point(TargetPoint(target="itch"))
     within = math.radians(90)
     turned = 0
     for seed in range(12):
@@ -400,7 +401,7 @@ def test_scripted_policy_scratches_an_itch_under_the_forearm(scratch):
 
     policy = ScriptedPolicy(scratch)
     obs, _ = scratch.reset(seed=14)
-    itch = scratch.snap.point({"target": "itch"})
+    itch = scratch.snap.point(TargetPoint(target="itch"))
     assert scratch.snap.normal(itch)[2] < -0.3  # underside
     for _ in range(scratch.manifest.sim.episode_steps):
         obs, _, _, truncated, info = scratch.step(policy(obs))

@@ -6,23 +6,22 @@ with ``snap.point`` / ``snap.joints``, then the snapshot's arrays are written di
 orientations, velocities, frames, actions, particle events), or bodies are placed in pybullet and
 the snapshot refreshed (joint angles, contacts). Contact-force expectations are sums over
 ``pybullet.getContactPoints`` / ``getClosestPoints`` computed here, independently of the terms.
-Terms are called through the registry, ``terms(category)[name].fn(snap, params)``, with params a
-namespace holding the model's defaults plus the handles and values given (the names are checked
-against the term's parameter model).
+Terms are called through the registry, ``terms(category)[name].fn(snap, params)``, with params the
+term's own parameter model validated from its defaults plus the handles and values given.
 """
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pybullet as pb
 import pytest
 
 from assistive_compiler.artifact import TermUse
-from assistive_compiler.runtime.env import bind_term
+from assistive_compiler.references import LinkPoint, PointHandle, TargetPoint
+from assistive_compiler.runtime.binding import bind, bind_params
 from assistive_compiler.runtime.snapshot import ParticleEvents, Snapshot
 from assistive_compiler.terms.registry import terms
 
@@ -56,11 +55,11 @@ def call(category: str, name: str, snap: Snapshot, **given):
     values = {k: f.get_default(call_default_factory=True) for k, f in fields.items() if not f.is_required()}
     values.update(given)
     assert set(values) == set(fields), f"{name}: missing params {set(fields) - set(values)}"
-    return tdef.fn(snap, SimpleNamespace(**values))
+    return tdef.fn(snap, tdef.params.model_validate(values))
 
 
 def point(snap: Snapshot, body: str, link: str):
-    return snap.point({"body": body, "link": link})
+    return snap.point(LinkPoint(body=body, link=link))
 
 
 def contacts(env, a: str, b: str) -> tuple:
@@ -76,9 +75,9 @@ def press_spoon_into_face(env, snap: Snapshot, depth: float = 0.01, steps: int =
     w = env.world
     person = env.snap.handle("person")
     head, mouth, spoon = (
-        env.snap.point({"body": "person", "link": "head"}),
-        env.snap.point({"target": "mouth"}),
-        env.snap.point({"body": "spoon", "link": "spoon"}),
+        env.snap.point(LinkPoint(body="person", link="head")),
+        env.snap.point(TargetPoint(target="mouth")),
+        env.snap.point(LinkPoint(body="spoon", link="spoon")),
     )
     hp, mp, sp = (np.array(env.snap.position(h), dtype=float) for h in (head, mouth, spoon))
     inward = (hp - mp) / np.linalg.norm(hp - mp)
@@ -155,7 +154,7 @@ def test_joint_angles_with_and_without_wrap(env, snap):
     for name, q, lo, hi in zip(m.robot.arm_joints, raw, m.robot.joint_lower, m.robot.joint_upper):
         assert lo <= q <= hi
         pb.resetJointState(w.robot.id, w.robot.joints[name], q, physicsClientId=w.client)
-    arm = snap.joints({"body": "robot", "joints": m.robot.arm_joints})
+    arm = snap.joints(m.joint_groups["robot.arm"])
     snap.refresh()
     np.testing.assert_allclose(call("observation", "joint_angles", snap, joints=arm, wrap=False), raw, atol=1e-12)
     wrapped = [-math.pi / 2, 4.0 - 2 * math.pi, math.pi / 2, 1.0, 5.0 - 2 * math.pi, 2.0, 0.25]
@@ -187,7 +186,7 @@ def test_contact_force_observation_and_reward(env, snap):
 
 def test_distance_between_points_and_to_a_target(snap):
     a, b = point(snap, "spoon", "spoon"), point(snap, "person", "head")
-    mouth = snap.point({"target": "mouth"})
+    mouth = snap.point(TargetPoint(target="mouth"))
     snap.pos[a.slot] = (1.0, 2.0, 3.0)
     snap.pos[b.slot] = (4.0, 6.0, 3.0)
     assert call("reward", "distance", snap, a=a, b=b) == pytest.approx(5.0, abs=1e-12)
@@ -323,7 +322,7 @@ def test_pressure(env, snap):
 
 def test_target_offset_on_a_rotated_link(snap):
     head = point(snap, "person", "head")
-    mouth = snap.point({"target": "mouth"})
+    mouth = snap.point(TargetPoint(target="mouth"))
     assert mouth.slot == head.slot  # a target reads its link
     snap.target_offsets["mouth"] = np.array(MOUTH_OFFSET)
     snap.pos[head.slot] = (1.0, 2.0, 3.0)
@@ -341,7 +340,7 @@ def test_target_offset_follows_the_person_variant(env):
     """After reset the env's mouth is the drawn variant's offset on its real head pose."""
     expected = {v.name: v.target_offsets["mouth"] for v in env.manifest.person.variants}
     assert expected == {"male_50th": (0.0, -0.11, 0.03), "female_50th": (0.0, -0.1, 0.03)}
-    mouth = env.snap.point({"target": "mouth"})
+    mouth = env.snap.point(TargetPoint(target="mouth"))
     seen = set()
     for seed in range(20):
         _, info = env.reset(seed=seed)
@@ -364,7 +363,7 @@ def test_target_offset_follows_the_person_variant(env):
 # binding, and the whole reward
 
 
-def test_bind_term_replaces_references_with_handles(snap):
+def test_bind_replaces_references_with_handles(snap):
     use = TermUse(
         name="d",
         term="distance",
@@ -372,7 +371,7 @@ def test_bind_term_replaces_references_with_handles(snap):
         weight=-1.0,
         params={"a": {"body": "spoon", "link": "spoon"}, "b": {"body": "person", "link": "head"}},
     )
-    fn = bind_term(use, snap)
+    fn = bind(use, snap)
     a, b = point(snap, "spoon", "spoon"), point(snap, "person", "head")  # the same slots
     snap.pos[a.slot] = (0.0, 0.0, 0.0)
     snap.pos[b.slot] = (0.0, 3.0, 4.0)
@@ -384,10 +383,43 @@ def test_bind_term_replaces_references_with_handles(snap):
         weight=0.25,
         params={"of": [{"body": "spoon", "link": "spoon"}, {"body": "person", "link": "head"}]},
     )
-    fn = bind_term(use, snap)
+    fn = bind(use, snap)
     snap.vel[a.slot] = (0.0, 3.0, 0.0)
     snap.vel[b.slot] = (4.0, 0.0, 0.0)
     assert fn(snap) == pytest.approx(-7.0, abs=1e-12)
+
+
+def test_a_term_receives_its_own_parameter_model_validated_with_handles(snap):
+    use = TermUse(
+        name="d",
+        term="negative_distance_sum",
+        category="reward",
+        weight=1.0,
+        params={"a": [{"target": "mouth"}], "b": [{"body": "spoon", "link": "spoon"}]},
+    )
+    params = bind_params(use, snap)
+    model = terms("reward")["negative_distance_sum"].params
+    assert type(params) is model
+    assert params.a == [PointHandle(snap.point(TargetPoint(target="mouth")).slot, "mouth")]
+    assert params.b == [point(snap, "spoon", "spoon")]
+    unpaired = TermUse(**(use.model_dump() | {"params": {"a": [{"target": "mouth"}], "b": [{"target": "mouth"}] * 2}}))
+    with pytest.raises(ValueError, match="a and b must pair up: a has 1 points, b has 2"):
+        bind_params(unpaired, snap)  # the model's own validators run on the bound values too
+
+
+def test_a_term_with_memory_gets_an_instance_per_binding_and_is_reset(snap):
+    use = TermUse(
+        name="s",
+        term="contact_events",
+        category="reward",
+        weight=1.0,
+        params={"tool": ["spoon"], "onto": ["person"], "target": {"target": "mouth"}},
+    )
+    first, second = bind(use, snap), bind(use, snap)
+    first.instance.last = (0.0, 0.0, 0.0)
+    assert second.instance.last is None
+    first.reset()
+    assert first.instance.last is None
 
 
 def test_reward_is_the_weighted_sum_on_a_constructed_state(env):
@@ -396,8 +428,8 @@ def test_reward_is_the_weighted_sum_on_a_constructed_state(env):
     # nothing touches the person after a reset
     for body in ("robot", "spoon"):
         assert not contacts(env, body, "person")
-    spoon = snap.point({"body": "spoon", "link": "spoon"})
-    head = snap.point({"body": "person", "link": "head"})
+    spoon = snap.point(LinkPoint(body="spoon", link="spoon"))
+    head = snap.point(LinkPoint(body="person", link="head"))
     snap.refresh()
     snap.pos[spoon.slot] = (0.0, 0.0, 1.0)
     snap.target_offsets["mouth"] = np.array(MOUTH_OFFSET)

@@ -33,10 +33,11 @@ from ..artifact import (
 )
 from ..paths import display
 from ..person.surface import SURFACE_TARGET_SPACING_M, link_surface
+from ..references import JointGroup
 from ..resolve import ResolvedTask
 from ..resolve.bodies import surface_region
 from ..spec.models import scalar_bounds
-from ..terms.registry import SizeContext, terms
+from ..terms.registry import SizeContext, spec_form, terms
 from ..urdf import urdf_info
 from .task import impairment_joints, policy_joints, rounded
 from .weld import gripper
@@ -89,7 +90,7 @@ def build_manifest(
             for name, ms in rt.markers.items()
         ],
         joint_groups=rt.joint_groups
-        | {"person.policy": {"body": "person", "group": "policy", "joints": policy_joints(rt)}},
+        | {"person.policy": JointGroup(body="person", group="policy", joints=tuple(policy_joints(rt)))},
         observations={agent: [_observation_use(rt, t) for t in ts] for agent, ts in rt.observations.items()},
         reward=[
             TermUse(name=t.name, term=t.term, category=t.category, weight=t.weight, params=t.params) for t in rt.reward
@@ -126,7 +127,7 @@ def _person(rt: ResolvedTask, variants: list[PersonVariant]) -> Person:
     compliant_joints = []
     if compliant:
         for ref in compliant.joints:
-            compliant_joints += rt.joint_groups[ref]["joints"]
+            compliant_joints += rt.joint_groups[ref].joints
     return Person(
         variants=variants,
         policy_joints=policy_joints(rt),
@@ -205,20 +206,10 @@ def _targets(rt: ResolvedTask) -> dict[str, Target]:
 
 def _observation_use(rt: ResolvedTask, t) -> TermUse:
     """An observation term with its size (a joint group's size from the task's joint groups)."""
-    sizes = {name: len(g["joints"]) for name, g in rt.joint_groups.items()} | {"person.policy": len(policy_joints(rt))}
+    sizes = {name: len(g.joints) for name, g in rt.joint_groups.items()} | {"person.policy": len(policy_joints(rt))}
     tdef = terms("observation")[t.term]
-    raw = {
-        k: (v["group"] if isinstance(v, dict) and "group" in v and "joints" in v else v) for k, v in t.params.items()
-    }
-    size_params = tdef.params.model_construct(
-        **{
-            k: (
-                f"{t.params[k]['body']}.{t.params[k]['group']}"
-                if isinstance(t.params[k], dict) and "joints" in t.params[k]
-                else v
-            )
-            for k, v in raw.items()
-        }
+    size_params = spec_form(tdef.params).model_construct(
+        **{k: (v.name if isinstance(v, JointGroup) else v) for k, v in t.params.items()}
     )
     return TermUse(
         name=t.name,

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..errors import Problem, SpecError
 from ..paths import display
+from ..references import JointGroup, LinkPoint
 from ..resolve import ResolvedTask
 from ..spec.load import LoadedSpec
 
@@ -61,7 +62,7 @@ def group_joints(rt: ResolvedTask, refs) -> list[str]:
     """The person joints of joint-group references (``person.policy`` included), in order, once each."""
     out: list[str] = []
     for ref in refs:
-        group = policy_joints(rt) if ref == "person.policy" else rt.joint_groups[ref]["joints"]
+        group = policy_joints(rt) if ref == "person.policy" else rt.joint_groups[ref].joints
         out += [j for j in group if j not in out]
     return out
 
@@ -82,8 +83,8 @@ def observed_person_joints(rt: ResolvedTask) -> set[str]:
     out: set[str] = set()
     for term in [t for ts in rt.observations.values() for t in ts] + list(rt.reward):
         for value in term.params.values():
-            if isinstance(value, dict) and value.get("body") == "person" and "joints" in value:
-                out |= set(value["joints"])
+            if isinstance(value, JointGroup) and value.body == "person":
+                out |= set(value.joints)
     return out
 
 
@@ -92,6 +93,8 @@ def referenced_person_links(rt: ResolvedTask) -> set[str]:
     found: set[str] = set()
 
     def visit(value: Any) -> None:
+        if isinstance(value, LinkPoint):
+            value = value.model_dump()
         if isinstance(value, dict):
             if value.get("body") == "person" and "link" in value:
                 found.add(value["link"])

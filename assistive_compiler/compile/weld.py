@@ -80,7 +80,7 @@ def robot_welds(rt: ResolvedTask, urdf_xml: str) -> dict[str, float]:
     welded (made fixed joints) in the artifact's URDF: Bullet builds a motor row for every moving
     joint every physics step, and each row costs in proportion to the robot's joint count, so a
     Jaco's six finger joints cost about a seventh of a Scratch Itch step while holding still."""
-    driven = set(rt.joint_groups["robot.arm"]["joints"])
+    driven = set(rt.joint_groups["robot.arm"].joints)
     part = rt.robot.part
     for side in rt.sides:  # joints moved with an arm joint (Stretch's telescoping tubes)
         driven |= set(part.arm_for(side)[1].follow)

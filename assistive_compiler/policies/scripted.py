@@ -26,6 +26,7 @@ import numpy as np
 import pybullet as pb
 
 from ..ik_options import ik_damping, ik_limits
+from ..references import LinkPoint, point_of
 from ..rotation import quat_about, quat_conj, quat_mul, quat_rotate, quat_towards, vec_angle
 
 STALL_STEPS = 10  # steps without getting STALL_GAIN_M closer before moving on to the next waypoint
@@ -41,10 +42,10 @@ class _Track:
 
     def __init__(self, env, section: dict, mount_link: str, joints: list[str]):
         snap, m = env.snap, env.manifest
-        self.move = snap.point(section["move"])
+        self.move = snap.point(point_of(section["move"]))
         self.waypoints = [
             (
-                snap.point(w["to"]),
+                snap.point(point_of(w["to"])),
                 np.asarray(w["offset_m"]),
                 w["tolerance_m"],
                 w.get("normal_offset_m", 0.0),
@@ -62,7 +63,7 @@ class _Track:
         self.repeat_from = section.get("repeat_from")
         robot = env.world.robot
         self.ee_link = robot.links[mount_link]
-        self.ee_point = snap.point({"body": "robot", "link": mount_link})
+        self.ee_point = snap.point(LinkPoint(body="robot", link=mount_link))
         order = list(m.robot.arm_joints)
         self.action_cols = [
             order.index(j) for j in joints
@@ -89,8 +90,10 @@ class ScriptedPolicy:
         links = m.robot.links
         if m.scripted.get("left") is not None:
             self.tracks = [
-                _Track(env, m.scripted, links["right_tool_mount"], m.joint_groups["robot.right_arm"]["joints"]),
-                _Track(env, m.scripted["left"], links["left_tool_mount"], m.joint_groups["robot.left_arm"]["joints"]),
+                _Track(env, m.scripted, links["right_tool_mount"], list(m.joint_groups["robot.right_arm"].joints)),
+                _Track(
+                    env, m.scripted["left"], links["left_tool_mount"], list(m.joint_groups["robot.left_arm"].joints)
+                ),
             ]
         else:
             self.tracks = [_Track(env, m.scripted, links["tool_mount"], list(m.robot.arm_joints))]

@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pybullet as pb
 
+from ..references import PointHandle
 from ..rotation import quat_rotate
-from ..runtime.snapshot import PointHandle
 
 
 class SceneReader:

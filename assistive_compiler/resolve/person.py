@@ -55,12 +55,12 @@ def _check_control(s: Scope) -> None:
     for i, ref in enumerate(person.control.policy_joints):
         group = s.joints(ref, ("person", "control", "policy_joints", i))
         if group:
-            if group["body"] != "person":
+            if group.body != "person":
                 s.problem(
                     ("person", "control", "policy_joints", i), f"policy_joints must be person joint groups, got '{ref}'"
                 )
             else:
-                s.policy_joints += [j for j in group["joints"] if j not in s.policy_joints]
+                s.policy_joints += [j for j in group.joints if j not in s.policy_joints]
     if person.control.compliant:
         for i, ref in enumerate(person.control.compliant.joints):
             s.joints(ref, ("person", "control", "compliant", "joints", i))
@@ -79,7 +79,7 @@ def _check_settle_stage(s: Scope) -> None:
     base = ("person", "placement", "settle", "then")
     for i, ref in enumerate(stage.dynamic):
         group = s.joints(ref, base + ("dynamic", i))
-        if group and group["body"] != "person":
+        if group and group.body != "person":
             s.problem(base + ("dynamic", i), f"dynamic joints must be person joint groups, got '{ref}'")
     for name, deg in stage.joints_deg.items():
         if name not in movable:

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..library import LoadedPart
+from ..references import JointGroup, ParamValue
 from ..spec.load import LoadedSpec
 from ..spec.models import TaskSpec
 from ..terms.registry import Category
@@ -18,13 +19,13 @@ from ..urdf import UrdfInfo
 
 @dataclass(frozen=True)
 class ResolvedTerm:
-    """A term use with its parameters validated and references normalised (JSON-ready)."""
+    """A term use with its parameters validated and its references resolved to reference models."""
 
     name: str
     term: str
     category: Category
     weight: float
-    params: dict[str, Any]
+    params: dict[str, ParamValue]
 
 
 @dataclass(kw_only=True)
@@ -40,7 +41,7 @@ class ResolvedTask:
     people: dict[str, LoadedPart]
     person_urdf: UrdfInfo
     robot_links: dict[str, str]
-    joint_groups: dict[str, dict[str, Any]]
+    joint_groups: dict[str, JointGroup]
     observations: dict[str, list[ResolvedTerm]]
     reward: list[ResolvedTerm]
     success_threshold: float

@@ -14,6 +14,7 @@ from typing import Any
 
 from ..errors import did_you_mean, one_of
 from ..library import LoadedPart
+from ..references import JointGroup
 from ..spec.models import TaskSpec
 from .located import expected
 from .scope import Scope
@@ -121,24 +122,22 @@ def robot_links(s: Scope) -> dict[str, str]:
     return out
 
 
-def joint_groups(s: Scope) -> dict[str, dict[str, Any]]:
+def joint_groups(s: Scope) -> dict[str, JointGroup]:
     """``robot.arm`` (the acting arms' joints), ``robot.<side>_arm`` and every ``person.<group>``."""
     from ..person.body import JOINT_GROUPS
 
     part = s.robot.part
-    groups: dict[str, dict[str, Any]] = {}
+    groups: dict[str, JointGroup] = {}
     arm_joints: list[str] = []
     for side in acting_sides(s.spec, s.robot):
         arm_joints += part.arm_for(side)[1].joints
-    groups["robot.arm"] = {"body": "robot", "group": "arm", "joints": arm_joints}
+    groups["robot.arm"] = JointGroup(body="robot", group="arm", joints=tuple(arm_joints))
     for side in ("right", "left"):
-        groups[f"robot.{side}_arm"] = {
-            "body": "robot",
-            "group": f"{side}_arm",
-            "joints": list(part.arm_for(side)[1].joints),
-        }
+        groups[f"robot.{side}_arm"] = JointGroup(
+            body="robot", group=f"{side}_arm", joints=tuple(part.arm_for(side)[1].joints)
+        )
     for name, joints in JOINT_GROUPS.items():
-        groups[f"person.{name}"] = {"body": "person", "group": name, "joints": list(joints)}
+        groups[f"person.{name}"] = JointGroup(body="person", group=name, joints=tuple(joints))
     return groups
 
 

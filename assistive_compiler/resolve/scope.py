@@ -5,10 +5,11 @@ names its sections declare, the robot's semantic links and the joint groups, and
 problems (it is a :class:`~.located.Collector`). The section passes fill it in (see
 :func:`assistive_compiler.resolve.resolve` for the order) and ask it to resolve references:
 
-* point → ``{"target": name}`` or ``{"body": body, "link": urdf_link}``
+* point → ``{"target": name}`` or ``{"body": body, "link": urdf_link}`` (a term's parameter: the
+  :class:`~assistive_compiler.references.TargetPoint` / ``LinkPoint`` of the same)
 * body → body name; bodies → list of body names
-* joints → ``{"body": "robot" | "person", "group": name, "joints": [urdf joint names]}``
-* node set → ``{"garment": name, "set": name, "nodes": [node indices]}``
+* joints → :class:`~assistive_compiler.references.JointGroup`
+* node set → :class:`~assistive_compiler.references.NodeSet`
 * particle set, marker set → their name
 """
 
@@ -18,11 +19,19 @@ from typing import Any
 
 from ..errors import SpecError
 from ..library import Library, LoadedPart
+from ..references import JointGroup, NodeSet, Point, point_of
 from ..spec.load import LoadedSpec
 from ..urdf import UrdfInfo
 from .located import Collector, expected
 
 RESERVED_BODIES = ("robot", "person")
+
+
+def as_point(resolved: dict[str, Any] | None) -> Point | None:
+    """A resolved point (``{"target"}`` or ``{"body", "link"}``) as its reference model."""
+    return None if resolved is None else point_of(resolved)
+
+
 GARMENT_HELD_LINK = "held"
 """The one link of a garment body: its held frame (the pose the robot's hand gives it)."""
 ROBOT_SEMANTIC_LINKS = ("base", "end_effector", "tool_mount")
@@ -41,7 +50,7 @@ class Scope(Collector):
     body_names: dict[str, str]
     """Every body name -> the section declaring it ("robot", "person", "tools", "particles", ...)."""
     robot_links: dict[str, str]
-    joint_groups: dict[str, dict[str, Any]]
+    joint_groups: dict[str, JointGroup]
 
     def __init__(self, loaded: LoadedSpec, library: Library, robot_name: str):
         super().__init__(loaded)
@@ -157,17 +166,17 @@ class Scope(Collector):
             out.append(p["link"])
         return out
 
-    def joints(self, value: str, path: tuple) -> dict[str, Any] | None:
+    def joints(self, value: str, path: tuple) -> JointGroup | None:
         if value == "person.policy":
-            return {"body": "person", "group": "policy", "joints": self.policy_joints}
+            return JointGroup(body="person", group="policy", joints=tuple(self.policy_joints))
         if value not in self.joint_groups:
             pool = list(self.joint_groups) + ["person.policy"]
             self.problem(path, f"unknown joint group '{value}'; {expected(pool, value, limit=20)}")
             return None
         return self.joint_groups[value]
 
-    def node_set(self, value: str, path: tuple) -> dict[str, Any] | None:
-        """``<garment>.<set>`` → {"garment", "set", "nodes"} (node indices of the generated mesh)."""
+    def node_set(self, value: str, path: tuple) -> NodeSet | None:
+        """``<garment>.<set>`` → its :class:`NodeSet` (node indices of the generated mesh)."""
         from ..garment import sleeve_node_sets
 
         name, _, set_name = value.partition(".")
@@ -181,7 +190,7 @@ class Scope(Collector):
                 f"unknown node set '{set_name}' of garment '{name}'; {expected(sets, set_name)} (write {name}.<set>)",
             )
             return None
-        return {"garment": name, "set": set_name, "nodes": [int(i) for i in sets[set_name]]}
+        return NodeSet(garment=name, set=set_name, nodes=tuple(int(i) for i in sets[set_name]))
 
     def declared(self, value: str, path: tuple, section: str, what: str) -> str | None:
         """``value`` if the spec's ``section`` (particles, markers, garments) declares it."""
@@ -197,7 +206,7 @@ class Scope(Collector):
     def ref(self, kind: str, value: Any, path: tuple) -> Any:
         """A term parameter's reference of ``kind`` (see terms.registry.ref_fields), resolved."""
         if kind == "point":
-            return self.point(value, path)
+            return as_point(self.point(value, path))
         if kind == "body":
             return self.body(value, path)
         if kind == "bodies":

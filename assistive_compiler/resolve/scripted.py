@@ -92,7 +92,7 @@ def check_segments(s: Scope) -> None:
 def _ik_damping(s: Scope, damping: dict[str, float]) -> dict[str, float]:
     """A robot's own script's IK damping by arm joint name; a problem for a name that is not one of
     the acting arm joints."""
-    arm = s.joint_groups["robot.arm"]["joints"]
+    arm = s.joint_groups["robot.arm"].joints
     for name in damping:
         if name not in arm:
             s.problem(

@@ -17,7 +17,7 @@ from pydantic import ValidationError
 
 from ..spec.models import PAPER_PREFERENCE_WEIGHTS, PREFERENCE_NAMES
 from ..spec.validation import problems_from_validation
-from ..terms.registry import Category, TermDef, ref_fields, terms
+from ..terms.registry import Category, TermDef, ref_fields, spec_form, terms
 from .located import expected
 from .resolved import ResolvedTerm
 from .scope import Scope
@@ -65,11 +65,13 @@ def _term(s: Scope, use: Any, category: Category, path: tuple, name: str, weight
 
 
 def _params(s: Scope, tdef: TermDef, raw: dict[str, Any], path: tuple) -> dict[str, Any] | None:
-    """``raw`` validated by the term's parameter model, its reference fields resolved (None on a problem)."""
+    """``raw`` validated by the spec form of the term's parameter model, its reference fields
+    resolved to reference models (None on a problem)."""
+    written = spec_form(tdef.params)
     try:
-        model = tdef.params.model_validate(raw)
+        model = written.model_validate(raw)
     except ValidationError as exc:
-        s.problems.extend(problems_from_validation(exc, raw, s.loaded.smap, tdef.params, prefix=path))
+        s.problems.extend(problems_from_validation(exc, raw, s.loaded.smap, written, prefix=path))
         return None
     values = model.model_dump()
     before = len(s.problems)

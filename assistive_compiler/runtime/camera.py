@@ -22,6 +22,8 @@ from __future__ import annotations
 import numpy as np
 import pybullet as pb
 
+from ..references import TargetPoint
+
 NEAR_M, FAR_M = 0.02, 10.0
 """Clipping planes of every render, m."""
 TARGET_RADIUS_M = 0.012
@@ -34,7 +36,7 @@ def overlay_spheres(env) -> list[tuple[list[float], float, tuple]]:
     not yet cleared, carried particles."""
     m, snap = env.manifest, env.snap
     spheres = [
-        (snap.position(snap.point({"target": name})).tolist(), TARGET_RADIUS_M, tuple(t.show_rgba))
+        (snap.position(snap.point(TargetPoint(target=name))).tolist(), TARGET_RADIUS_M, tuple(t.show_rgba))
         for name, t in m.targets.items()
         if t.show_rgba is not None
     ]
@@ -106,7 +108,7 @@ def labelled_frames(env) -> list[tuple[str, np.ndarray, np.ndarray | None]]:
             pos, orn = w.link_frame(handle, handle.links[link])
             out.append((f"{tool.body}.{name}", np.asarray(pos), rotation_matrix(orn)))
     for name in m.targets:
-        out.append((name, np.asarray(snap.position(snap.point({"target": name}))), None))
+        out.append((name, np.asarray(snap.position(snap.point(TargetPoint(target=name)))), None))
     return out
 
 

@@ -31,18 +31,16 @@ but can differ in the last digits from a replay.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
-from types import SimpleNamespace
-from typing import Any
 
 import gymnasium as gym
 import numpy as np
 import pybullet as pb
 
 from ..artifact import Manifest, TermUse
+from ..references import LinkPoint
 from ..rotation import capsule_axes
-from ..terms.registry import ref_fields, terms
+from .binding import bind
 from .drive import BaseDriveControl, FollowerControl
 from .human import PersonController, draw_impairment  # noqa: F401  (draw_impairment: re-exported)
 from .markers import MarkerSystem
@@ -51,32 +49,11 @@ from .snapshot import Snapshot
 from .world import PARK, World
 
 
-def bind_term(use: TermUse, snap: Snapshot) -> Callable[[Snapshot], Any]:
-    """The term's function with its references replaced by snapshot handles."""
-    tdef = terms(use.category)[use.term]
-    values = dict(use.params)
-    for fname, (kind, shape) in ref_fields(tdef.params).items():
-        v = values.get(fname)
-        if v is None:
-            continue
-        bind = {"point": snap.point, "joints": snap.joints, "nodes": snap.nodes}.get(kind.kind)
-        if bind is not None:
-            values[fname] = [bind(x) for x in v] if shape == "list" else bind(v)
-    params = SimpleNamespace(**values)
-    if isinstance(tdef.fn, type):  # a term with memory: one instance per env, reset every episode
-        instance = tdef.fn()
-        bound = lambda s: instance(s, params)  # noqa: E731
-        bound.reset = instance.reset  # type: ignore[attr-defined]
-        return bound
-    fn = tdef.fn
-    return lambda s: fn(s, params)
-
-
 class Features:
     """One agent's observation: its bound features concatenated into a float32 vector."""
 
     def __init__(self, uses: list[TermUse], snap: Snapshot):
-        self.fns = [bind_term(t, snap) for t in uses]
+        self.fns = [bind(t, snap) for t in uses]
         bounds = np.cumsum([0] + [t.size for t in uses])
         self.slices = [slice(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
         self.space = gym.spaces.Box(-np.inf, np.inf, (int(bounds[-1]),), np.float32)
@@ -163,11 +140,11 @@ class AssistiveEnv(gym.Env):
         )
 
         self.robot_features = Features(m.observations["robot"], self.snap)
-        self.reward_fns = [(t.name, t.weight, bind_term(t, self.snap)) for t in m.reward]
-        self._term_resets = [fn.reset for _, _, fn in self.reward_fns if hasattr(fn, "reset")]
+        self.reward_fns = [(t.name, t.weight, bind(t, self.snap)) for t in m.reward]
+        self._term_resets = [fn.reset for _, _, fn in self.reward_fns]
         self.markers = MarkerSystem(self.world, self.snap)
         self.success_threshold = m.success.threshold
-        self.tool_point = self.snap.point({"body": "robot", "link": m.robot.links["tool_mount"]})
+        self.tool_point = self.snap.point(LinkPoint(body="robot", link=m.robot.links["tool_mount"]))
         self._force_on_person = (
             [b.name for b in m.bodies if b.kind in ("robot", "tool")] + [g.name for g in m.garments],
             ["person"],

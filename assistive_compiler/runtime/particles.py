@@ -47,8 +47,9 @@ import numpy as np
 import pybullet as pb
 
 from ..artifact import Container, ParticleSet
+from ..references import PointHandle, TargetPoint
 from ..rotation import vec_angle
-from .snapshot import ParticleEvents, PointHandle, Snapshot
+from .snapshot import ParticleEvents, Snapshot
 from .world import PARK, World, rotation_matrix
 
 _AXIS = np.array([0.0, 0.0, 1.0])  # a container's axis in its frame, towards its opening
@@ -62,7 +63,7 @@ class ParticleSystem:
         self.snap = snap
         self.sets: list[tuple[ParticleSet, list[int], PointHandle | None]] = []
         for ps in world.m.particles:
-            target = snap.point({"target": ps.consumed_target}) if ps.consumed_target else None
+            target = snap.point(TargetPoint(target=ps.consumed_target)) if ps.consumed_target else None
             self.sets.append((ps, world.particles[ps.name], target))
         self.active: dict[str, np.ndarray] = {}
         self.hit: dict[str, np.ndarray] = {}

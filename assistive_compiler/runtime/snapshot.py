@@ -11,40 +11,23 @@ Units: metres, m/s, newtons; quaternions (x, y, z, w); world frame unless a meth
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 import pybullet as pb
 
+from ..references import JointGroup, JointsHandle, NodeSet, NodesHandle, Point, PointHandle, TargetPoint
 from ..rotation import quat_conj, quat_mul, quat_rotate  # noqa: F401  (re-exported)
-from .world import World, rotation_matrix
+from .world import BodyHandle, World, rotation_matrix
+
+ContactPoint = tuple[Any, ...]
+"""One of pybullet's contact points (getContactPoints: [5] position on A, [9] normal force, ...)."""
 
 CLOSEST_SLACK_M = (
     0.05  # closest_distance first looks this far beyond its last answer (m); any value gives the same result
 )
-
-
-@dataclass(frozen=True)
-class PointHandle:
-    """A point: link slot plus an offset in the link frame (targets; per person variant)."""
-
-    slot: int
-    target: str | None = None
-
-
-@dataclass(frozen=True)
-class JointsHandle:
-    body: str  # 'robot' or 'person'
-    indices: tuple[int, ...]
-
-
-@dataclass(frozen=True)
-class NodesHandle:
-    """A garment's node set: the garment's index in ``world.garments`` and the node indices."""
-
-    garment: int
-    indices: tuple[int, ...]
 
 
 @dataclass
@@ -77,15 +60,16 @@ class Snapshot:
         self.target_axes: dict[str, np.ndarray] = {}  # limb axes away from the joint (link frame)
         self.actions: dict[str, np.ndarray] = {"robot": np.zeros(0), "human": np.zeros(0)}
         self.events: dict[str, Any] = {}  # per particle set: ParticleEvents; per marker set: markers cleared (int)
-        self._contacts: dict[tuple[int, int], tuple] = {}
-        self._pooled: dict[tuple, list] = {}  # contacts(a, b) this step, per (a, b)
+        self._contacts: dict[tuple[int, int], tuple[ContactPoint, ...]] = {}
+        self._pooled: dict[
+            tuple[tuple[str, ...], tuple[str, ...]], list[ContactPoint]
+        ] = {}  # contacts(a, b) this step, per (a, b)
         self._joint_cache: dict[JointsHandle, np.ndarray] = {}
         self.pos, self.orn, self.vel = np.zeros((0, 3)), np.zeros((0, 4)), np.zeros((0, 3))
         self.frames: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self._ids: dict[tuple[str, ...], tuple[int, ...]] = {}
-        self._closest_hint: dict[
-            tuple, float
-        ] = {}  # last closest_distance per (body, bodies): where the next query starts
+        # last closest_distance per (body, bodies): where the next query starts
+        self._closest_hint: dict[tuple[str, tuple[int, ...]], float] = {}
         self._garment_nodes: dict[int, np.ndarray] = {}
         # pybullet reports a soft body's contact forces of its last solver sub-step only: scale them
         # back to the physics step (docs/dressing-study.md: then Σ|f_n| ≈ the weight it rests on).
@@ -97,23 +81,30 @@ class Snapshot:
         """'person' stands for the active variant; other names are bodies of the manifest."""
         return "person" if name == "person" or name.startswith("person_") else name
 
-    def handle(self, name: str):
+    def handle(self, name: str) -> BodyHandle:
         w = self.world
         if name == "person":
             return w.variant_bodies[w.active_variant.name]
         return w.bodies[name]
 
-    def point(self, ref: dict) -> PointHandle:
-        """Bind a normalised point reference ({target} or {body, link})."""
-        if "target" in ref:
-            t = self.world.m.targets[ref["target"]]
+    def point(self, ref: Point) -> PointHandle:
+        """Bind a point reference (a target, or a body's link)."""
+        if isinstance(ref, TargetPoint):
+            t = self.world.m.targets[ref.target]
             slot = self._slot(t.body, t.link)
-            self.target_offsets.setdefault(ref["target"], np.asarray(t.offset, dtype=float))
-            self.target_slots.setdefault(ref["target"], slot)
-            return PointHandle(slot, ref["target"])
-        return PointHandle(self._slot(ref["body"], ref["link"]))
+            self.target_offsets.setdefault(ref.target, np.asarray(t.offset, dtype=float))
+            self.target_slots.setdefault(ref.target, slot)
+            return PointHandle(slot, ref.target)
+        return PointHandle(self._slot(ref.body, ref.link))
 
-    def place_target(self, name: str, link_name: str, offset, normal=None, axis=None) -> None:
+    def place_target(
+        self,
+        name: str,
+        link_name: str,
+        offset: Sequence[float] | np.ndarray,
+        normal: Sequence[float] | np.ndarray | None = None,
+        axis: Sequence[float] | np.ndarray | None = None,
+    ) -> None:
         """Put target ``name`` on person link ``link_name`` at ``offset`` (link frame, m) for this
         episode, with an outward surface ``normal`` and the limb ``axis`` (link frame, unit) when
         it lies on a limb's surface."""
@@ -146,10 +137,10 @@ class Snapshot:
             self.vel = np.vstack([self.vel, np.zeros((1, 3))])
         return self._slots[(key, link)]
 
-    def nodes(self, ref: dict) -> NodesHandle:
-        """Bind a normalised node-set reference ({garment, set, nodes})."""
+    def nodes(self, ref: NodeSet) -> NodesHandle:
+        """Bind a garment's node set."""
         names = [g.name for g in self.world.garments]
-        return NodesHandle(names.index(ref["garment"]), tuple(int(i) for i in ref["nodes"]))
+        return NodesHandle(names.index(ref.garment), ref.nodes)
 
     def node_positions(self, h: NodesHandle) -> np.ndarray:
         """(k, 3) positions of a node set this step, world frame, m (one mesh read per garment per step)."""
@@ -158,10 +149,10 @@ class Snapshot:
             x = self._garment_nodes[h.garment] = self.world.garment_nodes(self.world.garments[h.garment])
         return x[list(h.indices)]
 
-    def joints(self, ref: dict) -> JointsHandle:
-        body = ref["body"]
-        h = self.handle(body)
-        return JointsHandle(body, tuple(h.joints[j] for j in ref["joints"]))
+    def joints(self, ref: JointGroup) -> JointsHandle:
+        """Bind a joint group (its joints' pybullet indices)."""
+        h = self.handle(ref.body)
+        return JointsHandle(ref.body, tuple(h.joints[j] for j in ref.joints))
 
     # -- per step -----------------------------------------------------------------------------
     def refresh(self) -> None:
@@ -188,7 +179,7 @@ class Snapshot:
         self._joint_cache.clear()
         self._garment_nodes.clear()
 
-    def set_frame(self, name: str, pos, orn) -> None:
+    def set_frame(self, name: str, pos: Sequence[float], orn: Sequence[float]) -> None:
         """Fix an observation frame for the episode (the robot's and the person's bases do not move)."""
         rot = rotation_matrix(orn)
         self.frames[name] = (np.asarray(pos, dtype=float), np.asarray(orn, dtype=float), rot.T)
@@ -249,13 +240,13 @@ class Snapshot:
     def particle_events(self, name: str) -> ParticleEvents:
         return self.events[name]
 
-    def _contact_points(self, a: int, b: int) -> tuple:
+    def _contact_points(self, a: int, b: int) -> tuple[ContactPoint, ...]:
         key = (a, b)
         if key not in self._contacts:
             self._contacts[key] = pb.getContactPoints(bodyA=a, bodyB=b, physicsClientId=self.world.client)
         return self._contacts[key]
 
-    def body_ids(self, names) -> tuple[int, ...]:
+    def body_ids(self, names: Sequence[str]) -> tuple[int, ...]:
         """pybullet ids of named bodies ('person' = the active variant), cached for the episode."""
         key = tuple(names)
         ids = self._ids.get(key)
@@ -269,7 +260,7 @@ class Snapshot:
         self._pooled.clear()
         self._closest_hint.clear()
 
-    def contacts(self, a, b) -> list:
+    def contacts(self, a: Sequence[str], b: Sequence[str]) -> list[ContactPoint]:
         """pybullet contact points between any body of ``a`` (as bodyA) and any of ``b`` this step
         (a list shared by the step's callers: do not modify it)."""
         key = (tuple(a), tuple(b))
@@ -282,7 +273,7 @@ class Snapshot:
             self._pooled[key] = out
         return out
 
-    def closest_distance(self, a: str, b, max_distance: float) -> float:
+    def closest_distance(self, a: str, b: Sequence[str], max_distance: float) -> float:
         """Smallest surface distance between body ``a`` and any body of ``b`` within ``max_distance`` (m).
 
         Asked first within the last answer for the same bodies plus ``CLOSEST_SLACK_M`` (most link
@@ -304,7 +295,7 @@ class Snapshot:
         self._closest_hint[key] = best
         return best
 
-    def _closest(self, ia: int, ids, reach: float) -> float | None:
+    def _closest(self, ia: int, ids: tuple[int, ...], reach: float) -> float | None:
         """Smallest distance (m) of the closest points of body ``ia`` and bodies ``ids`` within ``reach``; None if none."""
         client, best = self.world.client, None
         for ib in ids:
@@ -314,7 +305,9 @@ class Snapshot:
                 best = d if best is None or d < best else best
         return best
 
-    def contact_force(self, a, b, near: PointHandle | None = None, radius: float = 0.0) -> float:
+    def contact_force(
+        self, a: Sequence[str], b: Sequence[str], near: PointHandle | None = None, radius: float = 0.0
+    ) -> float:
         """Σ normal force (N) of contacts between any body of ``a`` and any of ``b``; with ``near``,
         only contacts whose point on ``a`` lies within ``radius`` of that point."""
         total = 0.0
@@ -325,7 +318,7 @@ class Snapshot:
                 total += cp[9] * (scale.get(cp[1]) or scale.get(cp[2]) or 1.0)
         return total
 
-    def contact_force_and_count(self, a: str, b, distance: float) -> tuple[float, int]:
+    def contact_force_and_count(self, a: str, b: Sequence[str], distance: float) -> tuple[float, int]:
         """Contact force of body ``a`` on ``b`` (N) and the number of closest points within ``distance``."""
         ia = self.body_ids([a])[0]
         count = sum(

@@ -4,9 +4,14 @@ newtons. ``frame`` expresses a feature in the world, the robot's base frame or t
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 
 from .registry import BodiesRef, FrameRef, JointsRef, Params, PointRef, SizeContext, term
+
+if TYPE_CHECKING:
+    from ..runtime.snapshot import Snapshot
 
 
 class PointInFrame(Params):
@@ -31,29 +36,30 @@ class ContactForce(Params):
 
 
 @term("position", "observation", PointInFrame, size=3)
-def position(snap, p) -> np.ndarray:
+def position(snap: Snapshot, p: PointInFrame) -> np.ndarray:
     """Position of a point in ``frame`` (m)."""
     return snap.point_in_frame(p.frame, snap.position(p.of))
 
 
 @term("orientation", "observation", PointInFrame, size=4)
-def orientation(snap, p) -> np.ndarray:
+def orientation(snap: Snapshot, p: PointInFrame) -> np.ndarray:
     """Orientation of a point's link in ``frame`` as a quaternion (x, y, z, w)."""
     return snap.quat_in_frame(p.frame, snap.orientation(p.of))
 
 
 @term("displacement", "observation", Displacement, size=3)
-def displacement(snap, p) -> np.ndarray:
+def displacement(snap: Snapshot, p: Displacement) -> np.ndarray:
     """Vector from ``to`` to ``of`` (``of − to``), rotated into ``frame`` (m)."""
     return snap.vector_in_frame(p.frame, snap.position(p.of) - snap.position(p.to))
 
 
-def _joint_size(p: JointAngles, ctx: SizeContext) -> int:
+def _joint_size(p: Any, ctx: SizeContext) -> int:
+    """The group's size; ``p`` is the parameters as the spec writes them (``joints``: the group's name)."""
     return ctx.joint_group_sizes[p.joints]
 
 
 @term("joint_angles", "observation", JointAngles, size=_joint_size)
-def joint_angles(snap, p) -> np.ndarray:
+def joint_angles(snap: Snapshot, p: JointAngles) -> np.ndarray:
     """Joint angles of a group (rad); wrapped to [−π, π] when ``wrap`` (the robot's, as in the paper)."""
     q = snap.joint_angles(p.joints)
     if p.wrap:
@@ -62,6 +68,6 @@ def joint_angles(snap, p) -> np.ndarray:
 
 
 @term("contact_force", "observation", ContactForce, size=1)
-def contact_force_obs(snap, p) -> np.ndarray:
+def contact_force_obs(snap: Snapshot, p: ContactForce) -> np.ndarray:
     """Sum of contact normal forces between bodies ``a`` and ``b`` this step (N)."""
     return np.array([snap.contact_force(p.a, p.b)])

@@ -1,23 +1,29 @@
 """The term registry: reward terms, observation features and preference costs by name.
 
-A term is a small documented function of the per-step :class:`~assistive_compiler.runtime.snapshot.Snapshot`
-plus parameters. Its parameters are a strict pydantic model; fields annotated with a reference kind
-(:data:`PointRef`, :data:`BodyRef`, :data:`JointsRef`, :data:`ParticlesRef`, :data:`FrameRef`,
-:data:`BodiesRef`) name things in the spec. The resolver checks those names at validation time;
-the runtime replaces them with handles once, when the env is built, so a step only indexes arrays.
+A term is a small documented function ``fn(snap: Snapshot, p: ItsParams)`` of the per-step
+:class:`~assistive_compiler.runtime.snapshot.Snapshot` and its parameters. Its parameters are a
+strict pydantic model; fields annotated with a reference kind (:data:`PointRef`, :data:`BodyRef`,
+:data:`JointsRef`, :data:`ParticlesRef`, :data:`FrameRef`, :data:`BodiesRef`, ...) refer to things
+of the task. The model declares what the term *receives*: the handles the runtime binds the
+references to (:mod:`assistive_compiler.references`). What a spec *writes* is the model's
+:func:`spec_form`: the same fields with those references as names, validated by the resolver
+(which then resolves each name to a reference model for the manifest).
 
 Importing this module (and the term modules) is cheap: numpy and pydantic only.
 """
 
 from __future__ import annotations
 
+import functools
 import types
 import typing
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict
+from pydantic import BaseModel, ConfigDict, create_model
+
+from ..references import JointsHandle, NodesHandle, PointHandle
 
 
 @dataclass(frozen=True)
@@ -27,20 +33,23 @@ class RefKind:
     kind: Literal["point", "body", "bodies", "joints", "particles", "markers", "frame", "nodes"]
 
 
-PointRef = Annotated[str, RefKind("point")]
-"""A point: a target name, ``body`` (its reference link) or ``body.link``."""
+PointRef = Annotated[PointHandle, RefKind("point")]
+"""A point: a target name, ``body`` (its reference link) or ``body.link`` in the spec."""
 BodyRef = Annotated[str, RefKind("body")]
 """A body: robot, person, a tool, a furniture piece or a particle set."""
 BodiesRef = Annotated[list[str], RefKind("bodies")]
 """Several bodies whose contacts are pooled, e.g. [robot, spoon]."""
-JointsRef = Annotated[str, RefKind("joints")]
-"""A joint group: ``robot.arm`` or ``person.<group>``."""
+JointsRef = Annotated[JointsHandle, RefKind("joints")]
+"""A joint group: ``robot.arm`` or ``person.<group>`` in the spec."""
 ParticlesRef = Annotated[str, RefKind("particles")]
 """A particle set name."""
 MarkersRef = Annotated[str, RefKind("markers")]
 """A marker set name."""
-NodesRef = Annotated[str, RefKind("nodes")]
-"""A garment's node set: ``<garment>.<set>`` (e.g. ``sleeve.opening``)."""
+NodesRef = Annotated[NodesHandle, RefKind("nodes")]
+"""A garment's node set: ``<garment>.<set>`` (e.g. ``sleeve.opening``) in the spec."""
+
+BOUND_KINDS = ("point", "joints", "nodes")
+"""Reference kinds the runtime binds to handles; the others (bodies, sets, frames) stay names."""
 FrameRef = Annotated[Literal["world", "robot_base", "person_base"], RefKind("frame")]
 """An observation frame: the world, the robot's base or the person's base (chest)."""
 
@@ -126,6 +135,28 @@ def ref_fields(params: type[Params]) -> dict[str, tuple[RefKind, str]]:
         if found is not None:
             out[fname] = found
     return out
+
+
+@functools.cache
+def spec_form(params: type[Params]) -> type[Params]:
+    """``params`` as a spec writes it: every reference the runtime binds (point, joints, nodes) as
+    a name (``str``; a list of names; a name or null), the fields' constraints, descriptions and
+    the model's validators kept. The resolver validates a spec's ``params`` with it."""
+    overrides: dict[str, Any] = {}
+    for fname, (kind, shape) in ref_fields(params).items():
+        if kind.kind not in BOUND_KINDS:
+            continue
+        name = Annotated[str, kind]
+        annotation = {"one": name, "list": list[name], "optional": name | None}[shape]
+        field = params.model_fields[fname]
+        info = type(field).merge_field_infos(field, annotation=annotation)
+        info.metadata = [m for m in info.metadata if not isinstance(m, RefKind)]
+        overrides[fname] = (annotation, info)
+    if not overrides:
+        return params
+    model: type[Params] = create_model(params.__name__, __base__=params, __module__=params.__module__, **overrides)
+    model.__doc__ = params.__doc__
+    return model
 
 
 def _ref_inside(annotation: Any) -> tuple[RefKind, str] | None:

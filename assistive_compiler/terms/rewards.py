@@ -5,12 +5,15 @@ sign and scale (e.g. a distance in metres with weight −1 penalises distance). 
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 from pydantic import Field, model_validator
 
 from ..rotation import quat_rotate, vec_angle
 from .registry import BodiesRef, BodyRef, MarkersRef, NodesRef, Params, ParticlesRef, PointRef, term
+
+if TYPE_CHECKING:
+    from ..runtime.snapshot import Snapshot
 
 
 class Distance(Params):
@@ -43,7 +46,7 @@ class ContactForce(Params):
 
 
 @term("distance", "reward", Distance)
-def distance(snap, p) -> float:
+def distance(snap: Snapshot, p: Distance) -> float:
     """Euclidean distance between two points (m)."""
     return math.dist(
         snap.position(p.a).tolist(), snap.position(p.b).tolist()
@@ -51,7 +54,7 @@ def distance(snap, p) -> float:
 
 
 @term("negative_distance_sum", "reward", DistanceSum)
-def negative_distance_sum(snap, p) -> float:
+def negative_distance_sum(snap: Snapshot, p: DistanceSum) -> float:
     """−Σᵢ ‖aᵢ − bᵢ‖ over paired points (m; 0 when every pair coincides), e.g. the reference's arm
     manipulation r_h = −‖p_elbow − p_stomach‖ − ‖p_wrist − p_waist‖: a value whose running max a
     success threshold can bound."""
@@ -59,25 +62,25 @@ def negative_distance_sum(snap, p) -> float:
 
 
 @term("action_norm", "reward", ActionNorm)
-def action_norm(snap, p) -> float:
+def action_norm(snap: Snapshot, p: ActionNorm) -> float:
     """‖a‖₂ of the raw (unclipped) action of ``agent`` — the paper's action penalty input."""
     return math.hypot(*snap.action(p.agent).tolist())
 
 
 @term("particles_consumed", "reward", ParticleSet)
-def particles_consumed(snap, p) -> float:
+def particles_consumed(snap: Snapshot, p: ParticleSet) -> float:
     """Particles of the set consumed this step (count), e.g. food that entered the mouth."""
     return float(snap.particle_events(p.particles).consumed)
 
 
 @term("particles_lost", "reward", ParticleSet)
-def particles_lost(snap, p) -> float:
+def particles_lost(snap: Snapshot, p: ParticleSet) -> float:
     """Particles of the set lost this step (count), e.g. food spilled from the spoon."""
     return float(snap.particle_events(p.particles).lost)
 
 
 @term("contact_force", "reward", ContactForce)
-def contact_force(snap, p) -> float:
+def contact_force(snap: Snapshot, p: ContactForce) -> float:
     """Sum of contact normal forces between bodies ``a`` and ``b`` this step (N)."""
     return float(snap.contact_force(p.a, p.b))
 
@@ -110,7 +113,7 @@ class ContactEventCounter:
     def reset(self) -> None:
         self.last = None
 
-    def __call__(self, snap, p) -> float:
+    def __call__(self, snap: Snapshot, p: ContactEvents) -> float:
         centre = snap.position(p.target).tolist()
         near = [cp for cp in snap.contacts(p.tool, p.onto) if math.dist(cp[5], centre) <= p.radius_m]
         if not near:
@@ -132,7 +135,7 @@ class Tilt(Params):
 
 
 @term("tilt", "reward", Tilt)
-def tilt(snap, p) -> float:
+def tilt(snap: Snapshot, p: Tilt) -> float:
     """Angle between a link axis and a world direction (rad): 0 when a cup stands upright."""
     return vec_angle(quat_rotate(snap.orientation(p.of), p.axis), p.up)
 
@@ -144,7 +147,7 @@ class ClosestDistance(Params):
 
 
 @term("closest_distance", "reward", ClosestDistance)
-def closest_distance(snap, p) -> float:
+def closest_distance(snap: Snapshot, p: ClosestDistance) -> float:
     """Smallest distance between the surfaces of body ``a`` and any of ``b`` (m; ≤ 0 when touching)."""
     return snap.closest_distance(p.a, p.b, p.max_m)
 
@@ -154,7 +157,7 @@ class MarkerSet(Params):
 
 
 @term("markers_cleared", "reward", MarkerSet)
-def markers_cleared(snap, p) -> float:
+def markers_cleared(snap: Snapshot, p: MarkerSet) -> float:
     """Markers of the set cleared this step (count), e.g. spots wiped clean."""
     return float(snap.events[p.markers])
 
@@ -207,7 +210,7 @@ class SleeveProgressTerm:
     def reset(self) -> None:
         self.forearm_seen = False
 
-    def __call__(self, snap, p) -> float:
+    def __call__(self, snap: Snapshot, p: SleeveProgress) -> float:
         from ..garment import sleeve_progress as r_dress
 
         value = r_dress(

@@ -56,7 +56,7 @@ def load_scene(rt: ResolvedTask, pc: PlacementClient, emitted: EmittedScene, out
     people, person_pos, person_orns = _load_people(rt, pc, emitted, furniture)
     robot = pc.load(emitted.written["robot"], (0, 0, 0), (0, 0, 0, 1), True)
     robot_joints = pc.joint_index(robot)
-    arm_joints = rt.joint_groups["robot.arm"]["joints"]
+    arm_joints = rt.joint_groups["robot.arm"].joints
     infos = {j: p.getJointInfo(robot, robot_joints[j], physicsClientId=c) for j in arm_joints}
     per_robot = spec.robot.per_robot.get(rt.robot_name)
     offset = per_robot.base_offset_m if per_robot and per_robot.base_offset_m else (0.0, 0.0, 0.0)
