@@ -21,11 +21,11 @@ import hashlib
 import json
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, SerializerFunctionWrapHandler, model_serializer
 
-from .references import JointGroup, ParamValue
+from .references import JointGroup, LinkPoint, ParamValue, TargetPoint
 
 FORMAT_VERSION = 1
 
@@ -129,6 +129,55 @@ class PersonVariant(_Model):
         return data
 
 
+class _Impairment(_Model):
+    """What every impairment choice has: the person joints it acts on and their limits."""
+
+    joints: list[str] = Field(default_factory=list, description="URDF person joints it acts on (empty: none named).")
+    limits: dict[str, tuple[float, float]] = Field(
+        default_factory=dict, description="Each of those joints' pose-independent URDF limits, rad (lower, upper)."
+    )
+
+    @model_serializer(mode="wrap")
+    def _without_empty(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """No ``joints`` and ``limits`` keys when it names no joints (the form artifacts were first written in)."""
+        data: dict[str, Any] = handler(self)
+        for key in ("joints", "limits"):
+            if not data.get(key):
+                data.pop(key, None)
+        return data
+
+
+class NoImpairment(_Impairment):
+    """The person is not impaired."""
+
+    kind: Literal["none"] = Field(description="No impairment.")
+
+
+class Tremor(_Impairment):
+    """Tremor: each joint's target jitters by up to ε, drawn per joint and episode (paper §III-C)."""
+
+    kind: Literal["tremor"] = Field(description="Tremor.")
+    amplitude_rad: tuple[float, float] = Field(description="Range ε is drawn from per joint, rad (low, high).")
+
+
+class Weakness(_Impairment):
+    """Weakness: the joints' forces × β, drawn per episode (paper §III-C)."""
+
+    kind: Literal["weakness"] = Field(description="Weakness.")
+    strength: tuple[float, float] = Field(description="Range β is drawn from (low, high; 1 = full strength).")
+
+
+class LimitedRange(_Impairment):
+    """Limited range of motion: the joints' limits × γ, drawn per episode (paper §III-C)."""
+
+    kind: Literal["limited_range"] = Field(description="Limited range of motion.")
+    scale: tuple[float, float] = Field(description="Range γ is drawn from (low, high).")
+
+
+Impairment = Annotated[NoImpairment | Tremor | Weakness | LimitedRange, Field(discriminator="kind")]
+"""One impairment choice of the task, by its ``kind``."""
+
+
 class Person(_Model):
     """The person: variants, control and impairments."""
 
@@ -141,7 +190,7 @@ class Person(_Model):
     compliant_joints: list[str] = Field(description="Joints held compliantly (static-person task).")
     compliant_gain: float = Field(0.0, description="Gain of the compliant hold.")
     compliant_force: float = Field(0.0, description="Force of the compliant hold, N·m.")
-    impairments: list[dict[str, Any]] = Field(description="Impairment choices (spec form, angles in rad).")
+    impairments: list[Impairment] = Field(description="Impairment choices; one is drawn per episode.")
     action_scale: float = Field(
         0.05, description="Policy-joint target change per unit human action per physics step, rad."
     )
@@ -401,6 +450,58 @@ class Sim(_Model):
     ground_friction: tuple[float, float] = Field(description="Floor friction, uniform [low, high] per reset.")
 
 
+class ScriptWaypoint(_Model):
+    """One waypoint of the scripted baseline: where the moved point goes next (world frame, m)."""
+
+    to: TargetPoint | LinkPoint = Field(description="The point it heads for.")
+    offset_m: Vec3 = Field(description="Offset from that point, world frame, m.")
+    tolerance_m: float = Field(description="Reached within this distance, m (0: never; a last waypoint to hold).")
+    normal_offset_m: float = Field(0.0, description="Offset along a surface target's outward normal, m.")
+    axis_offset_m: float = Field(0.0, description="Offset along a surface target's limb axis, m.")
+    rpy_rad: Vec3 | None = Field(
+        description="Orientation of the end effector to hold (roll, pitch, yaw, rad), or none."
+    )
+    face_normal_within_rad: float | None = Field(
+        description="Turn the tool towards the surface normal by at most this much, rad, or none."
+    )
+    step_m: float | None = Field(None, description="Straight-line look-ahead per step, m (none: straight to the goal).")
+    face_normal_level: bool = Field(False, description="Turn about the vertical only (keep the tool level).")
+    turn_step_rad: float | None = Field(None, description="Most the tool turns per step, rad (none: no limit).")
+
+    @model_serializer(mode="wrap")
+    def _without_unset_additions(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """``step_m``, ``face_normal_level`` and ``turn_step_rad`` are left out when unset (the form
+        artifacts were first written in)."""
+        data: dict[str, Any] = handler(self)
+        for key in ("step_m", "turn_step_rad"):
+            if data.get(key) is None:
+                data.pop(key, None)
+        if not data.get("face_normal_level"):
+            data.pop("face_normal_level", None)
+        return data
+
+
+class Script(_Model):
+    """The scripted baseline's script for one arm: the point it moves through its waypoints."""
+
+    move: TargetPoint | LinkPoint = Field(description="The point moved (a tool's tip, the end effector).")
+    waypoints: list[ScriptWaypoint] = Field(description="Waypoints in order.")
+    repeat_from: int | None = Field(description="After the last waypoint, go on from this one (none: hold the last).")
+    ik_damping: dict[str, float] | None = Field(None, description="IK damping of some arm joints, by URDF name.")
+    left: Script | None = Field(
+        None, description="A two-arm robot's left arm's own script (this one is the right arm's)."
+    )
+
+    @model_serializer(mode="wrap")
+    def _without_unset(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """``ik_damping`` and ``left`` are left out when unset."""
+        data: dict[str, Any] = handler(self)
+        for key in ("ik_damping", "left"):
+            if data.get(key) is None:
+                data.pop(key, None)
+        return data
+
+
 class Manifest(_Model):
     """The whole artifact description."""
 
@@ -436,8 +537,8 @@ class Manifest(_Model):
     garments: list[Garment] = Field(
         default_factory=list, description="Soft-body garments (their presence makes the world a deformable one)."
     )
-    scripted: dict[str, Any] | None = Field(
-        None, description="Scripted baseline: point moved and waypoints (normalised)."
+    scripted: Script | None = Field(
+        None, description="The scripted baseline's script for this robot (none: no baseline)."
     )
     camera: Camera = Field(default_factory=lambda: Camera(), description="The task's camera for this robot (renders).")
 

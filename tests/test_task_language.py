@@ -147,7 +147,7 @@ def test_scripted_ik_damping_damps_the_named_joints_only(tmp_path, scratch):
     try:
         policy = ScriptedPolicy(env)
         robot = env.world.robot
-        named = {policy.movable.index(robot.joints[j]): v for j, v in env.manifest.scripted["ik_damping"].items()}
+        named = {policy.movable.index(robot.joints[j]): v for j, v in env.manifest.scripted.ik_damping.items()}
         assert set(named.values()) == {1.0} and len(named) == 2
         assert all(d == (named[k] if k in named else 0.1) for k, d in enumerate(policy.damping))
     finally:
@@ -575,7 +575,7 @@ def test_scripted_cup_tips_no_faster_than_its_turn_step(tmp_path):
     for name, spec in (("slow", path), ("task", task)):
         env = AssistiveEnv(compile_task(spec, "jaco", tmp_path / name).out_dir)
         try:
-            assert [w.get("turn_step_rad") for w in env.manifest.scripted["waypoints"]] == (
+            assert [w.turn_step_rad for w in env.manifest.scripted.waypoints] == (
                 [None, None, pytest.approx(math.radians(1))] if name == "slow" else [None, None, None]
             )
             policy = ScriptedPolicy(env)

@@ -14,10 +14,13 @@ import math
 from pathlib import Path
 from typing import Any
 
+from pydantic import TypeAdapter
+
 from ..artifact import (
     Camera,
     Capsule,
     Drive,
+    Impairment,
     Manifest,
     MarkerPoint,
     MarkerSet,
@@ -41,6 +44,8 @@ from ..terms.registry import SizeContext, spec_form, terms
 from ..urdf import urdf_info
 from .task import impairment_joints, policy_joints, rounded
 from .weld import gripper
+
+IMPAIRMENT: TypeAdapter[Impairment] = TypeAdapter(Impairment)
 
 
 def gym_id(rt: ResolvedTask) -> str:
@@ -138,7 +143,7 @@ def _person(rt: ResolvedTask, variants: list[PersonVariant]) -> Person:
         compliant_joints=compliant_joints,
         compliant_gain=compliant.position_gain if compliant else 0.0,
         compliant_force=compliant.max_force_nm if compliant else 0.0,
-        impairments=[impairment_json(rt, ch) for ch in rt.spec.person.impairments.choices],
+        impairments=[impairment_choice(rt, ch) for ch in rt.spec.person.impairments.choices],
         action_scale=gains.action_scale_rad,
         arm_limits=gains.arm_limits,
     )
@@ -304,8 +309,8 @@ def _drawn_on_capsules(rt: ResolvedTask, ref: dict) -> bool:
     )
 
 
-def impairment_json(rt: ResolvedTask, choice) -> dict[str, Any]:
-    """An impairment choice for the runtime: ranges as [low, high] (angles in radians), joints by
+def impairment_choice(rt: ResolvedTask, choice) -> Impairment:
+    """An impairment choice for the runtime: ranges as (low, high) (angles in radians), joints by
     URDF name, and each joint's pose-independent limits (for limited range of motion)."""
     out: dict[str, Any] = {"kind": choice.kind}
     for key in ("amplitude_deg", "strength", "scale"):
@@ -320,4 +325,4 @@ def impairment_json(rt: ResolvedTask, choice) -> dict[str, Any]:
         movable = rt.person_urdf.movable_joints
         out["joints"] = joints
         out["limits"] = {j: [movable[j].lower, movable[j].upper] for j in joints}
-    return out
+    return IMPAIRMENT.validate_python(out)

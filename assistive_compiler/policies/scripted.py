@@ -25,8 +25,9 @@ import math
 import numpy as np
 import pybullet as pb
 
+from ..artifact import Script
 from ..ik_options import ik_damping, ik_limits
-from ..references import LinkPoint, point_of
+from ..references import LinkPoint
 from ..rotation import quat_about, quat_conj, quat_mul, quat_rotate, quat_towards, vec_angle
 
 STALL_STEPS = 10  # steps without getting STALL_GAIN_M closer before moving on to the next waypoint
@@ -40,27 +41,20 @@ class _Track:
     """One arm's part of the script: the moved point, its waypoints, its end effector and the
     action columns of its joints."""
 
-    def __init__(self, env, section: dict, mount_link: str, joints: list[str]):
+    def __init__(self, env, script: Script, mount_link: str, joints: list[str]):
         snap, m = env.snap, env.manifest
-        self.move = snap.point(point_of(section["move"]))
+        self.move = snap.point(script.move)
+        waypoints = script.waypoints
         self.waypoints = [
-            (
-                snap.point(point_of(w["to"])),
-                np.asarray(w["offset_m"]),
-                w["tolerance_m"],
-                w.get("normal_offset_m", 0.0),
-                w.get("axis_offset_m", 0.0),
-            )
-            for w in section["waypoints"]
+            (snap.point(w.to), np.asarray(w.offset_m), w.tolerance_m, w.normal_offset_m, w.axis_offset_m)
+            for w in waypoints
         ]
-        self.orientations = [
-            pb.getQuaternionFromEuler(w["rpy_rad"]) if w.get("rpy_rad") else None for w in section["waypoints"]
-        ]
-        self.face_normal = [w.get("face_normal_within_rad") for w in section["waypoints"]]
-        self.face_level = [w.get("face_normal_level", False) for w in section["waypoints"]]
-        self.steps_m = [w.get("step_m") for w in section["waypoints"]]
-        self.turn_steps = [w.get("turn_step_rad") for w in section["waypoints"]]
-        self.repeat_from = section.get("repeat_from")
+        self.orientations = [pb.getQuaternionFromEuler(w.rpy_rad) if w.rpy_rad else None for w in waypoints]
+        self.face_normal = [w.face_normal_within_rad for w in waypoints]
+        self.face_level = [w.face_normal_level for w in waypoints]
+        self.steps_m = [w.step_m for w in waypoints]
+        self.turn_steps = [w.turn_step_rad for w in waypoints]
+        self.repeat_from = script.repeat_from
         robot = env.world.robot
         self.ee_link = robot.links[mount_link]
         self.ee_point = snap.point(LinkPoint(body="robot", link=mount_link))
@@ -88,12 +82,10 @@ class ScriptedPolicy:
             )
         self.env = env
         links = m.robot.links
-        if m.scripted.get("left") is not None:
+        if m.scripted.left is not None:
             self.tracks = [
                 _Track(env, m.scripted, links["right_tool_mount"], list(m.joint_groups["robot.right_arm"].joints)),
-                _Track(
-                    env, m.scripted["left"], links["left_tool_mount"], list(m.joint_groups["robot.left_arm"].joints)
-                ),
+                _Track(env, m.scripted.left, links["left_tool_mount"], list(m.joint_groups["robot.left_arm"].joints)),
             ]
         else:
             self.tracks = [_Track(env, m.scripted, links["tool_mount"], list(m.robot.arm_joints))]
@@ -119,7 +111,7 @@ class ScriptedPolicy:
         # A mobile base drives: IK moves its planar joints with the arm, and the wheel actions head
         # for the planar change it asks of the base (see :meth:`_wheels`).
         # The robot's own script may damp some arm joints (e.g. a slow shoulder).
-        own = {robot.joints[name]: value for name, value in (m.scripted.get("ik_damping") or {}).items()}
+        own = {robot.joints[name]: value for name, value in (m.scripted.ik_damping or {}).items()}
         self.damping = ik_damping(movable, [], env.drive.idx if env.drive else [], own)
         self.drive_cols = [movable.index(j) for j in env.drive.idx] if env.drive else []
         self.arm_offset = 2 if env.drive else 0

@@ -42,7 +42,7 @@ from ..references import LinkPoint
 from ..rotation import capsule_axes
 from .binding import bind
 from .drive import BaseDriveControl, FollowerControl
-from .human import PersonController, draw_impairment  # noqa: F401  (draw_impairment: re-exported)
+from .human import PersonController
 from .markers import MarkerSystem
 from .particles import ParticleSystem
 from .snapshot import Snapshot
@@ -264,7 +264,7 @@ class AssistiveEnv(gym.Env):
         self._set_robot_base_frame()
         self.snap.set_frame("person_base", *w.base_frame(person))
         self.snap.refresh()
-        return self._observe(), {"person_variant": variant.name, "start": k, "impairment": impairment}
+        return self._observe(), {"person_variant": variant.name, "start": k, "impairment": impairment.info()}
 
     def step(self, action):
         """One env step of the robot; the person holds (or tremors) as the spec says."""

@@ -50,35 +50,65 @@ variant's ``movable_joints``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pybullet as pb
 
-from ..artifact import Manifest, PersonVariant
+from ..artifact import Impairment, LimitedRange, Manifest, PersonVariant, Tremor, Weakness
 from ..person.arm_limits import ARM_LIMIT_JOINTS, AnalyticArmLimits, ArmLimitGuard, ArmLimitModel, MLPArmLimits
 from .world import World
 
 __all__ = ["PersonController", "draw_impairment", "arm_limit_model", "guarded_arm"]
 
 
-def draw_impairment(choices: list[dict], rng: np.random.Generator) -> dict:
-    """One impairment for an episode, drawn uniformly from the spec's choices, with its values:
-    ``amplitude`` (tremor ε per joint, rad), ``strength`` (weakness β) or ``limits`` (limited range:
-    each joint's limits × γ, as the paper scales them), plus the ``joints`` it affects."""
+@dataclass(frozen=True)
+class DrawnImpairment:
+    """An episode's impairment with its drawn values (paper §III-C)."""
+
+    kind: str
+    """'none', 'tremor', 'weakness' or 'limited_range'."""
+    joints: tuple[str, ...] = ()
+    """The person joints it acts on."""
+    amplitude: dict[str, float] = field(default_factory=dict)
+    """Tremor: ε per joint, rad."""
+    strength: float = 1.0
+    """Weakness: β, the factor on the joints' forces."""
+    scale: float | None = None
+    """Limited range: γ."""
+    limits: dict[str, tuple[float, float]] = field(default_factory=dict)
+    """Limited range: each joint's limits × γ, rad."""
+
+    def info(self) -> dict[str, Any]:
+        """As ``reset()``'s ``info["impairment"]`` reports it: kind, joints and the drawn values."""
+        out: dict[str, Any] = {"kind": self.kind, "joints": list(self.joints)}
+        if self.kind == "tremor":
+            out["amplitude"] = dict(self.amplitude)
+        elif self.kind == "weakness":
+            out["strength"] = self.strength
+        elif self.kind == "limited_range":
+            out["scale"], out["limits"] = self.scale, dict(self.limits)
+        return out
+
+
+def draw_impairment(choices: list[Impairment], rng: np.random.Generator) -> DrawnImpairment:
+    """One impairment for an episode, drawn uniformly from the task's choices, with its values:
+    tremor ε per joint (rad), weakness β, or limited range γ (each joint's limits × γ, as the
+    paper scales them)."""
     choice = choices[int(rng.integers(len(choices)))]
-    drawn: dict = {"kind": choice["kind"], "joints": list(choice.get("joints", []))}
-    if choice["kind"] == "tremor":
-        lo, hi = choice["amplitude_rad"]
-        drawn["amplitude"] = {j: float(rng.uniform(lo, hi)) for j in drawn["joints"]}
-    elif choice["kind"] == "weakness":
-        drawn["strength"] = float(rng.uniform(*choice["strength"]))
-    elif choice["kind"] == "limited_range":
-        gamma = float(rng.uniform(*choice["scale"]))
-        drawn["scale"] = gamma
-        drawn["limits"] = {j: (lo * gamma, hi * gamma) for j, (lo, hi) in choice["limits"].items()}
-    return drawn
+    joints = tuple(choice.joints)
+    if isinstance(choice, Tremor):
+        lo, hi = choice.amplitude_rad
+        return DrawnImpairment("tremor", joints, amplitude={j: float(rng.uniform(lo, hi)) for j in joints})
+    if isinstance(choice, Weakness):
+        return DrawnImpairment("weakness", joints, strength=float(rng.uniform(*choice.strength)))
+    if isinstance(choice, LimitedRange):
+        gamma = float(rng.uniform(*choice.scale))
+        limits = {j: (lo * gamma, hi * gamma) for j, (lo, hi) in choice.limits.items()}
+        return DrawnImpairment("limited_range", joints, scale=gamma, limits=limits)
+    return DrawnImpairment(choice.kind, joints)
 
 
 def guarded_arm(policy_joints: list[str]) -> str | None:
@@ -119,12 +149,12 @@ class PersonController:
         self.guard: ArmLimitGuard | None = ArmLimitGuard(model, self.arm_side) if model is not None else None
         #: Arm-limit reverts so far this episode.
         self.reverts = 0
-        self.impairment: dict[str, Any] = {"kind": "none", "joints": []}
+        self.impairment = DrawnImpairment("none")
         self._acting = False
         self._tremor: list[tuple[int, float]] = []
 
     # -- per episode ---------------------------------------------------------------------------
-    def reset(self, variant: PersonVariant, rng: np.random.Generator) -> dict:
+    def reset(self, variant: PersonVariant, rng: np.random.Generator) -> DrawnImpairment:
         """Draw the episode's joint angles and impairment (in this order, from ``rng``), put the
         variant's movable joints there and hold them. Returns the drawn impairment."""
         m, w, c = self.m, self.world, self.world.client
@@ -138,7 +168,7 @@ class PersonController:
         # (γ·limits of a range without 0, e.g. the right shoulder_x's 5°…198°, can reach past the
         # URDF's own, which pybullet keeps enforcing: the effective range is the intersection).
         lower, upper = (list(x) for x in self._urdf_limits[variant.name])
-        scaled = impairment.get("limits", {})
+        scaled = impairment.limits
         for k, j in enumerate(movable):
             if j in scaled:
                 lower[k], upper[k] = max(lower[k], scaled[j][0]), min(upper[k], scaled[j][1])
@@ -158,14 +188,14 @@ class PersonController:
         self.hold = [angles[j] for j in movable]
         # Held stiffly, or compliantly (a weak hold that yields to contact) where the spec says so;
         # weakness scales the force of the joints it names.
-        strength = impairment.get("strength", 1.0)
-        weak = set(impairment.get("joints", ()))
+        strength = impairment.strength
+        weak = set(impairment.joints)
         self.hold_gains = [m.person.compliant_gain if j in compliant else m.person.hold_gain for j in movable]
         self.hold_forces = [
             (m.person.compliant_force if j in compliant else m.person.hold_force) * (strength if j in weak else 1.0)
             for j in movable
         ]
-        amplitude = impairment.get("amplitude", {})
+        amplitude = impairment.amplitude
         self._tremor = [(k, amplitude[j]) for k, j in enumerate(movable) if j in amplitude]
         if idx:
             pb.setJointMotorControlArray(
@@ -196,7 +226,7 @@ class PersonController:
         # Hard limits: on every movable joint while the person is an agent (acts or tremors); on a static
         # person only on its stiffly held joints (standing in for the reference's limits built into the
         # body), never on its limp ones (see the module docstring).
-        self._limited_k = [k for k, j in enumerate(movable) if j not in compliant] if impairment.get("limits") else []
+        self._limited_k = [k for k, j in enumerate(movable) if j not in compliant] if impairment.limits else []
         self._static_hook = bool(self._tremor) or bool(self._limited_k)
         if self.guard is not None:
             self.guard.reset([self.hold[k] for k in self._arm_k])
