@@ -218,6 +218,30 @@ class Drive(_Model):
     max_force: tuple[float, float, float] = Field(description="Force limits of x, y (N) and yaw (N·m).")
 
 
+class BasePose(_Model):
+    """A robot base pose the compile-time search kept (world frame)."""
+
+    position: Vec3 = Field(description="Base position, world frame, m.")
+    yaw_rad: float = Field(description="Base yaw about +z, rad.")
+    goals_reached: int = Field(description="Reach goals the arm reaches from it without collision.")
+    goals: int = Field(description="Reach goals searched for.")
+    jlwki: float = Field(
+        description="Joint-limit-weighted kinematic isotropy summed over the reached goals (higher: more dexterous)."
+    )
+
+
+class BaseSearch(_Model):
+    """The base was placed by the compile-time search (paper §IV): the poses it kept, best first."""
+
+    base_poses: list[BasePose] = Field(description="Kept base poses, best first; reset() draws starts among them.")
+
+
+class Mounted(_Model):
+    """The base is mounted on a furniture piece (no search)."""
+
+    mounted_on: str = Field(description="The furniture the robot is mounted on.")
+
+
 class Robot(_Model):
     """The robot: which joints act, links by role, control, gripper.
 
@@ -243,7 +267,7 @@ class Robot(_Model):
         default_factory=dict,
         description="Moving joints of the robot's URDF that the task never drives, made fixed in the artifact's robot.urdf at these values (rad or m): fingers at the grip, the rest at 0 (both within the joint's limits).",
     )
-    placement: dict[str, Any] = Field(
+    placement: dict[str, Mounted | BaseSearch] = Field(
         default_factory=dict,
         description="How the base was placed: mount, or the search's kept poses with goals reached and JLWKI.",
     )
@@ -566,7 +590,12 @@ class Manifest(_Model):
         run can be resumed across a change that compiles its task to the same files.
         ``with_input_hash``: the hash as artifacts written before 2026-11-28 recorded it (the
         manifest with its input hash, which covers the compiler source)."""
-        files = b"".join(Path(artifact_dir, b.urdf).read_bytes() for b in sorted(self.bodies, key=lambda b: b.urdf))
+        return self._hash(self._body_bytes(artifact_dir), with_input_hash=with_input_hash)
+
+    def _body_bytes(self, artifact_dir: str | Path) -> bytes:
+        return b"".join(Path(artifact_dir, b.urdf).read_bytes() for b in sorted(self.bodies, key=lambda b: b.urdf))
+
+    def _hash(self, files: bytes, *, with_input_hash: bool) -> str:
         blank = {"content_hash": ""} if with_input_hash else {"content_hash": "", "input_hash": ""}
         return hashlib.sha256(files + self.model_copy(update=blank).to_json().encode()).hexdigest()
 
@@ -581,9 +610,11 @@ class Manifest(_Model):
                 ET.parse(path)
             except ET.ParseError as exc:
                 return f"{path}: not complete URDF XML ({exc}); truncated or edited?"
-        if self.content_hash and self.content_hash not in (
-            self.hash_of(artifact_dir),
-            self.hash_of(artifact_dir, with_input_hash=True),
+        if not self.content_hash:
+            return None
+        files = self._body_bytes(artifact_dir)  # read once; the older hash only when the current one differs
+        if self.content_hash != self._hash(files, with_input_hash=False) and self.content_hash != self._hash(
+            files, with_input_hash=True
         ):
             return f"{artifact_dir}: files differ from what was compiled (the manifest's content hash does not match)"
         return None

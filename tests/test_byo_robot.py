@@ -47,11 +47,11 @@ def test_the_urdf_is_copied_with_absolute_mesh_paths(compiled):
 
 
 def test_base_pose_search_keeps_poses_that_reach_every_goal(compiled):
-    placement = compiled.manifest.robot.placement["male_50th"]["base_poses"]
+    placement = compiled.manifest.robot.placement["male_50th"].base_poses
     assert 1 <= len(placement) <= 4
-    assert all(p["goals_reached"] == p["goals"] == 3 for p in placement)
-    assert all(p["position"][2] == pytest.approx(0.7) for p in placement)  # the part's base height
-    jlwki = [p["jlwki"] for p in placement]
+    assert all(p.goals_reached == p.goals == 3 for p in placement)
+    assert all(p.position[2] == pytest.approx(0.7) for p in placement)  # the part's base height
+    jlwki = [p.jlwki for p in placement]
     assert jlwki == sorted(jlwki, reverse=True) and all(0 < j <= 3 for j in jlwki)  # Σ over 2 scored goals + start
 
 

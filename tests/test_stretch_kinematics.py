@@ -258,8 +258,8 @@ def test_base_search_ranks_poses_by_isotropy_for_a_three_joint_arm(scratch_env):
     # JLWKI over the directions the arm can move in: Stretch's 3 arm joints give a rank-3 Jacobian,
     # whose 6-D determinant is 0, so every pose used to score 0 and the search could not rank them.
     placement = scratch_env.manifest.robot.placement
-    poses = [p for variant in placement.values() for p in variant["base_poses"]] if isinstance(placement, dict) else []
-    assert poses and all(0.0 < p["jlwki"] <= p["goals_reached"] + 1e-9 for p in poses)
+    poses = [p for variant in placement.values() for p in variant.base_poses]
+    assert poses and all(0.0 < p.jlwki <= p.goals_reached + 1e-9 for p in poses)
 
 
 def test_wheel_actions_for_a_planar_change_invert_the_drive(scratch_env):

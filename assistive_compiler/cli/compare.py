@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..artifact import BaseSearch, Mounted
 from ..episode import rollout
 from .common import EXIT_OK, add_library_argument
 
@@ -46,13 +47,14 @@ def compare_robot(spec: str, robot: str, episodes: int, seed: int, out: Path | N
     m = result.manifest
     row["compile_s"] = round(result.seconds, 2)
     placements = list(m.robot.placement.values())
-    if all("mounted_on" in p for p in placements):
-        row["placement"] = f"mounted on {placements[0]['mounted_on']}"
+    mounts = [p for p in placements if isinstance(p, Mounted)]
+    if len(mounts) == len(placements):
+        row["placement"] = f"mounted on {mounts[0].mounted_on}"
     else:
-        best = [p["base_poses"][0] for p in placements]
+        best = [p.base_poses[0] for p in placements if isinstance(p, BaseSearch)]
         row["placement"] = "base search"
-        row["goals_reached"] = f"{min(b['goals_reached'] for b in best)}/{best[0]['goals']}"
-        row["jlwki"] = round(float(np.mean([b["jlwki"] for b in best])), 3)
+        row["goals_reached"] = f"{min(b.goals_reached for b in best)}/{best[0].goals}"
+        row["jlwki"] = round(float(np.mean([b.jlwki for b in best])), 3)
     if policy == EACH_PRETRAINED:
         from ..policies.pretrained import PREFIX, shipped_names
 

@@ -12,11 +12,10 @@ robot's manifest entry."""
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 
-from ...artifact import Body, StartState
+from ...artifact import BasePose, BaseSearch, Body, Mounted, StartState
 from ...resolve import ResolvedTask
 from ...rotation import quat_yaw
 from ..task import fail, mounted_on, rounded, seed
@@ -27,7 +26,7 @@ from .scene import PlacedScene
 
 def place_for_variant(
     rt: ResolvedTask, pc: PlacementClient, scene: PlacedScene, arms: list, variant: str
-) -> tuple[list[StartState], dict[str, Any]]:
+) -> tuple[list[StartState], Mounted | BaseSearch]:
     """(start states, placement record) for ``variant``; raises when no start is reachable."""
     for other, pid in scene.people.items():  # only this variant in the scene
         pc.place(pid, scene.person_pos[other] if other == variant else (0, 0, -20), scene.person_orns[other])
@@ -35,21 +34,21 @@ def place_for_variant(
     goals = reach_goals(rt, pc, scene, arms, variant)
     if scene.mount_pose is not None:
         bases = [(scene.mount_pose, len(goals), 0.0)]
-        placement: dict[str, Any] = {"mounted_on": mounted_on(rt)}
+        placement: Mounted | BaseSearch = Mounted(mounted_on=mounted_on(rt))
     else:
         bases = search_base(rt, [a[0] for a in arms], goals, scene.offset, rng, scene.carry)
-        placement = {
-            "base_poses": [
-                {
-                    "position": list(rounded(b[0][0])),
-                    "yaw_rad": rounded(quat_yaw(b[0][1])),
-                    "goals_reached": b[1],
-                    "goals": len(goals),
-                    "jlwki": rounded(b[2]),
-                }
+        placement = BaseSearch(
+            base_poses=[
+                BasePose(
+                    position=rounded(b[0][0]),
+                    yaw_rad=rounded(quat_yaw(b[0][1])),
+                    goals_reached=b[1],
+                    goals=len(goals),
+                    jlwki=rounded(b[2]),
+                )
                 for b in bases
             ]
-        }
+        )
     starts = _sample_starts(scene, arms, bases, rng)
     if not starts:
         start = arms[0][1]
