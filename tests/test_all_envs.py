@@ -70,7 +70,7 @@ def assert_the_camera_shows_person_arm_and_tools(env, width: int = 160, height: 
     from assistive_compiler.runtime.camera import camera_matrices
 
     w, m = env.world, env.manifest
-    view, proj = camera_matrices(m.camera.model_dump(), width, height, w.client)
+    view, proj = camera_matrices(m.camera, width, height, w.client)
     seg = np.asarray(
         pb.getCameraImage(
             width,

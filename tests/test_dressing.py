@@ -244,7 +244,7 @@ def _pixel(env, point, width=480, height=360) -> np.ndarray:
     """Where world ``point`` (m) lands in a render of the task's camera, pixels (x right, y down)."""
     from assistive_compiler.runtime.camera import camera_matrices, clip_transform
 
-    view_m, proj = camera_matrices(env.manifest.camera.model_dump(), width, height, env.world.client)
+    view_m, proj = camera_matrices(env.manifest.camera, width, height, env.world.client)
     clip = clip_transform(view_m, proj) @ np.array([*point, 1.0])
     return np.array([(clip[0] / clip[3] + 1.0) / 2.0 * width, (1.0 - clip[1] / clip[3]) / 2.0 * height])
 

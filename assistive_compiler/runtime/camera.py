@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 import pybullet as pb
 
+from ..artifact import Camera
 from ..references import TargetPoint
 
 NEAR_M, FAR_M = 0.02, 10.0
@@ -43,17 +44,17 @@ def overlay_spheres(env) -> list[tuple[list[float], float, tuple]]:
     return spheres + env.markers.visual_spheres() + env.particles.visual_spheres()
 
 
-def camera_matrices(view: dict, width: int, height: int, client: int) -> tuple[list[float], list[float]]:
+def camera_matrices(view: Camera, width: int, height: int, client: int) -> tuple[list[float], list[float]]:
     """pybullet's (view, projection) matrices for ``view`` (eye, target in world m; fov_deg vertical)."""
-    view_m = pb.computeViewMatrix(list(view["eye"]), list(view["target"]), [0, 0, 1], physicsClientId=client)
-    proj = pb.computeProjectionMatrixFOV(view["fov_deg"], width / height, NEAR_M, FAR_M, physicsClientId=client)
+    view_m = pb.computeViewMatrix(list(view.eye), list(view.target), [0, 0, 1], physicsClientId=client)
+    proj = pb.computeProjectionMatrixFOV(view.fov_deg, width / height, NEAR_M, FAR_M, physicsClientId=client)
     return view_m, proj
 
 
 def render_rgb(env, width: int = 480, height: int = 360, view: dict | None = None) -> np.ndarray:
     """An (height, width, 3) uint8 image of the env's current state from the task's camera for
     its robot (``view``: eye / target / fov_deg overriding it)."""
-    v = env.manifest.camera.model_dump() | (view or {})
+    v = env.manifest.camera.model_copy(update=view or {})
     w = env.world
     c = w.client
     view_m, proj = camera_matrices(v, width, height, c)
