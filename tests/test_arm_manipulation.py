@@ -15,6 +15,7 @@ from helpers import at, compiled_env
 
 from assistive_compiler.cli import main
 from assistive_compiler.paths import display, specs_dir
+from assistive_compiler.references import LinkPoint
 from assistive_compiler.terms.registry import terms
 
 SPEC = specs_dir() / "tasks" / "arm_manipulation.yaml"
@@ -59,7 +60,7 @@ def test_one_arm_robot_acts_with_its_arm_and_one_scooper_serves_both_hands(jaco)
     assert [t.body for t in m.tools] == ["scooper_right"] and "scooper_left" not in {b.name for b in m.bodies}
     # Every reference to the left scooper is the one scooper's.
     left_obs = m.observations["robot"][2].params["of"]
-    assert left_obs == {"body": "scooper_right", "link": "scooper_blade"}
+    assert left_obs == LinkPoint(body="scooper_right", link="scooper_blade")
     names = [t.name for t in m.reward]
     assert "tool_to_elbow" in names and "right_tool_to_wrist" not in names  # 2 x 0.25 to the elbow
     assert m.robot.gripper_position == [1.05, 1.05, 1.05]  # the reference's arm-manipulation grip
@@ -69,8 +70,8 @@ def test_one_arm_robot_acts_with_its_arm_and_one_scooper_serves_both_hands(jaco)
 def test_two_arm_robot_acts_with_both_arms_and_holds_two_scoopers(pr2):
     env, m = pr2, pr2.manifest
     assert env.action_space.shape == (14,) and env.observation_space.shape == (45,)
-    assert m.robot.arm_joints[:7] == m.joint_groups["robot.right_arm"]["joints"]
-    assert m.robot.arm_joints[7:] == m.joint_groups["robot.left_arm"]["joints"]
+    assert tuple(m.robot.arm_joints[:7]) == m.joint_groups["robot.right_arm"].joints
+    assert tuple(m.robot.arm_joints[7:]) == m.joint_groups["robot.left_arm"].joints
     assert {t.body: t.parent_link for t in m.tools} == {
         "scooper_right": "r_gripper_tool_frame",
         "scooper_left": "l_gripper_tool_frame",
@@ -142,7 +143,7 @@ def test_the_hanging_arm_is_free_to_be_lifted(jaco):
     person = w.variant_bodies[w.active_variant.name]
     jaco.step(np.zeros(7))
     z0 = _link_pos(jaco, "right_wrist")[2]
-    arm = [person.joints[j] for j in jaco.manifest.joint_groups["person.right_arm"]["joints"]]
+    arm = [person.joints[j] for j in jaco.manifest.joint_groups["person.right_arm"].joints]
     lift = {k: 2 * 9.81 * pb.getDynamicsInfo(person.id, k, physicsClientId=c)[0] for k in arm}
     for _ in range(50):  # twice the arm's weight upwards on each of its links for 1 s: the weak hold yields
         for k, f in lift.items():

@@ -28,6 +28,7 @@ import pytest
 import xacro
 import yourdfpy
 
+from assistive_compiler.artifact import Mounted
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.compile.lint import lint_urdf
 from assistive_compiler.library import Library
@@ -240,7 +241,7 @@ def test_jaco_mounted_on_nightstand(mounted):
     out, manifest = mounted
     assert manifest.robot_name == "jaco"
     variants = [v.name for v in manifest.person.variants]
-    assert manifest.robot.placement == {v: {"mounted_on": "nightstand"} for v in variants}
+    assert manifest.robot.placement == {v: Mounted(mounted_on="nightstand") for v in variants}
     stand = manifest.body("nightstand")
     assert stand.kind == "furniture" and stand.fixed_base
     np.testing.assert_allclose(stand.position, NIGHTSTAND_POS, atol=1e-9)

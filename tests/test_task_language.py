@@ -13,6 +13,7 @@ import pybullet as pb
 import pytest
 from helpers import compiled_env
 
+from assistive_compiler.artifact import BaseSearch
 from assistive_compiler.cli import main
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.paths import specs_dir
@@ -475,7 +476,7 @@ def test_nightstand_is_carried_under_the_searched_base(bathing):
     env = bathing
     w = env.world
     assert all(
-        "base_poses" in p for p in env.manifest.robot.placement.values()
+        isinstance(p, BaseSearch) for p in env.manifest.robot.placement.values()
     )  # searched, not mounted where the scene put it
     stand = w.bodies["nightstand"]
     bases = set()
@@ -512,7 +513,7 @@ def test_free_standing_robot_has_no_nightstand(tmp_path):
     try:
         assert "nightstand" not in {b.name for b in env.manifest.bodies}
         assert "nightstand" not in env.world.bodies
-        assert all("base_poses" in p for p in env.manifest.robot.placement.values())
+        assert all(isinstance(p, BaseSearch) for p in env.manifest.robot.placement.values())
         obs, _ = env.reset(seed=0)
         obs, *_ = env.step(np.zeros(env.action_space.shape))
         assert np.isfinite(obs).all()
