@@ -78,9 +78,6 @@ def point_of(resolved: dict[str, str]) -> Point:
     return LinkPoint(body=resolved["body"], link=resolved["link"])
 
 
-Reference = TargetPoint | LinkPoint | JointGroup | NodeSet
-"""Every reference model."""
-
 ParamValue = (
     TargetPoint
     | LinkPoint

@@ -57,15 +57,20 @@ def episode(env, policy_name: str, seed: int) -> dict[str, list[str]]:
     return out
 
 
+def rollouts(env) -> dict[str, dict[str, list[str]]]:
+    """Both rollouts in ``env``: {"scripted": ..., "random": ...}."""
+    return {"scripted": episode(env, "scripted", SCRIPTED_SEED), "random": episode(env, "random", RANDOM_SEED)}
+
+
 def digests(env_id: str) -> dict[str, dict[str, list[str]]]:
-    """Both rollouts of ``env_id``: {"scripted": ..., "random": ...}."""
+    """Both rollouts of the shipped id ``env_id``."""
     import gymnasium as gym
 
     import assistive_compiler  # noqa: F401  (registers the ids)
 
     env = gym.make(env_id).unwrapped
     try:
-        return {"scripted": episode(env, "scripted", SCRIPTED_SEED), "random": episode(env, "random", RANDOM_SEED)}
+        return rollouts(env)
     finally:
         env.close()
 

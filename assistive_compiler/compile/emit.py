@@ -116,10 +116,7 @@ def _movable_person_joints(rt: ResolvedTask) -> list[str]:
     """Person joints that keep a joint of their own (URDF order): randomised, policy-driven,
     compliant, impaired (tremor moves them; limits need them) and observed ones."""
     person = rt.spec.person
-    movable = set(person.randomize_deg) | set(
-        rt.joint_groups["person.policy"].joints if "person.policy" in rt.joint_groups else ()
-    )
-    movable |= set(policy_joints(rt))
+    movable = set(person.randomize_deg) | set(policy_joints(rt))
     if person.control.compliant:
         for ref in person.control.compliant.joints:
             movable |= set(rt.joint_groups[ref].joints)

@@ -93,9 +93,10 @@ def referenced_person_links(rt: ResolvedTask) -> set[str]:
     found: set[str] = set()
 
     def visit(value: Any) -> None:
-        if isinstance(value, LinkPoint):
-            value = value.model_dump()
-        if isinstance(value, dict):
+        if isinstance(value, LinkPoint):  # a term's point
+            if value.body == "person":
+                found.add(value.link)
+        elif isinstance(value, dict):  # the resolver's points (targets, the script)
             if value.get("body") == "person" and "link" in value:
                 found.add(value["link"])
             for v in value.values():

@@ -19,17 +19,12 @@ from typing import Any
 
 from ..errors import SpecError
 from ..library import Library, LoadedPart
-from ..references import JointGroup, NodeSet, Point, point_of
+from ..references import JointGroup, NodeSet, point_of
 from ..spec.load import LoadedSpec
 from ..urdf import UrdfInfo
 from .located import Collector, expected
 
 RESERVED_BODIES = ("robot", "person")
-
-
-def as_point(resolved: dict[str, Any] | None) -> Point | None:
-    """A resolved point (``{"target"}`` or ``{"body", "link"}``) as its reference model."""
-    return None if resolved is None else point_of(resolved)
 
 
 GARMENT_HELD_LINK = "held"
@@ -206,7 +201,8 @@ class Scope(Collector):
     def ref(self, kind: str, value: Any, path: tuple) -> Any:
         """A term parameter's reference of ``kind`` (see terms.registry.ref_fields), resolved."""
         if kind == "point":
-            return as_point(self.point(value, path))
+            resolved = self.point(value, path)
+            return None if resolved is None else point_of(resolved)
         if kind == "body":
             return self.body(value, path)
         if kind == "bodies":
