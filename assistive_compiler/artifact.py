@@ -23,11 +23,21 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, SerializerFunctionWrapHandler, model_serializer
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    SerializerFunctionWrapHandler,
+    model_serializer,
+    model_validator,
+)
 
 from .references import JointGroup, LinkPoint, ParamValue, TargetPoint
 
-FORMAT_VERSION = 1
+#: 2 (2026-11-28): the reset's draws are ``events``; floor friction and furniture noise moved there
+#: from ``sim.ground_friction`` and ``Body.position_noise`` (format 1 is read and migrated).
+FORMAT_VERSION = 2
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
@@ -48,7 +58,6 @@ class Body(_Model):
     fixed_base: bool = Field(description="Loaded with useFixedBase.")
     gravity: float | None = Field(description="Gravity on this body, m/s² along z (None: the world's).")
     friction: float | None = Field(None, description="Lateral friction of every link (None: URDF value).")
-    position_noise: Vec3 = Field((0.0, 0.0, 0.0), description="Per-reset uniform position noise half-widths, m.")
     carried_by_robot: tuple[Vec3, Quat] | None = Field(
         None,
         description="Furniture carried under the robot (robot.mount_base: search): its frame (position m, quaternion) in the "
@@ -471,7 +480,72 @@ class Sim(_Model):
     sub_steps: int = Field(description="Solver sub-steps.")
     solver_iterations: int = Field(description="Solver iterations.")
     contact_breaking_threshold: float = Field(0.02, description="Contact breaking threshold, m (see bullet.connect).")
-    ground_friction: tuple[float, float] = Field(description="Floor friction, uniform [low, high] per reset.")
+
+
+class PersonVariantEvent(_Model):
+    """Draw the episode's person body among ``person.variants``, uniformly (``reset(options=
+    {"person_variant": name})`` chooses it instead; the draw is made anyway, so the rest of the
+    episode is the seed's); put it in place, park the others, and move the person-attached targets
+    to its offsets."""
+
+    event: Literal["person_variant"] = Field("person_variant", description="Event name.")
+
+
+class ComponentResetEvent(_Model):
+    """Start one runtime component's episode (:class:`~assistive_compiler.runtime.events.EpisodeComponent`):
+    ``person`` draws the joint angles and then the impairment, sets and holds them; ``markers``
+    puts every marker back; ``reward_terms`` clears the memory of terms that keep some;
+    ``particles`` puts them at their settled places in their holder; ``garments`` puts each at its
+    settled shape in the hand. Components that draw take the reset's random stream."""
+
+    event: Literal["reset"] = Field("reset", description="Event name.")
+    component: Literal["person", "markers", "reward_terms", "particles", "garments"] = Field(
+        description="The component whose episode starts."
+    )
+
+
+class SurfaceTargetsEvent(_Model):
+    """Draw each surface target's point on the episode's person (``PersonVariant.surfaces``: a limb,
+    a distance along it and an azimuth; ``surface_points``: a link, then one of its points), in
+    the variant's order (e.g. the itch, a new spot every episode)."""
+
+    event: Literal["surface_targets"] = Field("surface_targets", description="Event name.")
+
+
+class RobotStartEvent(_Model):
+    """Draw one of the variant's precomputed ``starts`` uniformly: the robot's base and arm there,
+    motor targets at the start, the tools in the hand and furniture carried under the base placed
+    with it (no IK)."""
+
+    event: Literal["robot_start"] = Field("robot_start", description="Event name.")
+
+
+class FurnitureNoiseEvent(_Model):
+    """Move a piece of furniture from its nominal position by a uniform draw per axis."""
+
+    event: Literal["furniture_noise"] = Field("furniture_noise", description="Event name.")
+    body: str = Field(description="The furniture body (a name in ``bodies``).")
+    half_width: Vec3 = Field(description="Uniform noise half-widths along world x, y, z, m.")
+
+
+class FloorFrictionEvent(_Model):
+    """Draw the floor's lateral friction coefficient, uniform in [low, high]."""
+
+    event: Literal["floor_friction"] = Field("floor_friction", description="Event name.")
+    low: float = Field(description="Lowest friction coefficient.")
+    high: float = Field(description="Highest friction coefficient.")
+
+
+#: One event of a reset, applied in the manifest's order with the episode's one random stream.
+Event = Annotated[
+    PersonVariantEvent
+    | ComponentResetEvent
+    | SurfaceTargetsEvent
+    | RobotStartEvent
+    | FurnitureNoiseEvent
+    | FloorFrictionEvent,
+    Field(discriminator="event"),
+]
 
 
 class ScriptWaypoint(_Model):
@@ -565,6 +639,22 @@ class Manifest(_Model):
         None, description="The scripted baseline's script for this robot (none: no baseline)."
     )
     camera: Camera = Field(default_factory=lambda: Camera(), description="The task's camera for this robot (renders).")
+    events: list[Event] = Field(
+        description="What ``reset()`` does, in order, with the episode's one random stream: the draws "
+        "(person variant, surface targets, robot start, furniture noise, floor friction) and the "
+        "components' episode starts (:func:`reset_events`)."
+    )
+    #: The manifest as its file holds it, when that was an older format (migrated on reading):
+    #: its content hash covers that form.
+    _as_written: dict[str, Any] | None = PrivateAttr(None)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _migrate(cls, data: Any) -> Any:
+        """Format 1 (before 2026-11-28) had no ``events``: build the ones its runtime applied."""
+        if isinstance(data, dict) and data.get("format_version") == 1:
+            data = _format_1_migrated(data)
+        return data
 
     @property
     def label(self) -> str:
@@ -595,9 +685,14 @@ class Manifest(_Model):
     def _body_bytes(self, artifact_dir: str | Path) -> bytes:
         return b"".join(Path(artifact_dir, b.urdf).read_bytes() for b in sorted(self.bodies, key=lambda b: b.urdf))
 
-    def _hash(self, files: bytes, *, with_input_hash: bool) -> str:
+    def _hash(self, files: bytes, *, with_input_hash: bool, as_written: bool = False) -> str:
+        """``as_written``: of the manifest in the form its file holds (an older format's), not today's."""
         blank = {"content_hash": ""} if with_input_hash else {"content_hash": "", "input_hash": ""}
-        return hashlib.sha256(files + self.model_copy(update=blank).to_json().encode()).hexdigest()
+        if as_written and self._as_written is not None:
+            text = json.dumps(self._as_written | blank, indent=1, sort_keys=True) + "\n"
+        else:
+            text = self.model_copy(update=blank).to_json()
+        return hashlib.sha256(files + text.encode()).hexdigest()
 
     def damage(self, artifact_dir: str | Path) -> str | None:
         """What is wrong with the files of the artifact at ``artifact_dir`` (a missing, truncated or
@@ -613,9 +708,9 @@ class Manifest(_Model):
         if not self.content_hash:
             return None
         files = self._body_bytes(artifact_dir)  # read once; the older hash only when the current one differs
-        if self.content_hash != self._hash(files, with_input_hash=False) and self.content_hash != self._hash(
-            files, with_input_hash=True
-        ):
+        if self.content_hash != self._hash(
+            files, with_input_hash=False, as_written=True
+        ) and self.content_hash != self._hash(files, with_input_hash=True, as_written=True):
             return f"{artifact_dir}: files differ from what was compiled (the manifest's content hash does not match)"
         return None
 
@@ -631,7 +726,10 @@ class Manifest(_Model):
                 str(artifact_dir), "not a compiled artifact (no manifest.json); compile a spec into it first"
             )
         try:
-            manifest = cls.model_validate_json(path.read_text())
+            text = path.read_text()
+            manifest = cls.model_validate_json(text)
+            if manifest.format_version != json.loads(text).get("format_version"):
+                manifest._as_written = json.loads(text)
         except (ValueError, UnicodeDecodeError) as exc:
             raise SpecError.at(
                 str(path), f"not a readable manifest ({str(exc).splitlines()[0]}); recompile with 'compile --force'"
@@ -643,3 +741,60 @@ class Manifest(_Model):
                 f"damaged artifact: {problem}; recompile it (assistive-compiler compile SPEC --out {artifact_dir} --force)",
             )
         return manifest
+
+
+def reset_events(
+    *,
+    surface_targets: bool,
+    markers: bool,
+    furniture_noise: list[tuple[str, Vec3]],
+    floor_friction: tuple[float, float],
+    particles: bool,
+    garments: bool,
+) -> list[Event]:
+    """A task's reset, in the order its draws are made: the person variant; the person's joint
+    angles and impairment; the surface targets; markers and term memories back; the robot's start;
+    each noisy piece of furniture (in body order); the floor's friction; then particles and
+    garments, which settle in the hand placed by the start. Parts the task lacks are left out."""
+    events: list[Event] = [PersonVariantEvent(), ComponentResetEvent(component="person")]
+    if surface_targets:
+        events.append(SurfaceTargetsEvent())
+    if markers:
+        events.append(ComponentResetEvent(component="markers"))
+    events += [ComponentResetEvent(component="reward_terms"), RobotStartEvent()]
+    events += [FurnitureNoiseEvent(body=body, half_width=noise) for body, noise in furniture_noise]
+    events.append(FloorFrictionEvent(low=floor_friction[0], high=floor_friction[1]))
+    if particles:
+        events.append(ComponentResetEvent(component="particles"))
+    if garments:
+        events.append(ComponentResetEvent(component="garments"))
+    return events
+
+
+def _format_1_migrated(data: dict[str, Any]) -> dict[str, Any]:
+    """A format-1 manifest's data in format 2: the events its runtime applied at every reset, from
+    ``sim.ground_friction`` and the furniture's ``position_noise``, which move into them."""
+    sim = dict(data["sim"])
+    low, high = sim.pop("ground_friction")
+    bodies, noisy = [], []
+    for body in data["bodies"]:
+        body = dict(body)
+        noise = tuple(body.pop("position_noise", (0.0, 0.0, 0.0)))
+        if body["kind"] == "furniture" and any(noise):
+            noisy.append((body["name"], noise))
+        bodies.append(body)
+    variants = data["person"]["variants"]
+    events = reset_events(
+        surface_targets=any(v.get("surfaces") or v.get("surface_points") for v in variants),
+        markers=bool(data.get("markers")),
+        furniture_noise=noisy,
+        floor_friction=(low, high),
+        particles=bool(data["particles"]),
+        garments=bool(data.get("garments")),
+    )
+    return data | {
+        "format_version": FORMAT_VERSION,
+        "sim": sim,
+        "bodies": bodies,
+        "events": [e.model_dump(mode="json") for e in events],
+    }

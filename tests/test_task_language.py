@@ -331,9 +331,15 @@ def test_scratch_events_need_movement_gentle_force_and_nearness():
 
 
 def test_scratch_env_resets_the_counter_each_episode(scratch):
+    """The env's reset clears the counter's memory (its ``reward_terms`` reset event): the same
+    gentle touch that counts once and not again counts anew after a reset."""
     scratch.reset(seed=3)
     fn = next(fn for name, _, fn in scratch.reward_fns if name == "scratch")
-    assert fn.reset in scratch._term_resets  # the env calls it at every reset
+    p = SimpleNamespace(tool=[], onto=[], target=None, radius_m=0.025, min_move_m=0.01, max_force_n=10.0)
+    touch = _snap_with([_contact(0.0, 2.0)])
+    assert (fn.instance(touch, p), fn.instance(touch, p)) == (1.0, 0.0)
+    scratch.reset(seed=4)
+    assert fn.instance(touch, p) == 1.0
 
 
 def test_scripted_tool_turns_no_further_than_needed_to_face_the_itch(scratch):

@@ -20,6 +20,7 @@ from ..artifact import (
     Camera,
     Capsule,
     Drive,
+    Event,
     Impairment,
     Manifest,
     MarkerPoint,
@@ -33,6 +34,7 @@ from ..artifact import (
     SurfacePoint,
     Target,
     TermUse,
+    reset_events,
 )
 from ..paths import display
 from ..person.surface import SURFACE_TARGET_SPACING_M, link_surface
@@ -42,7 +44,7 @@ from ..resolve.bodies import surface_region
 from ..spec.models import scalar_bounds
 from ..terms.registry import SizeContext, spec_form, terms
 from ..urdf import urdf_info
-from .task import impairment_joints, policy_joints, rounded
+from .task import impairment_joints, policy_joints, present_furniture, rounded
 from .weld import gripper
 
 IMPAIRMENT: TypeAdapter[Impairment] = TypeAdapter(Impairment)
@@ -76,7 +78,6 @@ def build_manifest(
             sub_steps=spec.sim.solver.sub_steps,
             solver_iterations=spec.sim.solver.iterations,
             contact_breaking_threshold=spec.sim.solver.contact_breaking_threshold_m,
-            ground_friction=scalar_bounds(spec.sim.ground.friction),
         ),
         bodies=bodies,
         person=_person(rt, variants),
@@ -109,6 +110,23 @@ def build_manifest(
         garments=list(garments),
         scripted=rt.scripted,
         camera=camera(rt),
+        events=_events(rt, bodies, variants, particles, garments),
+    )
+
+
+def _events(rt: ResolvedTask, bodies, variants: list[PersonVariant], particles, garments) -> list[Event]:
+    """The reset's events (:func:`~assistive_compiler.artifact.reset_events`): the furniture's
+    position noise (m, in body order) and the floor's friction range come from the spec."""
+    noise = {name: rounded(use.position_noise_m) for name, use in present_furniture(rt).items()}
+    return reset_events(
+        surface_targets=any(v.surfaces or v.surface_points for v in variants),
+        markers=bool(rt.markers),
+        furniture_noise=[
+            (b.name, noise[b.name]) for b in bodies if b.kind == "furniture" and any(noise.get(b.name, ()))
+        ],
+        floor_friction=scalar_bounds(rt.spec.sim.ground.friction),
+        particles=bool(particles),
+        garments=bool(garments),
     )
 
 

@@ -17,9 +17,10 @@
   co-optimisation face. Hard joint limits and pose-dependent arm limits then hold after every
   physics step.
 
-``reset()`` restores a saved state and applies the episode's draws — person variant, randomised
-joint angles, one of the precomputed start configurations, furniture noise, floor friction —
-without reloading anything or solving IK (about a millisecond).
+``reset()`` restores a saved state and applies the manifest's reset events in order
+(:mod:`.events`: person variant, randomised joint angles and impairment, surface targets, one of
+the precomputed start configurations, furniture noise, floor friction, and the components'
+episode starts) without reloading anything or solving IK (about a millisecond).
 
 Reproducibility: ``reset(seed=s)`` gives the same episode for the same actions, bit for bit,
 whatever the env did before — when the world has been reset or stepped since it was built, a
@@ -39,14 +40,15 @@ import pybullet as pb
 
 from ..artifact import Manifest, TermUse
 from ..references import LinkPoint
-from ..rotation import capsule_axes
 from .binding import bind
+from .component import EnvStep, Episode, EpisodeComponent
 from .drive import BaseDriveControl, FollowerControl
+from .events import Garments, TermMemories, bind_events
 from .human import PersonController
 from .markers import MarkerSystem
 from .particles import ParticleSystem
 from .snapshot import Snapshot
-from .world import PARK, World
+from .world import World
 
 
 class Features:
@@ -63,28 +65,6 @@ class Features:
         for fn, where in zip(self.fns, self.slices):
             obs[where] = fn(snap)
         return obs
-
-
-def draw_surface_point(capsules, rng: np.random.Generator) -> tuple[str, np.ndarray, np.ndarray]:
-    """A point on one of the limbs' capsules, as the reference draws an itch (paper §III-B): a limb
-    uniformly, the distance from its joint end U(r, L) along the axis, the azimuth U(0, 2π).
-    Returns (link, point, outward normal, axis away from the joint), in the link frame (m)."""
-    cap = capsules[int(rng.integers(len(capsules)))]
-    start = np.asarray(cap.start)
-    length, axis, u, v = capsule_axes(cap.start, cap.end)
-    along = rng.uniform(min(cap.radius, length), length)
-    azimuth = rng.uniform(0.0, 2 * np.pi)
-    normal = np.cos(azimuth) * u + np.sin(azimuth) * v
-    return cap.link, start + axis * along + cap.radius * normal, normal, axis
-
-
-def draw_listed_point(points, rng: np.random.Generator):
-    """One of a surface target's listed points (``PersonVariant.surface_points``): a link uniformly,
-    then one of its points uniformly (so a small link is drawn as often as a large one, as on capsules)."""
-    links = list(dict.fromkeys(p.link for p in points))
-    link = links[int(rng.integers(len(links)))]
-    on_link = [p for p in points if p.link == link]
-    return on_link[int(rng.integers(len(on_link)))]
 
 
 class AssistiveEnv(gym.Env):
@@ -141,7 +121,6 @@ class AssistiveEnv(gym.Env):
 
         self.robot_features = Features(m.observations["robot"], self.snap)
         self.reward_fns = [(t.name, t.weight, bind(t, self.snap)) for t in m.reward]
-        self._term_resets = [fn.reset for _, _, fn in self.reward_fns]
         self.markers = MarkerSystem(self.world, self.snap)
         self.success_threshold = m.success.threshold
         self.tool_point = self.snap.point(LinkPoint(body="robot", link=m.robot.links["tool_mount"]))
@@ -162,6 +141,17 @@ class AssistiveEnv(gym.Env):
         self.human_action_space = gym.spaces.Box(-1.0, 1.0, (n_human,), np.float32) if n_human else None
         self.human_features = Features(m.observations.get("human", []), self.snap)
         self.human_observation_space = self.human_features.space
+        #: The parts with per-episode state, in the order each env step runs them (:mod:`.component`).
+        self.components: dict[str, EpisodeComponent] = {
+            "person": self.human,
+            "particles": self.particles,
+            "markers": self.markers,
+            "garments": Garments(self.world),
+            "reward_terms": TermMemories([fn for _, _, fn in self.reward_fns]),
+        }
+        self._stepped = list(self.components.values())
+        #: What a reset does, in the manifest's order (:mod:`.events`).
+        self.events = bind_events(self, m.events)
 
     @classmethod
     def from_spec(
@@ -181,53 +171,34 @@ class AssistiveEnv(gym.Env):
 
     # -- Gymnasium API ------------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        """Restore the saved world and apply the manifest's reset events in order (:mod:`.events`).
+        ``options["person_variant"]`` (a variant's name) chooses the person body."""
         super().reset(seed=seed)
-        rng = self.np_random
         if seed is not None and self._used:
             self.world.rebuild()
         self._used = True
-        m, w, c = self.manifest, self.world, self.world.client
-        w.restore()
-        # Person variant: the drawn one in place, the others parked. ``options["person_variant"]``
-        # (a variant name) chooses it instead; the draw is still made, so every other draw is the seed's.
-        variant = m.person.variants[int(rng.integers(len(m.person.variants)))]
-        chosen = (options or {}).get("person_variant")
-        if chosen is not None:
-            names = [v.name for v in m.person.variants]
-            if chosen not in names:
-                raise ValueError(f"unknown person variant {chosen!r}; this task has {', '.join(names)}")
-            variant = m.person.variants[names.index(chosen)]
-        w.active_variant = variant
-        self.snap.begin_episode()
-        for i, v in enumerate(m.person.variants):
-            body = m.body(v.body)
-            parked = (PARK[0] + 10.0 * i, PARK[1], PARK[2])
-            w.set_base_frame(
-                w.variant_bodies[v.name], body.position if v.name == variant.name else parked, body.orientation
-            )
-            w.set_asleep(w.variant_bodies[v.name], v.name != variant.name)
-        person = w.variant_bodies[variant.name]
-        # Joint angles (randomised), the impairment, and the hold: all drawn and set by the person controller.
-        impairment = self.impairment = self.human.reset(variant, rng)
-        for name, offset in variant.target_offsets.items():
-            if name in self.snap.target_offsets:
-                self.snap.target_offsets[name] = np.asarray(offset, dtype=float)
-        for name, capsules in variant.surfaces.items():  # e.g. the itch: a new spot every episode
-            link, point, normal, axis = draw_surface_point(capsules, rng)
-            self.snap.place_target(name, link, point, normal, axis)
-        for name, points in variant.surface_points.items():  # the same on spheres or in a region
-            p = draw_listed_point(points, rng)
-            self.snap.place_target(name, p.link, np.asarray(p.offset), np.asarray(p.normal), np.asarray(p.axis))
-        self.markers.reset(variant)
-        for reset_term in self._term_resets:
-            reset_term()
+        self.world.restore()
+        episode = Episode(self.np_random, options or {})
+        for event in self.events:
+            event(episode)
+        assert episode.impairment is not None
+        self.impairment = episode.impairment
+        m = self.manifest
         if m.success.fraction_of is not None:
             self.success_threshold = m.success.threshold * self.markers.count(m.success.fraction_of)
-        # Robot: one precomputed start — base pose and arm configuration (no IK); the fingers are welded at the grip (compiler).
-        k = int(rng.integers(len(variant.starts)))
-        start = variant.starts[k]
-        w.set_base_frame(w.robot, start.base_position, start.base_orientation)
-        q0 = list(start.joints) + self.follow.start(start.joints) + ([0.0, 0.0, 0.0] if self.drive else [])
+        self.steps = 0
+        self.success_metric = None
+        self.snap.actions = {"robot": np.zeros(m.robot.action_size), "human": np.zeros(0)}
+        self._set_robot_base_frame()
+        self.snap.set_frame("person_base", *self.world.base_frame(self.world.variant_bodies[episode.variant.name]))
+        self.snap.refresh()
+        return self._observe(), episode.info()
+
+    def command_start(self, joints: list[float]) -> None:
+        """The arm at ``joints`` (rad, action order), its followers with it and the wheels at 0, at
+        rest, with position-control targets there (a reset's robot start)."""
+        w, c = self.world, self.world.client
+        q0 = joints + self.follow.start(joints) + ([0.0, 0.0, 0.0] if self.drive else [])
         for i, q in zip(self._command_idx, q0):
             pb.resetJointState(w.robot.id, i, q, physicsClientId=c)
         pb.setJointMotorControlArray(
@@ -239,32 +210,6 @@ class AssistiveEnv(gym.Env):
             forces=self._command_forces,
             physicsClientId=c,
         )
-        # Tools follow the hand exactly.
-        for att in m.tools:
-            link_pos, link_orn = w.link_frame(w.robot, w.robot.links[att.parent_link])
-            pos, orn = pb.multiplyTransforms(link_pos, link_orn, att.position, att.orientation)
-            w.set_base_frame(w.bodies[att.body], pos, orn)
-            pb.resetBaseVelocity(w.bodies[att.body].id, (0, 0, 0), (0, 0, 0), physicsClientId=c)
-        # Furniture carried under the robot's base (robot.mount_base: search), furniture noise and floor friction.
-        for body in m.bodies:
-            if body.carried_by_robot is not None:
-                pos, orn = pb.multiplyTransforms(start.base_position, start.base_orientation, *body.carried_by_robot)
-                w.set_base_frame(w.bodies[body.name], pos, orn)
-            if body.kind == "furniture" and any(body.position_noise):
-                noise = rng.uniform(-np.asarray(body.position_noise), np.asarray(body.position_noise))
-                w.set_base_frame(w.bodies[body.name], tuple(np.asarray(body.position) + noise), body.orientation)
-        lo, hi = m.sim.ground_friction
-        pb.changeDynamics(w.ground, -1, lateralFriction=float(rng.uniform(lo, hi)), physicsClientId=c)
-        self.particles.reset()
-        w.reset_garments()  # settled shape at the hand's held frame (after the robot is placed)
-
-        self.steps = 0
-        self.success_metric = None
-        self.snap.actions = {"robot": np.zeros(m.robot.action_size), "human": np.zeros(0)}
-        self._set_robot_base_frame()
-        self.snap.set_frame("person_base", *w.base_frame(person))
-        self.snap.refresh()
-        return self._observe(), {"person_variant": variant.name, "start": k, "impairment": impairment.info()}
 
     def step(self, action):
         """One env step of the robot; the person holds (or tremors) as the spec says."""
@@ -304,17 +249,18 @@ class AssistiveEnv(gym.Env):
         )
         # The person: held / tremoring without a human action, else its policy joints act (runtime/human.py).
         human = None if human_action is None else np.asarray(human_action, dtype=np.float64).reshape(-1)
-        self.human.apply(human, self.steps)
         self.snap.actions["human"] = np.zeros(0) if human is None else human
-        self.particles.before_physics()
+        step = EnvStep(self.steps, human)
+        for component in self._stepped:
+            component.before_physics(step)
         w.step_physics()
         self.steps += 1
         self.snap.actions["robot"] = raw
         if self.drive:  # robot_base observations are in the moving base's frame
             self._set_robot_base_frame()
         self.snap.refresh()
-        self.particles.update()
-        self.markers.update()
+        for component in self._stepped:
+            component.after_step()
 
         values = {name: float(fn(self.snap)) for name, _, fn in self.reward_fns}
         reward = float(sum(weight * values[name] for name, weight, _ in self.reward_fns))

@@ -1,8 +1,9 @@
 """The person as an agent: impairments, holds, policy control and the limits enforced on the body.
 
 :class:`PersonController` is the one place the runtime moves the person's joints. Per episode
-(:meth:`PersonController.reset`) it draws the impairment, sets the variant's joints to their
-(randomised) initial angles and holds them; per env step (:meth:`PersonController.apply`) it
+(:meth:`PersonController.reset`, the manifest's ``reset`` event of the ``person`` component) it
+draws the variant's joint angles and then the impairment, sets the joints there and holds them;
+per env step (:meth:`PersonController.before_physics`) it
 either keeps holding (no human action: the static, compliant or tremoring person of the
 single-agent task) or drives the policy joints from a human action; after every physics step
 (:meth:`PersonController.after_physics_step`, run by :meth:`World.step_physics` only when
@@ -57,8 +58,9 @@ from typing import Any
 import numpy as np
 import pybullet as pb
 
-from ..artifact import Impairment, LimitedRange, Manifest, PersonVariant, Tremor, Weakness
+from ..artifact import Impairment, LimitedRange, Manifest, Tremor, Weakness
 from ..person.arm_limits import ARM_LIMIT_JOINTS, AnalyticArmLimits, ArmLimitGuard, ArmLimitModel, MLPArmLimits
+from .component import EnvStep, Episode, EpisodeComponent
 from .world import World
 
 __all__ = ["PersonController", "draw_impairment", "arm_limit_model", "guarded_arm"]
@@ -128,7 +130,7 @@ def arm_limit_model(setting: str, artifact_dir: str | Path) -> ArmLimitModel | N
     return MLPArmLimits.from_npz(Path(artifact_dir) / setting)
 
 
-class PersonController:
+class PersonController(EpisodeComponent):
     """Moves the active person variant's joints: holds, policy actions, tremor, limits."""
 
     def __init__(self, world: World, manifest: Manifest, artifact_dir: str | Path):
@@ -154,16 +156,19 @@ class PersonController:
         self._tremor: list[tuple[int, float]] = []
 
     # -- per episode ---------------------------------------------------------------------------
-    def reset(self, variant: PersonVariant, rng: np.random.Generator) -> DrawnImpairment:
-        """Draw the episode's joint angles and impairment (in this order, from ``rng``), put the
-        variant's movable joints there and hold them. Returns the drawn impairment."""
+    def reset(self, episode: Episode) -> None:
+        """Draw the episode's joint angles and impairment (in this order, from ``episode.rng``) for
+        its person variant, put the movable joints there and hold them; the impairment goes into
+        ``episode.impairment``."""
         m, w, c = self.m, self.world, self.world.client
+        variant, rng = episode.variant, episode.rng
+        assert variant is not None, "the person's reset comes after the person_variant event"
         person = w.variant_bodies[variant.name]
         movable = variant.movable_joints
         angles = {j: variant.initial_angles[j] for j in movable}
         for j, (lo, hi) in variant.randomize.items():
             angles[j] = float(rng.uniform(lo, hi))
-        impairment = self.impairment = draw_impairment(m.person.impairments, rng)
+        impairment = self.impairment = episode.impairment = draw_impairment(m.person.impairments, rng)
         # Limits in movable order: the URDF's, narrowed to γ·limits under a limited range of motion
         # (γ·limits of a range without 0, e.g. the right shoulder_x's 5°…198°, can reach past the
         # URDF's own, which pybullet keeps enforcing: the effective range is the intersection).
@@ -231,13 +236,12 @@ class PersonController:
         if self.guard is not None:
             self.guard.reset([self.hold[k] for k in self._arm_k])
         self.world.after_physics_step = self.after_physics_step if self._static_hook else None
-        return impairment
 
     # -- per env step --------------------------------------------------------------------------
-    def apply(self, action: np.ndarray | None, step_index: int) -> None:
-        """Send this env step's motor commands: hold (``action`` None) or act on the policy joints."""
-        c = self.world.client
-        sign = 1.0 if step_index % 2 == 0 else -1.0  # the paper's tremor: q̄ + ε·(−1)^t
+    def before_physics(self, step: EnvStep) -> None:
+        """Send this env step's motor commands: hold (no human action) or act on the policy joints."""
+        c, action = self.world.client, step.human_action
+        sign = 1.0 if step.index % 2 == 0 else -1.0  # the paper's tremor: q̄ + ε·(−1)^t
         if action is None:
             if self._tremor or self._acting:
                 targets = list(self.hold)

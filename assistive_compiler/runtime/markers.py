@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pybullet as pb
 
+from .component import Episode, EpisodeComponent
 from .snapshot import Snapshot
 from .world import World, rotation_matrix
 
@@ -18,7 +19,7 @@ MARKER_RADIUS_M = 0.008
 """Radius of a marker's dot in renders, m."""
 
 
-class MarkerSystem:
+class MarkerSystem(EpisodeComponent):
     """All marker sets of a world, for the active person variant."""
 
     def __init__(self, world: World, snap: Snapshot):
@@ -30,10 +31,11 @@ class MarkerSystem:
         self.remaining: dict[str, np.ndarray] = {}
         self._groups: dict[str, list[tuple[int, np.ndarray, np.ndarray]]] = {}
 
-    def reset(self, variant) -> None:
-        """All markers of ``variant`` back, none cleared."""
+    def reset(self, episode: Episode) -> None:
+        """All markers of the episode's person variant back, none cleared."""
+        assert episode.variant is not None, "markers reset after the person_variant event"
         for ms in self.sets:
-            points = variant.markers[ms.name]
+            points = episode.variant.markers[ms.name]
             groups = []
             for link in dict.fromkeys(p.link for p in points):
                 index = np.array([k for k, p in enumerate(points) if p.link == link])
@@ -51,7 +53,7 @@ class MarkerSystem:
             out[index] = snap.pos[slot] + offsets @ rotation_matrix(snap.orn[slot]).T
         return out
 
-    def update(self) -> None:
+    def after_step(self) -> None:
         """Clear the markers near this step's contacts (after physics and the snapshot refresh)."""
         c = self.world.client
         person = self.snap.handle("person").id

@@ -49,13 +49,14 @@ import pybullet as pb
 from ..artifact import Container, ParticleSet
 from ..references import PointHandle, TargetPoint
 from ..rotation import vec_angle
+from .component import EnvStep, Episode, EpisodeComponent
 from .snapshot import ParticleEvents, Snapshot
 from .world import PARK, World, rotation_matrix
 
 _AXIS = np.array([0.0, 0.0, 1.0])  # a container's axis in its frame, towards its opening
 
 
-class ParticleSystem:
+class ParticleSystem(EpisodeComponent):
     """All particle sets of a world."""
 
     def __init__(self, world: World, snap: Snapshot):
@@ -159,7 +160,7 @@ class ParticleSystem:
         self._carry_weight(ps)
 
     # -- lifecycle -------------------------------------------------------------------------------
-    def reset(self) -> None:
+    def reset(self, episode: Episode) -> None:
         """Place every particle at its settled position in its holder's frame; all active (and
         carried, for a set that rests in a container that starts within its tilt limit and is
         carried from the reset on)."""
@@ -183,7 +184,7 @@ class ParticleSystem:
                 self._still_steps[ps.name] = 0
                 self._maybe_carry(ps, ids, settled=True)
 
-    def before_physics(self) -> None:
+    def before_physics(self, step: EnvStep) -> None:
         """At the start of an env step: simulate carried particles again if the last env step turned
         their container's apparent up too far from where they came to rest, or tilted it too far."""
         for ps, ids, _ in self.sets:
@@ -286,7 +287,7 @@ class ParticleSystem:
             else:
                 self._parked_age[pid] = (age + 1, k)
 
-    def update(self) -> None:
+    def after_step(self) -> None:
         """Evaluate this step's events (after physics, after the snapshot refresh)."""
         w, c, snap = self.world, self.world.client, self.snap
         base_velocity, closest = pb.getBaseVelocity, pb.getClosestPoints

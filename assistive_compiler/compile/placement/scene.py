@@ -117,7 +117,6 @@ def _load_furniture(
                 fixed_base=static,
                 gravity=None,
                 friction=use.friction if use.friction is not None else part.friction,
-                position_noise=rounded(use.position_noise_m),
             )
         )
     return ids, bodies
