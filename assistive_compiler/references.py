@@ -71,13 +71,6 @@ class NodeSet(_Reference):
     nodes: tuple[int, ...] = Field(description="Node indices of the generated mesh, in the set's order.")
 
 
-def point_of(resolved: dict[str, str]) -> Point:
-    """A point the resolver wrote as a dict (``{"target"}`` or ``{"body", "link"}``) as its model."""
-    if "target" in resolved:
-        return TargetPoint(target=resolved["target"])
-    return LinkPoint(body=resolved["body"], link=resolved["link"])
-
-
 ParamValue = (
     TargetPoint
     | LinkPoint

@@ -187,12 +187,9 @@ def test_scripted_right_replaces_the_main_script_on_two_arm_robots_only(tmp_path
     )
     loaded = load_spec(path)
     two, one = resolve(loaded, "pr2").scripted, resolve(loaded, "jaco").scripted
-    assert [w["to"]["link"] for w in two["waypoints"]] == ["waist"]
-    assert (
-        len(one["waypoints"]) == len(loaded.spec.scripted.waypoints)
-        and one["waypoints"][-1]["to"]["link"] == "right_shoulder"
-    )
-    assert "left" in two and "left" not in one
+    assert [w.to.link for w in two.waypoints] == ["waist"]
+    assert len(one.waypoints) == len(loaded.spec.scripted.waypoints) and one.waypoints[-1].to.link == "right_shoulder"
+    assert two.left is not None and one.left is None
 
 
 def test_two_arm_robots_sweep_with_the_left_arm_and_their_own_right_arm_script():
@@ -203,9 +200,9 @@ def test_two_arm_robots_sweep_with_the_left_arm_and_their_own_right_arm_script()
 
     loaded = load_spec(SPEC)
     one, pr2, baxter = (resolve(loaded, r).scripted for r in ("sawyer", "pr2", "baxter"))
-    assert pr2["left"]["waypoints"] == one["waypoints"] == baxter["left"]["waypoints"]
-    assert pr2["left"]["move"]["body"] == "scooper_left" and pr2["move"]["body"] == "scooper_right"
-    assert pr2["waypoints"][0]["to"]["link"] == "right_wrist" and baxter["waypoints"][0]["to"]["link"] == "waist"
+    assert pr2.left.waypoints == one.waypoints == baxter.left.waypoints
+    assert pr2.left.move.body == "scooper_left" and pr2.move.body == "scooper_right"
+    assert pr2.waypoints[0].to.link == "right_wrist" and baxter.waypoints[0].to.link == "waist"
 
 
 # --------------------------------------------------------------------------------------------

@@ -173,13 +173,13 @@ def test_scripted_per_robot_replaces_the_waypoints_for_that_robot_only(tmp_path)
     task = loaded.spec.scripted
     # Every shipped robot has a script of its own; the override replaces Sawyer's and Panda's and deletes PR2's.
     sawyer, panda, pr2 = (resolve(loaded, r).scripted for r in ("sawyer", "panda", "pr2"))
-    assert [w["to"]["link"] for w in sawyer["waypoints"]] == ["right_elbow", "right_wrist"]
-    assert sawyer["repeat_from"] == 0 and sawyer["waypoints"][1]["rpy_rad"] == pytest.approx(
-        [math.radians(-30), 0.0, math.radians(90)]
+    assert [w.to.link for w in sawyer.waypoints] == ["right_elbow", "right_wrist"]
+    assert sawyer.repeat_from == 0 and sawyer.waypoints[1].rpy_rad == pytest.approx(
+        (math.radians(-30), 0.0, math.radians(90))
     )
-    assert sawyer["move"] == pr2["move"] and panda["move"] != pr2["move"]
-    assert len(panda["waypoints"]) == 1 and panda["repeat_from"] is None
-    assert len(pr2["waypoints"]) == len(task.spliced(task.waypoints, ())) and pr2["repeat_from"] == task.repeat_from
+    assert sawyer.move == pr2.move and panda.move != pr2.move
+    assert len(panda.waypoints) == 1 and panda.repeat_from is None
+    assert len(pr2.waypoints) == len(task.spliced(task.waypoints, ())) and pr2.repeat_from == task.repeat_from
 
 
 # Jaco's bed-bathing script written out (a robot's step_m of 0.12 replaces the segments' 0.07): the spliced script
@@ -226,11 +226,8 @@ def test_segments_splice_into_the_script_they_replaced(tmp_path):
     bare.write_text(f"extends: {TASKS / 'bed_bathing.yaml'}\nscripted:\n  per_robot: {{$replace: {{}}}}\n")
     task = resolve(load_spec(bare), "jaco").scripted
     segments = shipped.spec.scripted.segments
-    assert (
-        len(task["waypoints"]) == len(segments["lane_40"]) + len(segments["onto_forearm"]) + 2
-        and task["repeat_from"] == 1
-    )
-    assert [w["offset_m"] for w in task["waypoints"][:4]] == [list(w.offset_m) for w in segments["lane_40"]]
+    assert len(task.waypoints) == len(segments["lane_40"]) + len(segments["onto_forearm"]) + 2 and task.repeat_from == 1
+    assert [w.offset_m for w in task.waypoints[:4]] == [tuple(w.offset_m) for w in segments["lane_40"]]
 
 
 def test_scripted_per_robot_step_m_replaces_the_look_ahead_of_straight_line_waypoints_only(tmp_path):
@@ -251,11 +248,11 @@ def test_scripted_per_robot_step_m_replaces_the_look_ahead_of_straight_line_wayp
     )
     loaded = load_spec(path)
     sawyer, panda = (resolve(loaded, r).scripted for r in ("sawyer", "panda"))
-    assert [{k: v for k, v in w.items() if k != "step_m"} for w in panda["waypoints"]] == [
-        {k: v for k, v in w.items() if k != "step_m"} for w in sawyer["waypoints"]
+    assert [w.model_copy(update={"step_m": None}) for w in panda.waypoints] == [
+        w.model_copy(update={"step_m": None}) for w in sawyer.waypoints
     ]
-    assert [w.get("step_m") for w in sawyer["waypoints"]] == [None, 0.07]
-    assert [w.get("step_m") for w in panda["waypoints"]] == [None, 0.12]
+    assert [w.step_m for w in sawyer.waypoints] == [None, 0.07]
+    assert [w.step_m for w in panda.waypoints] == [None, 0.12]
 
 
 def test_scripted_step_m_is_accepted_in_the_task_own_script_too(tmp_path):
@@ -273,7 +270,7 @@ def test_scripted_step_m_is_accepted_in_the_task_own_script_too(tmp_path):
     loaded = load_spec(path)
     assert loaded.spec.scripted.step_m == 0.09
     own = resolve(loaded, "jaco").scripted
-    assert [w.get("step_m") for w in own["waypoints"]] == [None, 0.09]
+    assert [w.step_m for w in own.waypoints] == [None, 0.09]
 
 
 class _capture:

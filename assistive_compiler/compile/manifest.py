@@ -41,6 +41,7 @@ from ..person.surface import SURFACE_TARGET_SPACING_M, link_surface
 from ..references import JointGroup
 from ..resolve import ResolvedTask
 from ..resolve.bodies import surface_region
+from ..resolve.resolved import ResolvedMarkerSet, SurfaceTarget
 from ..spec.models import scalar_bounds
 from ..terms.registry import SizeContext, spec_form, terms
 from ..urdf import urdf_info
@@ -88,10 +89,10 @@ def build_manifest(
         markers=[
             MarkerSet(
                 name=name,
-                tool=ms["tool"]["body"],
-                tool_link=ms["tool"]["link"],
-                radius=ms["radius_m"],
-                show_rgba=ms["show_rgba"],
+                tool=ms.tool.body,
+                tool_link=ms.tool.link,
+                radius=ms.radius_m,
+                show_rgba=ms.show_rgba,
             )
             for name, ms in rt.markers.items()
         ],
@@ -216,13 +217,14 @@ def _robot(rt: ResolvedTask, arm_joints, lower, upper, placements, welded) -> Ro
 def _targets(rt: ResolvedTask) -> dict[str, Target]:
     targets = {}
     for name, t in rt.spec.targets.items():
-        ref = rt.points[name]
+        resolved = rt.targets[name]
+        point = resolved.point if isinstance(resolved, SurfaceTarget) else resolved
         targets[name] = Target(
-            body=ref["body"],
-            link=ref["link"],
+            body=point.body,
+            link=point.link,
             offset=rounded(tuple(t.offset_m)),
             show_rgba=t.show_rgba,
-            surface="surface_links" in ref,
+            surface=isinstance(resolved, SurfaceTarget),
         )
     return targets
 
@@ -258,12 +260,13 @@ def person_variant(
     person_spec = rt.spec.person
     offsets = {}
     for tname, target in rt.spec.targets.items():
-        if rt.points.get(tname, {}).get("body") == "person":
+        resolved = rt.targets.get(tname)
+        if isinstance(resolved, SurfaceTarget) or (resolved is not None and resolved.body == "person"):
             offsets[tname] = rounded(tuple(target.offset_by_variant.get(variant, target.offset_m)))
     info = urdf_info(urdf.read_text())
-    drawn = {t: ref for t, ref in rt.points.items() if "surface_links" in ref}
+    drawn = {t: ref for t, ref in rt.targets.items() if isinstance(ref, SurfaceTarget)}
     surfaces = {
-        t: [_capsule(info.capsules, link) for link in ref["surface_links"]]
+        t: [_capsule(info.capsules, link) for link in ref.surface_links]
         for t, ref in drawn.items()
         if _drawn_on_capsules(rt, ref)
     }
@@ -300,30 +303,30 @@ def _capsule(limbs: dict, link: str) -> Capsule:
     return Capsule(link=link, start=rounded(cap.start), end=rounded(cap.end), radius=rounded(cap.radius))
 
 
-def _marker_points(rt: ResolvedTask, info, variant: str, ms: dict) -> list[MarkerPoint]:
+def _marker_points(rt: ResolvedTask, info, variant: str, ms: ResolvedMarkerSet) -> list[MarkerPoint]:
     """The markers of one set on one variant: each link's surface points ``spacing_m`` apart
     (:func:`~assistive_compiler.person.surface.link_surface`), in its region."""
-    region = surface_region(rt.spec, ms["region"], variant)
+    region = surface_region(rt.spec, ms.region, variant)
     return [
         MarkerPoint(link=p.link, offset=rounded(p.offset))
-        for link in ms["links"]
-        for p in link_surface(info, link, ms["spacing_m"], region)
+        for link in ms.links
+        for p in link_surface(info, link, ms.spacing_m, region)
     ]
 
 
-def _surface_points(rt: ResolvedTask, info, variant: str, ref: dict) -> list[SurfacePoint]:
-    region = surface_region(rt.spec, ref.get("region"), variant)
+def _surface_points(rt: ResolvedTask, info, variant: str, ref: SurfaceTarget) -> list[SurfacePoint]:
+    region = surface_region(rt.spec, ref.region, variant)
     return [
         SurfacePoint(link=p.link, offset=rounded(p.offset), normal=rounded(p.normal), axis=rounded(p.axis))
-        for link in ref["surface_links"]
+        for link in ref.surface_links
         for p in link_surface(info, link, SURFACE_TARGET_SPACING_M, region)
     ]
 
 
-def _drawn_on_capsules(rt: ResolvedTask, ref: dict) -> bool:
+def _drawn_on_capsules(rt: ResolvedTask, ref: SurfaceTarget) -> bool:
     """A surface target drawn as the reference draws an itch: plain capsules, no region."""
-    return "region" not in ref and all(
-        link in rt.person_urdf.capsules and link not in rt.person_urdf.spheres for link in ref["surface_links"]
+    return ref.region is None and all(
+        link in rt.person_urdf.capsules and link not in rt.person_urdf.spheres for link in ref.surface_links
     )
 
 

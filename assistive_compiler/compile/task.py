@@ -18,6 +18,7 @@ from ..errors import Problem, SpecError
 from ..paths import display
 from ..references import JointGroup, LinkPoint
 from ..resolve import ResolvedTask
+from ..resolve.resolved import SurfaceTarget
 from ..spec.load import LoadedSpec
 
 
@@ -92,27 +93,26 @@ def referenced_person_links(rt: ResolvedTask) -> set[str]:
     """Person links the task refers to (they must survive the merge as links of their own)."""
     found: set[str] = set()
 
-    def visit(value: Any) -> None:
-        if isinstance(value, LinkPoint):  # a term's point
-            if value.body == "person":
-                found.add(value.link)
-        elif isinstance(value, dict):  # the resolver's points (targets, the script)
-            if value.get("body") == "person" and "link" in value:
-                found.add(value["link"])
-            for v in value.values():
-                visit(v)
-        elif isinstance(value, list):
-            for v in value:
-                visit(v)
+    def visit(point: object) -> None:
+        if isinstance(point, LinkPoint) and point.body == "person":
+            found.add(point.link)
 
     for term in [*rt.reward, *(t for ts in rt.observations.values() for t in ts)]:
-        visit(term.params)
-    visit(rt.points)
-    visit(rt.scripted)
-    for ref in rt.points.values():
-        found.update(ref.get("surface_links", ()))
+        for value in term.params.values():
+            for v in value if isinstance(value, list) else [value]:
+                visit(v)
+    for target in rt.targets.values():
+        if isinstance(target, SurfaceTarget):
+            found.update(target.surface_links)
+        else:
+            visit(target)
+    script = rt.scripted
+    while script is not None:
+        for point in [script.move, *(w.to for w in script.waypoints)]:
+            visit(point)
+        script = script.left
     for ms in rt.markers.values():
-        found.update(ms["links"])
+        found.update(ms.links)
     return found
 
 

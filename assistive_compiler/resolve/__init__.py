@@ -4,7 +4,8 @@ Every name a spec uses is checked here, with a located message and a "did you me
 library parts, body names, links (semantic names for robots and tools; URDF names for the
 person), joints and joint limits, targets, particle sets, term kinds and term parameters,
 preference names, and the success term. References come out normalised so the compiler and the
-runtime never parse a spec string again (:mod:`.scope` lists their shapes).
+runtime never parse a spec string again (:mod:`.scope` lists how each kind of reference resolves;
+:mod:`.resolved` the types handed to the compiler).
 
 One module per spec section, all reporting into one :class:`~.located.Collector` (the
 :class:`~.scope.Scope` of the task on one robot): :mod:`.robot`, :mod:`.person`, :mod:`.bodies`
@@ -75,7 +76,7 @@ def resolve(loaded: LoadedSpec, robot: str | None = None, library: Library | Non
     person.check_person(s)
     robot_section.check_mount(s)
     robot_section.check_arm_rest(s)
-    points = bodies.targets(s)
+    targets = bodies.targets(s)
     markers = bodies.markers(s)
     bodies.check_particles(s)
     bodies.check_garments(s)
@@ -99,7 +100,7 @@ def resolve(loaded: LoadedSpec, robot: str | None = None, library: Library | Non
         observations=observations,
         reward=reward,
         success_threshold=threshold,
-        points=points,
+        targets=targets,
         scripted=script,
         base_goals=base_goals,
         markers=markers,

@@ -12,11 +12,13 @@ sets.
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from typing import Literal
 
 from ..errors import did_you_mean, one_of
 from ..person.surface import SURFACE_TARGET_SPACING_M, Region, link_surface
+from ..references import LinkPoint, TargetPoint
 from .located import expected
+from .resolved import RegionCentre, ResolvedMarkerSet, ResolvedRegion, ResolvedTarget, SurfaceTarget
 from .scope import RESERVED_BODIES, Scope
 
 
@@ -44,10 +46,10 @@ def name_bodies(s: Scope) -> None:
                 s.body_names[name] = section
 
 
-def targets(s: Scope) -> dict[str, dict[str, Any]]:
-    """Target name -> a point (``surface_of`` targets: the first limb, plus ``surface_links``)."""
+def targets(s: Scope) -> dict[str, ResolvedTarget]:
+    """Target name -> the link it sits on, or the person links (and region) it is drawn on."""
     spec = s.spec
-    out: dict[str, dict[str, Any]] = {}
+    out: dict[str, ResolvedTarget] = {}
     for name, target in spec.targets.items():
         if target.surface_of:
             links = s.surface_links(target.surface_of, ("targets", name, "surface_of"))
@@ -55,11 +57,9 @@ def targets(s: Scope) -> dict[str, dict[str, Any]]:
             if region and links:
                 region = _non_empty(s, region, links, SURFACE_TARGET_SPACING_M, ("targets", name, "region"))
             if links and region is not False:
-                out[name] = {"body": "person", "link": links[0], "surface_links": links} | (
-                    {"region": region} if region else {}
-                )
+                out[name] = SurfaceTarget(surface_links=tuple(links), region=region)
             continue
-        p = s.point(target.link, ("targets", name, "link"), allow_target=False)
+        p = s.link_point(target.link, ("targets", name, "link"))
         for variant in target.offset_by_variant:
             if variant not in spec.person.variants:
                 s.problem(
@@ -72,18 +72,18 @@ def targets(s: Scope) -> dict[str, dict[str, Any]]:
     return out
 
 
-def markers(s: Scope) -> dict[str, dict[str, Any]]:
+def markers(s: Scope) -> dict[str, ResolvedMarkerSet]:
     """Marker set name -> the limbs it is drawn on, the clearing tool link, radius and spacing (m)."""
     spec = s.spec
-    out: dict[str, dict[str, Any]] = {}
+    out: dict[str, ResolvedMarkerSet] = {}
     for name, ms in spec.markers.items():
         base = ("markers", name)
         if name in s.body_names or name in spec.targets:
             s.problem(base, f"marker set name '{name}' is already used by a body or target", key=True)
         links = s.surface_links(ms.surface_of, base + ("surface_of",))
         region = region_of(s, ms.region, links, base + ("region",))
-        tool = s.point(ms.cleared_by.tool, base + ("cleared_by", "tool"), allow_target=False)
-        if tool is not None and tool["body"] not in spec.tools:
+        tool = s.link_point(ms.cleared_by.tool, base + ("cleared_by", "tool"))
+        if tool is not None and tool.body not in spec.tools:
             s.problem(
                 base + ("cleared_by", "tool"),
                 f"markers are cleared by a tool link; '{ms.cleared_by.tool}' is not on a tool (tools: {one_of(spec.tools)})",
@@ -92,38 +92,38 @@ def markers(s: Scope) -> dict[str, dict[str, Any]]:
         if region and links:
             region = _non_empty(s, region, links, ms.spacing_m, base + ("region",))
         if links and tool and region is not False:
-            out[name] = {
-                "links": links,
-                "tool": tool,
-                "radius_m": ms.cleared_by.radius_m,
-                "spacing_m": ms.spacing_m,
-                "show_rgba": ms.show_rgba,
-                "region": region,
-            }
+            out[name] = ResolvedMarkerSet(
+                links=tuple(links),
+                tool=tool,
+                radius_m=ms.cleared_by.radius_m,
+                spacing_m=ms.spacing_m,
+                show_rgba=None if ms.show_rgba is None else tuple(ms.show_rgba),
+                region=region,
+            )
     return out
 
 
-def surface_region(spec, region: dict[str, Any] | None, variant: str) -> Region | None:
+def surface_region(spec, region: ResolvedRegion | None, variant: str) -> Region | None:
     """A resolved region (:func:`region_of`) on person ``variant``, in its link's frame."""
     if region is None:
         return None
     centre = None
-    if region["near"] is not None:
-        target = region["near"]["target"]
+    if region.near is not None:
+        target = region.near.target
         t = spec.targets[target] if target else None
         centre = tuple(t.offset_by_variant.get(variant, t.offset_m)) if t else (0.0, 0.0, 0.0)
     return Region(
         centre=centre,
-        radius=region["radius_m"],
-        facing=tuple(region["facing"]) if region["facing"] else None,
-        max_angle=region["max_angle_rad"],
-        along=tuple(region["along"]) if region["along"] else None,
+        radius=region.radius_m,
+        facing=region.facing,
+        max_angle=region.max_angle_rad,
+        along=region.along,
     )
 
 
 def _non_empty(
-    s: Scope, region: dict[str, Any], links: list[str], spacing: float, path: tuple
-) -> dict[str, Any] | Literal[False]:
+    s: Scope, region: ResolvedRegion, links: list[str], spacing: float, path: tuple
+) -> ResolvedRegion | Literal[False]:
     """``region``, or False and a problem when it keeps no point of the links on some person variant."""
     for variant in s.spec.person.variants:
         info = s.lib.default_urdf("people", variant)
@@ -139,28 +139,23 @@ def _non_empty(
     return region
 
 
-def region_of(s: Scope, region, links: list[str], path: tuple) -> dict[str, Any] | None | Literal[False]:
-    """A surface region resolved for the runtime: ``near`` as ``{"link", "target"}`` (the target whose
-    per-variant offset is the centre; None: the link's origin), ``facing`` as a unit vector,
+def region_of(s: Scope, region, links: list[str], path: tuple) -> ResolvedRegion | None | Literal[False]:
+    """A surface region resolved for the compiler: its centre (a link and the target whose
+    per-variant offset is the centre, or the link's origin), ``facing`` as a unit vector,
     ``max_angle_rad`` and ``along``. None when there is no region, False when it has a problem."""
     if region is None:
         return None
-    out: dict[str, Any] = {
-        "radius_m": region.radius_m,
-        "along": list(region.along) if region.along else None,
-        "max_angle_rad": math.radians(region.max_angle_deg) if region.facing is not None else None,
-        "facing": None,
-        "near": None,
-    }
+    facing = None
     ok = True
     if region.facing is not None:
         n = math.sqrt(sum(v * v for v in region.facing))
-        out["facing"] = [v / n for v in region.facing]
+        facing = (region.facing[0] / n, region.facing[1] / n, region.facing[2] / n)
+    near = None
     if region.near is not None:
         p = s.point(region.near, path + ("near",))
         if p is None:
             return False
-        target = p.get("target")
+        target = p.target if isinstance(p, TargetPoint) else None
         if target is not None:
             t = s.spec.targets[target]
             if t.surface_of:
@@ -169,11 +164,12 @@ def region_of(s: Scope, region, links: list[str], path: tuple) -> dict[str, Any]
                     f"'{region.near}' is drawn anew at every reset; a region is fixed on the link: give a landmark, a fixed target or a link",
                 )
                 return False
-            p = s.point(t.link, ("targets", target, "link"), allow_target=False)
+            p = s.link_point(t.link, ("targets", target, "link"))
             if p is None:
                 return False
-        if p["body"] != "person" or (links and p["link"] not in links):
-            on = f"person.{p['link']}" if p["body"] == "person" else f"{p['body']}.{p['link']}"
+        assert isinstance(p, LinkPoint)
+        if p.body != "person" or (links and p.link not in links):
+            on = f"{p.body}.{p.link}"
             s.problem(
                 path + ("near",),
                 f"'{region.near}' is on {on}; a region is centred on a covered link "
@@ -183,11 +179,11 @@ def region_of(s: Scope, region, links: list[str], path: tuple) -> dict[str, Any]
         if len(links) > 1:
             s.problem(
                 path + ("near",),
-                f"a region near a point covers one link, the point's (person.{p['link']}); "
-                f"surface_of names {len(links)}: give only person.{p['link']}",
+                f"a region near a point covers one link, the point's (person.{p.link}); "
+                f"surface_of names {len(links)}: give only person.{p.link}",
             )
             return False
-        out["near"] = {"link": p["link"], "target": target}
+        near = RegionCentre(link=p.link, target=target)
     if region.along is not None:
         no_capsule = [link for link in links if link not in s.person_urdf.capsules]
         if no_capsule:
@@ -197,7 +193,15 @@ def region_of(s: Scope, region, links: list[str], path: tuple) -> dict[str, Any]
                 f"(capsule links: {one_of(['person.' + link for link in s.person_urdf.capsules])})",
             )
             ok = False
-    return out if ok else False
+    if not ok:
+        return False
+    return ResolvedRegion(
+        radius_m=region.radius_m,
+        along=(region.along[0], region.along[1]) if region.along else None,
+        max_angle_rad=math.radians(region.max_angle_deg) if region.facing is not None else None,
+        facing=facing,
+        near=near,
+    )
 
 
 def check_particles(s: Scope) -> None:

@@ -10,13 +10,13 @@ robot's semantic links, the joint groups (robot arms and person groups) and the 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import Any
 
 from ..errors import did_you_mean, one_of
 from ..library import LoadedPart
 from ..references import JointGroup
 from ..spec.models import TaskSpec
 from .located import expected
+from .resolved import BaseGoal
 from .scope import Scope
 
 
@@ -219,7 +219,7 @@ def _check_searched_mount(s: Scope, mount: str | None) -> None:
                 )
 
 
-def base_goals(s: Scope) -> list[dict[str, Any]]:
+def base_goals(s: Scope) -> list[BaseGoal]:
     """The base search's goals: a resolved point, an offset (m) and the arm that should reach it."""
     spec = s.spec
     own = spec.robot.per_robot.get(s.robot_name)
@@ -229,16 +229,19 @@ def base_goals(s: Scope) -> list[dict[str, Any]]:
         else ("robot", "base_search")
     )
     search = spec.robot.search_for(s.robot_name)
-    goals = [
-        {
-            "point": s.point(g.point, where + ("goals", i, "point")),
-            "offset_m": list(g.offset_m),
-            "oriented": g.oriented,
-            "required": g.required,
-            "arm": (g.arm or "right") if len(s.sides) > 1 else s.sides[0],
-        }
-        for i, g in enumerate(search.goals)
-    ]
+    goals = []
+    for i, g in enumerate(search.goals):
+        point = s.point(g.point, where + ("goals", i, "point"))
+        if point is not None:
+            goals.append(
+                BaseGoal(
+                    point=point,
+                    offset_m=(g.offset_m[0], g.offset_m[1], g.offset_m[2]),
+                    oriented=g.oriented,
+                    required=g.required,
+                    arm=(g.arm or "right") if len(s.sides) > 1 else s.sides[0],
+                )
+            )
     for i, g in enumerate(search.goals):
         if g.arm is not None and spec.robot.arm != "both":
             s.problem(

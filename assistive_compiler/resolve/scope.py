@@ -5,8 +5,8 @@ names its sections declare, the robot's semantic links and the joint groups, and
 problems (it is a :class:`~.located.Collector`). The section passes fill it in (see
 :func:`assistive_compiler.resolve.resolve` for the order) and ask it to resolve references:
 
-* point → ``{"target": name}`` or ``{"body": body, "link": urdf_link}`` (a term's parameter: the
-  :class:`~assistive_compiler.references.TargetPoint` / ``LinkPoint`` of the same)
+* point → :class:`~assistive_compiler.references.TargetPoint` (a target's name) or ``LinkPoint``
+  (a body and its URDF link name)
 * body → body name; bodies → list of body names
 * joints → :class:`~assistive_compiler.references.JointGroup`
 * node set → :class:`~assistive_compiler.references.NodeSet`
@@ -19,7 +19,7 @@ from typing import Any
 
 from ..errors import SpecError
 from ..library import Library, LoadedPart
-from ..references import JointGroup, NodeSet, point_of
+from ..references import JointGroup, LinkPoint, NodeSet, Point, TargetPoint
 from ..spec.load import LoadedSpec
 from ..urdf import UrdfInfo
 from .located import Collector, expected
@@ -119,23 +119,29 @@ class Scope(Collector):
         )
         return True
 
-    def point(self, value: str, path: tuple, *, allow_target: bool = True) -> dict[str, Any] | None:
-        if allow_target and value in self.spec.targets:
-            return {"target": value}
+    def point(self, value: str, path: tuple) -> Point | None:
+        """A point reference: a target's name, or a body's link (:meth:`link_point`)."""
+        if value in self.spec.targets:
+            return TargetPoint(target=value)
+        return self.link_point(value, path, targets_too=True)
+
+    def link_point(self, value: str, path: tuple, *, targets_too: bool = False) -> LinkPoint | None:
+        """``body`` (its reference link) or ``body.link`` → the body and its URDF link name.
+        ``targets_too``: the problem's list of names also offers the targets (a :meth:`point`)."""
         body, _, link = value.partition(".")
         if body in self.body_names:
             body = self.tool_aliases.get(body, body)  # a one-arm robot's second name for its tool
         if body not in self.body_names or self.body_names[body] == "particles":
             pool = [b for b, s in self.body_names.items() if s != "particles"] + (
-                list(self.spec.targets) if allow_target else []
+                list(self.spec.targets) if targets_too else []
             )
-            what = "target or body" if allow_target else "body"
+            what = "target or body" if targets_too else "body"
             self.problem(path, f"unknown {what} '{value}'; {expected(pool, body)}")
             return None
         if self.conditional(body, path):
             return None
         if not link:
-            return {"body": body, "link": self.reference_link(body)}
+            return LinkPoint(body=body, link=self.reference_link(body))
         links = self.links_of(body)
         if link not in links:
             if body == "person":
@@ -143,22 +149,22 @@ class Scope(Collector):
             else:
                 self.problem(path, f"unknown link '{link}' of {body}; {expected(links, link)}")
             return None
-        return {"body": body, "link": links[link]}
+        return LinkPoint(body=body, link=links[link])
 
     def surface_links(self, refs: list[str], path: tuple) -> list[str]:
         """URDF names of person links with a collision shape (capsule or sphere) to cover."""
         out = []
         for i, ref in enumerate(refs):
-            p = self.point(ref, path + (i,), allow_target=False)
+            p = self.link_point(ref, path + (i,))
             if p is None:
                 continue
-            if p["body"] != "person" or p["link"] not in self.person_urdf.surface_links:
+            if p.body != "person" or p.link not in self.person_urdf.surface_links:
                 pool = ["person." + link for link in self.person_urdf.surface_links]
                 self.problem(
                     path + (i,), f"'{ref}' is not a person link with a collision shape; {expected(pool, ref, limit=21)}"
                 )
                 continue
-            out.append(p["link"])
+            out.append(p.link)
         return out
 
     def joints(self, value: str, path: tuple) -> JointGroup | None:
@@ -201,8 +207,7 @@ class Scope(Collector):
     def ref(self, kind: str, value: Any, path: tuple) -> Any:
         """A term parameter's reference of ``kind`` (see terms.registry.ref_fields), resolved."""
         if kind == "point":
-            resolved = self.point(value, path)
-            return None if resolved is None else point_of(resolved)
+            return self.point(value, path)
         if kind == "body":
             return self.body(value, path)
         if kind == "bodies":

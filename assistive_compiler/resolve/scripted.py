@@ -14,28 +14,29 @@ problem in a segment's waypoint is reported where the segment writes it.
 from __future__ import annotations
 
 import math
-from typing import Any
 
+from ..artifact import Script, ScriptWaypoint
 from ..spec.models import SegmentUse
 from .located import expected
 from .robot import check_per_robot_keys
 from .scope import Scope
 
 
-def scripted(s: Scope) -> dict[str, Any] | None:
+def scripted(s: Scope) -> Script | None:
+    """This robot's script (None: the task has none, or a problem was found and recorded)."""
     spec = s.spec
     if spec.scripted is None:
         return None
     check_per_robot_keys(s, ("scripted", "per_robot"), spec.scripted.per_robot)
     check_segments(s)
     own = spec.scripted.per_robot.get(s.robot_name)
-    out = (
+    main = (
         _script(s, own, ("scripted", "per_robot", s.robot_name))
         if own is not None
         else _script(s, spec.scripted, ("scripted",))
     )
-    if own is not None and own.ik_damping:
-        out["ik_damping"] = _ik_damping(s, own.ik_damping)
+    ik_damping = _ik_damping(s, own.ik_damping) if own is not None and own.ik_damping else None
+    left = None
     for side in (
         "left",
         "right",
@@ -45,10 +46,12 @@ def scripted(s: Scope) -> dict[str, Any] | None:
             continue
         resolved = _script(s, arm, ("scripted", side))
         if side == "left":
-            out["left"] = resolved
+            left = resolved
         else:
-            out.update(resolved)
-    return out
+            main = resolved
+    if main is None:
+        return None
+    return main.model_copy(update={"ik_damping": ik_damping, "left": left})
 
 
 def check_segments(s: Scope) -> None:
@@ -102,11 +105,13 @@ def _ik_damping(s: Scope, damping: dict[str, float]) -> dict[str, float]:
     return dict(damping)
 
 
-def _script(s: Scope, script, base: tuple) -> dict[str, Any]:
+def _script(s: Scope, script, base: tuple) -> Script | None:
     """One arm's script (``move``, ``waypoints``, ``repeat_from``) with segments spliced in and
-    its references resolved (each problem located where its waypoint is written)."""
+    its references resolved (each problem located where its waypoint is written); None when a
+    point is unknown (the problem is recorded)."""
     spec = s.spec
-    waypoints = []
+    waypoints: list[ScriptWaypoint] = []
+    complete = True
     step_m = getattr(script, "step_m", None)  # a robot's own script may set every straight-line waypoint's look-ahead
     for w, at in spec.scripted.spliced(script.waypoints, base + ("waypoints",)):
         to = s.point(w.to, at + ("to",))
@@ -124,25 +129,29 @@ def _script(s: Scope, script, base: tuple) -> dict[str, Any]:
         for key in used:
             if used[key] and not (w.to in spec.targets and spec.targets[w.to].surface_of):
                 s.problem(at + (key,), f"{key} needs a target drawn on a surface (surface_of); '{w.to}' is not one")
+        if to is None:
+            complete = False
+            continue
         waypoints.append(
-            {
-                "to": to,
-                "offset_m": list(w.offset_m),
-                "tolerance_m": w.tolerance_m,
-                "normal_offset_m": w.normal_offset_m,
-                "axis_offset_m": w.axis_offset_m,
-                "rpy_rad": [math.radians(a) for a in w.rpy_deg] if w.rpy_deg is not None else None,
-                "face_normal_within_rad": math.radians(w.face_normal_within_deg)
+            ScriptWaypoint(
+                to=to,
+                offset_m=(w.offset_m[0], w.offset_m[1], w.offset_m[2]),
+                tolerance_m=w.tolerance_m,
+                normal_offset_m=w.normal_offset_m,
+                axis_offset_m=w.axis_offset_m,
+                rpy_rad=tuple(math.radians(a) for a in w.rpy_deg) if w.rpy_deg is not None else None,
+                face_normal_within_rad=math.radians(w.face_normal_within_deg)
                 if w.face_normal_within_deg is not None
                 else None,
-            }
-            | (
-                {"step_m": step_m or w.step_m} if w.step_m is not None else {}
-            )  # absent when unset: other artifacts unchanged
-            | ({"face_normal_level": True} if w.face_normal_level else {})
-            | ({"turn_step_rad": math.radians(w.turn_step_deg)} if w.turn_step_deg is not None else {})
+                step_m=(step_m or w.step_m) if w.step_m is not None else None,
+                face_normal_level=w.face_normal_level,
+                turn_step_rad=math.radians(w.turn_step_deg) if w.turn_step_deg is not None else None,
+            )
         )
     move, where = (
         (script.move, base + ("move",)) if script.move is not None else (spec.scripted.move, ("scripted", "move"))
     )  # a robot's own script may keep the task's point
-    return {"move": s.point(move, where), "waypoints": waypoints, "repeat_from": script.repeat_from}
+    point = s.point(move, where)
+    if point is None or not complete:
+        return None
+    return Script(move=point, waypoints=waypoints, repeat_from=script.repeat_from)

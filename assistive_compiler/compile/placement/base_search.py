@@ -13,7 +13,9 @@ from collections import Counter
 
 import numpy as np
 
+from ...references import Point, TargetPoint
 from ...resolve import ResolvedTask
+from ...resolve.resolved import SurfaceTarget
 from ...rotation import quat_from_rpy
 from ..task import fail
 
@@ -42,29 +44,28 @@ def reach_goals(rt: ResolvedTask, pc, scene, arms: list, variant: str) -> list[t
         what = "the start pose" if len(arms) == 1 else f"the {side} arm's start pose"
         goals.append((tuple(side_start.tool_position_m), side_orn, True, what, kin, True))
     for g in rt.base_goals:
-        where = np.asarray(_point_world(pc, rt, g["point"], scene, variant)) + g["offset_m"]
-        k = rt.sides.index(g["arm"]) if g["arm"] in rt.sides else 0
+        where = np.asarray(_point_world(pc, rt, g.point, scene, variant)) + g.offset_m
+        k = rt.sides.index(g.arm) if g.arm in rt.sides else 0
         kin, _, side_orn = arms[k]
-        goals.append(
-            (tuple(where), side_orn if g["oriented"] else None, g["required"], _describe_point(g["point"]), kin, False)
-        )
+        goals.append((tuple(where), side_orn if g.oriented else None, g.required, _describe_point(g.point), kin, False))
     return goals
 
 
-def _describe_point(ref: dict) -> str:
-    return f"target '{ref['target']}'" if "target" in ref else f"{ref['body']}.{ref['link']}"
+def _describe_point(ref: Point) -> str:
+    return f"target '{ref.target}'" if isinstance(ref, TargetPoint) else f"{ref.body}.{ref.link}"
 
 
-def _point_world(pc, rt: ResolvedTask, ref, scene, variant: str) -> tuple[float, float, float]:
-    """World position of a normalised point reference in the compile-time scene."""
-    if "target" in ref:
-        target = rt.spec.targets[ref["target"]]
-        base = rt.points[ref["target"]]
+def _point_world(pc, rt: ResolvedTask, ref: Point, scene, variant: str) -> tuple[float, float, float]:
+    """World position of a point reference in the compile-time scene."""
+    if isinstance(ref, TargetPoint):
+        target = rt.spec.targets[ref.target]
+        resolved = rt.targets[ref.target]
+        base = resolved.point if isinstance(resolved, SurfaceTarget) else resolved
         offset = target.offset_by_variant.get(variant, target.offset_m)
     else:
         base, offset = ref, (0.0, 0.0, 0.0)
     body = {"person": scene.people[variant]} | scene.furniture | scene.tools
-    pos, orn = pc.named_link_pose(body[base["body"]], base["link"])
+    pos, orn = pc.named_link_pose(body[base.body], base.link)
     return tuple(pc.p.multiplyTransforms(pos, orn, tuple(offset), (0, 0, 0, 1))[0])
 
 
