@@ -31,13 +31,18 @@ def _rounded(v) -> list[float]:
     return [round(float(c), 4) + 0.0 for c in v]
 
 
+def _marker_set(env, name: str) -> dict:
+    where, _ = env.marker_state(name)
+    return {"name": name, "count": len(where), "centroid_m": _rounded(np.mean(where, axis=0)) if len(where) else None}
+
+
 def describe_scene(env) -> dict:
     """The scene of ``env`` as it is now (call after ``reset``): a JSON-able dict (see the module doc)."""
-    m, w = env.manifest, env.world
+    m = env.manifest
     reader = SceneReader(env)
     pos, quat = reader.link_poses()
-    active = w.active_variant
-    parked = {v.body for v in m.person.variants if v.name != active.name}
+    person = env.person_body
+    parked = {v.body for v in m.person.variants if v.body != person}
     bodies = []
     for body in reader.bodies:
         if body["kind"] == "garment":
@@ -56,16 +61,16 @@ def describe_scene(env) -> dict:
                     }
                 )
         bodies.append(entry)
-    person_base = next(b for b in reader.bodies if b["name"] == active.body)["links"][0]  # base link first
-    person_rot = rotation_matrix(quat[reader.links.index([active.body, person_base])])  # the person faces its base's -y
+    person_base = next(b for b in reader.bodies if b["name"] == person)["links"][0]  # base link first
+    person_rot = rotation_matrix(quat[reader.links.index([person, person_base])])  # the person faces its base's -y
     targets = reader.target_positions(pos, quat)
     out = {
         "task": m.task,
         "robot": m.robot_name,
         "gym_id": m.gym_id,
         "person": {
-            "variant": active.name,
-            "body": active.body,
+            "variant": next(v.name for v in m.person.variants if v.body == person),
+            "body": person,
             "faces": axis_direction(-person_rot[:, 1]),
             "base_link": person_base,
         },
@@ -83,21 +88,12 @@ def describe_scene(env) -> dict:
             }
             for k, name in enumerate(reader.targets)
         ],
-        "markers": [
-            {
-                "name": s.name,
-                "count": env.markers.count(s.name),
-                "centroid_m": _rounded(np.mean(env.markers.positions(s.name), axis=0))
-                if env.markers.count(s.name)
-                else None,
-            }
-            for s in m.markers
-        ],
+        "markers": [_marker_set(env, s.name) for s in m.markers],
         "particles": [
             {
                 "name": p.name,
                 "count": p.count,
-                "centroid_m": _rounded(np.mean(env.particles.shown_positions(p.name), axis=0)),
+                "centroid_m": _rounded(np.mean(env.particle_state(p.name)[0], axis=0)),
             }
             for p in m.particles
         ],

@@ -320,10 +320,13 @@ def test_pooled_contacts_follow_the_world(make_env):
 
 
 def test_food_starts_in_the_spoon_and_stays_while_still(env):
-    env.reset(seed=0)
+    _, info = env.reset(seed=0)
     bowl = env.snap.point(LinkPoint(body="spoon", link=env.manifest.tools[0].links["bowl"]))
     pos = particle_positions(env)
     assert pos.shape == (8, 3)
+    shown, active = env.particle_state("food")  # the public read: where each appears, which are in play
+    assert np.allclose(shown, pos, atol=1e-6) and active.all()
+    assert env.person_body == f"person_{info['person_variant']}" and env.arm_limit_reverts == 0
     assert np.all(np.linalg.norm(pos - where(env, bowl), axis=1) < 0.03)
     for _ in range(30):
         _, _, _, _, info = env.step(np.zeros(7))

@@ -455,7 +455,10 @@ def test_markers_lie_on_the_arm_and_are_cleared_once(bathing):
     count = len(variant.markers["wipe_spots"])
     assert env.success_threshold == pytest.approx(0.3 * count)
     # Every marker sits on its limb's capsule surface: radius from the axis, in the world.
-    where = env.markers.positions("wipe_spots")
+    where, remaining = env.marker_state("wipe_spots")
+    assert where.shape == (count, 3) and remaining.all() and env.person_body == variant.body
+    remaining[:] = False  # a copy: the env's own is untouched
+    assert env.marker_state("wipe_spots")[1].all()
     person = env.world.variant_bodies[variant.name]
     for link in ("right_shoulder", "right_elbow"):
         pos, orn = env.world.link_frame(person, person.links[link])
@@ -467,7 +470,7 @@ def test_markers_lie_on_the_arm_and_are_cleared_once(bathing):
     for _ in range(120):
         obs, _, _, _, info = env.step(policy(obs))
         cleared_total += info["terms"]["wiped"]
-        assert int((~env.markers.remaining["wipe_spots"]).sum()) == cleared_total
+        assert int((~env.marker_state("wipe_spots")[1]).sum()) == cleared_total
     assert cleared_total > 0
     assert info["success_metric"] == cleared_total
 

@@ -134,7 +134,7 @@ class AssistiveParallelEnv(ParallelEnv):
         if done:
             self.agents = []
         agents = self.possible_agents
-        infos = {"robot": info, "human": {**info, "arm_limit_reverts": self.env.human.reverts}}
+        infos = {"robot": info, "human": {**info, "arm_limit_reverts": self.env.arm_limit_reverts}}
         return (
             dict(self._obs),
             dict.fromkeys(agents, reward),

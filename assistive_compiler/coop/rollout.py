@@ -80,7 +80,7 @@ def bench_coop(artifact_dir: str | Path, steps: int = 200, repeats: int = 5, see
                 start, k = start + n, k + 1
             for name in rates:
                 rates[name].append(steps / spent[name])
-        reverts = multi.env.human.reverts
+        reverts = multi.env.arm_limit_reverts
     finally:
         single.close()
         multi.close()

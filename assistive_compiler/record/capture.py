@@ -52,7 +52,7 @@ class SceneReader:
             "markers": [
                 {
                     "name": s.name,
-                    "count": self.env.markers.count(s.name),
+                    "count": len(self.env.marker_state(s.name)[1]),
                     "radius": s.radius,
                     "rgba": list(s.show_rgba) if s.show_rgba else None,
                 }
@@ -86,7 +86,7 @@ class SceneReader:
                 out[k] = snap.position(PointHandle(snap.target_slots[name], name))
                 continue
             t = m.targets[name]
-            body = env.world.active_variant.body if t.body == "person" else t.body
+            body = env.person_body if t.body == "person" else t.body
             j = self.links.index([body, t.link])
             out[k] = pos[j] + quat_rotate(quat[j], np.asarray(t.offset, dtype=float))
         return out
@@ -97,11 +97,9 @@ class SceneReader:
         pos, quat = self.link_poses()
         row = {"link_pos": pos, "link_quat": quat, "target_pos": self.target_positions(pos, quat)}
         for ps in env.manifest.particles:
-            row[f"particles/{ps.name}"] = env.particles.shown_positions(ps.name)
-            row[f"particles_active/{ps.name}"] = env.particles.active[ps.name].copy()
+            row[f"particles/{ps.name}"], row[f"particles_active/{ps.name}"] = env.particle_state(ps.name)
         for ms in env.manifest.markers:
-            row[f"markers/{ms.name}"] = env.markers.positions(ms.name)
-            row[f"markers_remaining/{ms.name}"] = env.markers.remaining[ms.name].copy()
-        for g in env.world.garments:
-            row[f"garment/{g.name}"] = env.world.garment_nodes(g)
+            row[f"markers/{ms.name}"], row[f"markers_remaining/{ms.name}"] = env.marker_state(ms.name)
+        for name, nodes in env.garment_nodes().items():
+            row[f"garment/{name}"] = nodes
         return row

@@ -43,7 +43,7 @@ class RecordEpisodes(gym.Wrapper):
             "seed": seed,
             "person_variant": info["person_variant"],
             "start": info["start"],
-            "person_body": base.world.active_variant.body,
+            "person_body": base.person_body,
         }
         self._rows = {"observations": [np.asarray(obs, dtype=np.float32)]}
         self._add_state()

@@ -68,7 +68,24 @@ class Features:
 
 
 class AssistiveEnv(gym.Env):
-    """A compiled assistive task as a Gymnasium environment (robot acting, person static)."""
+    """A compiled assistive task as a Gymnasium environment (robot acting, person static).
+
+    What other code may use (policies, recording, description, co-optimisation, the CLI):
+
+    * the Gymnasium API and, for co-optimisation, :meth:`step_agents`, :meth:`observe_human`,
+      ``human_action_space`` and ``human_observation_space``;
+    * ``manifest`` (the compiled task), ``steps`` (env steps this episode), ``impairment`` (this
+      episode's, drawn), ``success_threshold``;
+    * the scene as it is now: :attr:`person_body`, :meth:`marker_state`, :meth:`particle_state`,
+      :meth:`garment_nodes`, :attr:`arm_limit_reverts`;
+    * for controllers, renders and benchmarks that work on the physics itself: ``world``
+      (:class:`~.world.World`: the pybullet client, body handles, link frames), ``snap`` (the
+      :class:`~.snapshot.Snapshot` every term reads, refreshed each step; read it, never write it),
+      ``arm_idx`` (the arm's pybullet joint indices, in action order) and ``drive`` (a mobile
+      base's :class:`~.drive.BaseDriveControl`, or None).
+
+    The rest (components, bound terms, command tables) is the env's own.
+    """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
 
@@ -283,6 +300,31 @@ class AssistiveEnv(gym.Env):
 
     def close(self):
         self.world.close()
+
+    # -- the scene as it is now (recording, description, co-optimisation) ----------------------
+    @property
+    def person_body(self) -> str:
+        """Body name of this episode's person variant (``person_<variant>``)."""
+        return self.world.active_variant.body
+
+    def marker_state(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """Marker set ``name``: every marker's position, (N, 3) world m (cleared ones too), and
+        which are not cleared yet, (N,) bool (a copy)."""
+        return self.markers.positions(name), self.markers.remaining[name].copy()
+
+    def particle_state(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """Particle set ``name``: where each particle appears, (N, 3) world m (removed ones are
+        parked far away), and which are still in play, (N,) bool (a copy)."""
+        return self.particles.shown_positions(name), self.particles.active[name].copy()
+
+    def garment_nodes(self) -> dict[str, np.ndarray]:
+        """Each garment's simulation-mesh node positions, (n, 3) world m."""
+        return {g.name: self.world.garment_nodes(g) for g in self.world.garments}
+
+    @property
+    def arm_limit_reverts(self) -> int:
+        """How often this episode a person's arm was put back inside its pose-dependent limits."""
+        return self.human.reverts
 
     # -- helpers -------------------------------------------------------------------------------
     def _set_robot_base_frame(self) -> None:
