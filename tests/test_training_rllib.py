@@ -264,7 +264,7 @@ def test_a_refused_authentication_token_says_so_and_names_rays_remedy(tmp_path):
     finally:
         os.killpg(head.pid, signal.SIGTERM)
         head.wait(timeout=60)
-        from test_multinode import forget_cluster
+        from ray_cluster import forget_cluster
 
         forget_cluster(port)
     assert proc.returncode == 2
