@@ -7,8 +7,9 @@ An artifact is a directory::
 
 Everything the runtime needs is here, already decided: body files and poses, the person's
 posture and which joints move, the robot's arm joints and precomputed start configurations,
-tool attachments, targets, particles with their settled positions, and the observation, reward
-and success programs with references normalised to URDF link and joint names. The runtime never
+tool attachments, targets, particles with their settled positions, the observation, reward
+and success programs with references normalised to URDF link and joint names, and what a reset
+does, as ordered events. The runtime never
 reads YAML and never searches (no IK at reset).
 
 Frames and units: positions in metres in the world frame unless a field says otherwise;
