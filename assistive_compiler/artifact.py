@@ -728,9 +728,10 @@ class Manifest(_Model):
             )
         try:
             text = path.read_text()
-            manifest = cls.model_validate_json(text)
-            if manifest.format_version != json.loads(text).get("format_version"):
-                manifest._as_written = json.loads(text)
+            manifest = cls.model_validate_json(text)  # pydantic's own messages for malformed JSON
+            written = json.loads(text)
+            if manifest.format_version != written.get("format_version"):
+                manifest._as_written = written
         except (ValueError, UnicodeDecodeError) as exc:
             raise SpecError.at(
                 str(path), f"not a readable manifest ({str(exc).splitlines()[0]}); recompile with 'compile --force'"

@@ -27,7 +27,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests"))
 
-from ray_cluster import Cluster, namespaces_unavailable  # noqa: E402
+from ray_cluster import Cluster, namespaces_unavailable, train_command  # noqa: E402
 
 CONFIG = """\
 algorithm: ppo
@@ -50,25 +50,7 @@ def run_once(root: Path, cpus: list[int], config: Path) -> float:
         for k, n in enumerate(cpus):
             cluster.add_worker(cpus=n, cluster_cpus=sum(cpus[: k + 1]))
         result = subprocess.run(
-            [
-                sys.executable,
-                "-m",
-                "assistive_compiler.cli",
-                "train",
-                str(REPO / "specs" / "tasks" / "feeding.yaml"),
-                "--robot",
-                "jaco",
-                "--config",
-                str(config),
-                "--engine",
-                "rllib",
-                "--address",
-                cluster.address,
-                "--out",
-                str(cluster.hidden / "run"),
-                "--quiet",
-                "--json",
-            ],
+            train_command(cluster.address, cluster.hidden / "run", config),
             env=cluster.driver_env,
             capture_output=True,
             text=True,

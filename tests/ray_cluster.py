@@ -15,6 +15,34 @@ import tempfile
 import time
 from pathlib import Path
 
+REPO = Path(__file__).resolve().parents[1]
+FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
+
+
+def train_command(address: str, out: Path, config: Path, *extra: str) -> list[str]:
+    """``train`` of Feeding × Jaco with ``config`` on the cluster at ``address`` (RLlib), into
+    ``out``, printing its summary as JSON; ``extra``: more options (``--coop``, ``--resume``)."""
+    return [
+        sys.executable,
+        "-m",
+        "assistive_compiler.cli",
+        "train",
+        str(FEEDING),
+        "--robot",
+        "jaco",
+        "--config",
+        str(config),
+        "--engine",
+        "rllib",
+        "--address",
+        address,
+        "--out",
+        str(out),
+        "--quiet",
+        "--json",
+        *extra,
+    ]
+
 
 def namespaces_unavailable(tmp_path: Path) -> str | None:
     """Why a worker cannot get a private mount namespace here (None: it can)."""

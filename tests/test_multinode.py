@@ -16,14 +16,12 @@ import time
 from pathlib import Path
 
 import pytest
-from ray_cluster import Cluster, namespaces_unavailable
+from ray_cluster import REPO, Cluster, namespaces_unavailable, train_command
 
 pytest.importorskip("ray", reason='needs the "train" extra (README: Training); CI installs it')
 # Ray clusters run one at a time: under pytest-xdist every Ray test goes to the same worker.
 pytestmark = pytest.mark.xdist_group("ray")
 
-REPO = Path(__file__).resolve().parents[1]
-FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
 TINY = """\
 algorithm: ppo
 network: {hidden: [32, 32]}
@@ -53,31 +51,7 @@ def cluster(tmp_path_factory):
 
 def _train(address: str, out: Path, env: dict, config: Path, *extra: str) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "assistive_compiler.cli",
-            "train",
-            str(FEEDING),
-            "--robot",
-            "jaco",
-            "--config",
-            str(config),
-            "--engine",
-            "rllib",
-            "--address",
-            address,
-            "--out",
-            str(out),
-            "--quiet",
-            "--json",
-            *extra,
-        ],
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=REPO,
+        train_command(address, out, config, *extra), env=env, capture_output=True, text=True, timeout=300, cwd=REPO
     )
 
 
@@ -107,25 +81,7 @@ def test_train_on_a_worker_that_cannot_see_the_drivers_files(cluster, coop, tmp_
 def _train_and_kill_a_node_mid_run(c: Cluster, config: Path, out: Path, node: subprocess.Popen):
     """Start ``train --address`` in the background, SIGKILL ``node`` once the run's first checkpoint
     is written (the run still going), and wait for the driver: (driver, stdout, stderr)."""
-    command = [
-        sys.executable,
-        "-m",
-        "assistive_compiler.cli",
-        "train",
-        str(FEEDING),
-        "--robot",
-        "jaco",
-        "--config",
-        str(config),
-        "--engine",
-        "rllib",
-        "--address",
-        c.address,
-        "--out",
-        str(out),
-        "--quiet",
-        "--json",
-    ]
+    command = train_command(c.address, out, config)
     driver = subprocess.Popen(
         command, env=c.driver_env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO
     )

@@ -197,7 +197,7 @@ def region_of(s: Scope, region, links: list[str], path: tuple) -> ResolvedRegion
         return False
     return ResolvedRegion(
         radius_m=region.radius_m,
-        along=(region.along[0], region.along[1]) if region.along else None,
+        along=region.along or None,
         max_angle_rad=math.radians(region.max_angle_deg) if region.facing is not None else None,
         facing=facing,
         near=near,

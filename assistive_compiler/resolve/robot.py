@@ -236,7 +236,7 @@ def base_goals(s: Scope) -> list[BaseGoal]:
             goals.append(
                 BaseGoal(
                     point=point,
-                    offset_m=(g.offset_m[0], g.offset_m[1], g.offset_m[2]),
+                    offset_m=g.offset_m,
                     oriented=g.oriented,
                     required=g.required,
                     arm=(g.arm or "right") if len(s.sides) > 1 else s.sides[0],

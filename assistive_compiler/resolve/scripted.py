@@ -135,7 +135,7 @@ def _script(s: Scope, script, base: tuple) -> Script | None:
         waypoints.append(
             ScriptWaypoint(
                 to=to,
-                offset_m=(w.offset_m[0], w.offset_m[1], w.offset_m[2]),
+                offset_m=w.offset_m,
                 tolerance_m=w.tolerance_m,
                 normal_offset_m=w.normal_offset_m,
                 axis_offset_m=w.axis_offset_m,

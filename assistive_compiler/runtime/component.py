@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
-    from ..artifact import PersonVariant, StartState
+    from ..artifact import PersonVariant
     from .human import DrawnImpairment
 
 
@@ -34,8 +34,6 @@ class Episode:
     """The person body of the episode (the ``person_variant`` event)."""
     start_index: int | None = None
     """Which of the variant's precomputed robot starts (the ``robot_start`` event)."""
-    start: StartState | None = None
-    """That start: robot base pose and arm joints."""
     impairment: DrawnImpairment | None = None
     """The person's impairment with its drawn values (the person's reset)."""
 

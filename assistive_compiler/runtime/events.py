@@ -115,7 +115,7 @@ def robot_start(env: AssistiveEnv, episode: Episode, event: RobotStartEvent) -> 
     assert episode.variant is not None, "the robot's start is drawn after the person_variant event"
     k = int(episode.rng.integers(len(episode.variant.starts)))
     start = episode.variant.starts[k]
-    episode.start_index, episode.start = k, start
+    episode.start_index = k
     w.set_base_frame(w.robot, start.base_position, start.base_orientation)
     env.command_start(list(start.joints))
     for att in m.tools:  # tools follow the hand exactly
