@@ -22,7 +22,8 @@ import pytest
 from assistive_compiler.artifact import TermUse
 from assistive_compiler.references import LinkPoint, PointHandle, TargetPoint
 from assistive_compiler.runtime.binding import bind, bind_params
-from assistive_compiler.runtime.snapshot import ParticleEvents, Snapshot
+from assistive_compiler.runtime.snapshot import Snapshot
+from assistive_compiler.terms.reads import ParticleEvents
 from assistive_compiler.terms.registry import terms
 
 REPO = Path(__file__).resolve().parents[1]

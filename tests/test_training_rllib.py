@@ -18,8 +18,8 @@ pytest.importorskip("ray", reason='needs the "train" extra (README: Training); C
 pytestmark = pytest.mark.xdist_group("ray")
 
 from assistive_compiler.cli import main  # noqa: E402 (after the importorskip)
+from assistive_compiler.run_dir import RunDir  # noqa: E402 (after the importorskip)
 from assistive_compiler.training.evaluate import evaluate  # noqa: E402 (after the importorskip)
-from assistive_compiler.training.run_dir import RunDir  # noqa: E402 (after the importorskip)
 from assistive_compiler.training.train import train  # noqa: E402 (after the importorskip)
 
 REPO = Path(__file__).resolve().parents[1]
@@ -87,8 +87,8 @@ def test_multi_agent_ppo_iteration_checkpoint_resume_evaluate(local_ray, tmp_pat
     # for the motion, but the action penalty sees them raw), and the NumPy export gives the same.
     import torch
 
+    from assistive_compiler.policies.checkpoint import RLlibPolicy
     from assistive_compiler.training.export import export_run
-    from assistive_compiler.training.rllib import RLlibPolicy
 
     pair = RLlibPolicy(checkpoint.parent / f"step_{400:010d}", coop=True, algorithm="ppo")
     with torch.no_grad():  # a head whose means leave the bounds
@@ -135,7 +135,7 @@ def test_multi_agent_sac_trains_and_exports_a_pair_that_plays_under_coop(local_r
     config.write_text(SAC_TINY)
     out = tmp_path / "feeding-coop-sac"
     figures = train(str(FEEDING), robot="jaco", config_path=str(config), coop=True, out=str(out), quiet=True)
-    assert figures["steps"] >= 100 and RunDir(out).info().training_config.algorithm == "sac"
+    assert figures["steps"] >= 100 and RunDir(out).info().algorithm == "sac"
     record = export_run(out, tmp_path / "pair", episodes=1, seed=7)
     assert record["coop"] and record["export_max_action_difference"] < 1e-4
     assert {p.name for p in (tmp_path / "pair").iterdir()} >= {"policy.json", "robot", "human"}

@@ -27,9 +27,10 @@ from assistive_compiler.cli import main
 from assistive_compiler.cli.run import rollout
 from assistive_compiler.errors import SpecError
 from assistive_compiler.policies import make_policy
+from assistive_compiler.run_dir import RunDir
 from assistive_compiler.runtime.env import AssistiveEnv
 from assistive_compiler.training.evaluate import evaluate
-from assistive_compiler.training.run_dir import RunDir, check_resumable
+from assistive_compiler.training.resume import check_resumable
 
 pytestmark = pytest.mark.slow
 
@@ -270,7 +271,7 @@ def test_sac_run_checkpoints_with_its_replay_buffer_and_resumes(sac_run, tmp_pat
     assert not (run.checkpoint_dir(400) / "replay_buffer.pkl").exists()
     assert (run.checkpoint_dir(600) / "replay_buffer.pkl").is_file()
     assert json.loads((run.checkpoint_dir(600) / "COMPLETE").read_text())["algorithm"] == "sac"
-    assert run.info().training_config.algorithm == "sac" and "ppo" not in (sac_run / "config.yaml").read_text()
+    assert run.info().algorithm == "sac" and "ppo" not in (sac_run / "config.yaml").read_text()
     copy = tmp_path / "resumed"
     shutil.copytree(sac_run, copy)
     assert (
@@ -332,9 +333,9 @@ def test_sac_resume_without_the_replay_buffer_is_refused(sac_run, tmp_path, caps
 def test_export_gives_the_checkpoints_actions_in_numpy(which, reach_run, sac_run, tmp_path):
     """An exported policy (NumPy) acts as its checkpoint does: same actions to float precision,
     the same episodes; its policy.json carries the evaluation on unseen seeds."""
+    from assistive_compiler.policies.checkpoint import SB3Policy
     from assistive_compiler.policies.mlp import MLPPolicy
     from assistive_compiler.training.export import export_run
-    from assistive_compiler.training.sb3 import SB3Policy
 
     run_dir = reach_run if which == "ppo" else sac_run
     record = export_run(run_dir, tmp_path / which, episodes=3, seed=100, label=f"{which} tiny")

@@ -16,8 +16,8 @@ from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, engine_modules, requir
 def cmd_evaluate(args: argparse.Namespace) -> int:
     from ..policies.mlp import POLICY_FILE
     from ..policies.pretrained import PREFIX
+    from ..run_dir import RunDir
     from ..training.evaluate import evaluate_exported, format_report
-    from ..training.run_dir import RunDir
 
     source = args.policy or args.run_dir
     if source is None:

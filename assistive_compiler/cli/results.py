@@ -12,7 +12,7 @@ from .common import EXIT_FAILED, EXIT_OK, engine_modules, require_extra
 
 
 def cmd_export(args: argparse.Namespace) -> int:
-    from ..training.run_dir import RunDir
+    from ..run_dir import RunDir
 
     if not require_extra(*engine_modules(RunDir(args.run_dir).info().engine)):
         return EXIT_FAILED

@@ -48,7 +48,7 @@ def make_player(name: str, env, seed: int = 0):
 
         policy, info = load_trained(name)
         if info.get("coop"):
-            from ..coop.rollout import both_agents
+            from .pair import both_agents
 
             check_fits(info, env.manifest, name, coop=True)
             return both_agents(env, policy)

@@ -21,7 +21,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import UsageError, did_you_mean, one_of
-from ..paths import data_root, display
+from ..paths import data_root
+from ..run_dir import RUN_FILE
 from .mlp import POLICY_FILE, MLPPolicy
 
 PREFIX = "pretrained:"
@@ -87,34 +88,10 @@ def load_trained(source: str):
     if (path / POLICY_FILE).is_file():
         policy = load_folder(path)
         return policy, policy.info
-    if (path / "run.json").is_file():
-        import importlib.util
+    if (path / RUN_FILE).is_file():
+        from .checkpoint import load_run
 
-        info = json.loads((path / "run.json").read_text())
-        missing = [
-            m
-            for m in ("torch", "stable_baselines3" if info["engine"] == "sb3" else "ray")
-            if importlib.util.find_spec(m) is None
-        ]
-        if missing:
-            raise UsageError(
-                f"--policy {source}: playing a run directory needs its training library ({', '.join(missing)} not "
-                "installed): install the 'train' extra (README: Training), or play its export (assistive-compiler export)"
-            )
-        from ..training.evaluate import latest_checkpoint, load_policy
-        from ..training.run_dir import RunDir
-
-        run = RunDir(path)
-        run_info = run.info()
-        steps, checkpoint = latest_checkpoint(run)
-        policy = load_policy(run_info, checkpoint)
-        return policy, {
-            "task": run_info.task,
-            "robot": run_info.robot,
-            "coop": run_info.coop,
-            "run": display(path),
-            "trained_steps": steps,
-        }
+        return load_run(path, source)
     expected = f"{one_of(BASELINES)}, {PREFIX}<task>-<robot> (shipped: {', '.join(shipped_names()) or 'none'}), a run directory or an exported policy folder"
     if path.exists():
         raise UsageError(

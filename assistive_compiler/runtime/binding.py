@@ -18,6 +18,7 @@ from ..references import (
     PointHandle,
     TargetPoint,
 )
+from ..terms.reads import SceneReads
 from ..terms.registry import BOUND_KINDS, Params, ref_fields, terms
 from .snapshot import Snapshot
 
@@ -26,7 +27,7 @@ class BoundTerm(Protocol):
     """A term ready to evaluate: ``term(snap)`` gives its value this step; ``reset()`` starts an
     episode (a no-op for terms without memory)."""
 
-    def __call__(self, snap: Snapshot) -> Any: ...
+    def __call__(self, snap: SceneReads) -> Any: ...
 
     def reset(self) -> None: ...
 
@@ -61,10 +62,10 @@ def bind_params(use: TermUse, snap: Snapshot) -> Params:
 class _Stateless:
     """A term function with its parameters bound."""
 
-    def __init__(self, fn: Callable[[Snapshot, Params], Any], params: Params):
+    def __init__(self, fn: Callable[[SceneReads, Params], Any], params: Params):
         self.fn, self.params = fn, params
 
-    def __call__(self, snap: Snapshot) -> Any:
+    def __call__(self, snap: SceneReads) -> Any:
         return self.fn(snap, self.params)
 
     def reset(self) -> None:
@@ -77,7 +78,7 @@ class _WithMemory:
     def __init__(self, cls: type, params: Params):
         self.instance, self.params = cls(), params
 
-    def __call__(self, snap: Snapshot) -> Any:
+    def __call__(self, snap: SceneReads) -> Any:
         return self.instance(snap, self.params)
 
     def reset(self) -> None:

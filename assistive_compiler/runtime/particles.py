@@ -49,8 +49,9 @@ import pybullet as pb
 from ..artifact import Container, ParticleSet
 from ..references import PointHandle, TargetPoint
 from ..rotation import vec_angle
+from ..terms.reads import ParticleEvents
 from .component import EnvStep, Episode, EpisodeComponent
-from .snapshot import ParticleEvents, Snapshot
+from .snapshot import Snapshot
 from .world import PARK, World, rotation_matrix
 
 _AXIS = np.array([0.0, 0.0, 1.0])  # a container's axis in its frame, towards its opening

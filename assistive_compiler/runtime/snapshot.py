@@ -13,31 +13,19 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pybullet as pb
 
 from ..references import JointGroup, JointsHandle, NodeSet, NodesHandle, Point, PointHandle, TargetPoint
 from ..rotation import quat_conj, quat_mul, quat_rotate  # noqa: F401  (re-exported)
+from ..terms.reads import ContactPoint, ParticleEvents, SceneReads
 from .world import BodyHandle, World, rotation_matrix
-
-ContactPoint = tuple[Any, ...]
-"""One of pybullet's contact points (getContactPoints: [5] position on A, [9] normal force, ...)."""
 
 CLOSEST_SLACK_M = (
     0.05  # closest_distance first looks this far beyond its last answer (m); any value gives the same result
 )
-
-
-@dataclass
-class ParticleEvents:
-    """What happened to a particle set during the last env step."""
-
-    consumed: int = 0
-    lost: int = 0
-    hit: int = 0
-    consumed_speed_sum: float = 0.0
 
 
 @dataclass
@@ -48,7 +36,8 @@ class _BodyReads:
 
 
 class Snapshot:
-    """Batched reads of the world for one env step, plus the step's action and events."""
+    """Batched reads of the world for one env step, plus the step's action and events: the
+    :class:`~assistive_compiler.terms.reads.SceneReads` the terms read."""
 
     def __init__(self, world: World):
         self.world = world
@@ -238,7 +227,11 @@ class Snapshot:
         return self.actions[agent]
 
     def particle_events(self, name: str) -> ParticleEvents:
-        return self.events[name]
+        events: ParticleEvents = self.events[name]
+        return events
+
+    def markers_cleared(self, name: str) -> int:
+        return int(self.events[name])
 
     def _contact_points(self, a: int, b: int) -> tuple[ContactPoint, ...]:
         key = (a, b)
@@ -325,3 +318,7 @@ class Snapshot:
             len(pb.getClosestPoints(ia, ib, distance, physicsClientId=self.world.client)) for ib in self.body_ids(b)
         )
         return self.contact_force([a], b), count
+
+
+if TYPE_CHECKING:  # mypy checks that the snapshot offers every read the terms make
+    _SNAPSHOT_READS: type[SceneReads] = Snapshot

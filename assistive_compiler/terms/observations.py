@@ -11,7 +11,7 @@ import numpy as np
 from .registry import BodiesRef, FrameRef, JointsRef, Params, PointRef, SizeContext, term
 
 if TYPE_CHECKING:
-    from ..runtime.snapshot import Snapshot
+    from .reads import SceneReads
 
 
 class PointInFrame(Params):
@@ -36,19 +36,19 @@ class ContactForce(Params):
 
 
 @term("position", "observation", PointInFrame, size=3)
-def position(snap: Snapshot, p: PointInFrame) -> np.ndarray:
+def position(snap: SceneReads, p: PointInFrame) -> np.ndarray:
     """Position of a point in ``frame`` (m)."""
     return snap.point_in_frame(p.frame, snap.position(p.of))
 
 
 @term("orientation", "observation", PointInFrame, size=4)
-def orientation(snap: Snapshot, p: PointInFrame) -> np.ndarray:
+def orientation(snap: SceneReads, p: PointInFrame) -> np.ndarray:
     """Orientation of a point's link in ``frame`` as a quaternion (x, y, z, w)."""
     return snap.quat_in_frame(p.frame, snap.orientation(p.of))
 
 
 @term("displacement", "observation", Displacement, size=3)
-def displacement(snap: Snapshot, p: Displacement) -> np.ndarray:
+def displacement(snap: SceneReads, p: Displacement) -> np.ndarray:
     """Vector from ``to`` to ``of`` (``of − to``), rotated into ``frame`` (m)."""
     return snap.vector_in_frame(p.frame, snap.position(p.of) - snap.position(p.to))
 
@@ -59,7 +59,7 @@ def _joint_size(p: Any, ctx: SizeContext) -> int:
 
 
 @term("joint_angles", "observation", JointAngles, size=_joint_size)
-def joint_angles(snap: Snapshot, p: JointAngles) -> np.ndarray:
+def joint_angles(snap: SceneReads, p: JointAngles) -> np.ndarray:
     """Joint angles of a group (rad); wrapped to [−π, π] when ``wrap`` (the robot's, as in the paper)."""
     q = snap.joint_angles(p.joints)
     if p.wrap:
@@ -68,6 +68,6 @@ def joint_angles(snap: Snapshot, p: JointAngles) -> np.ndarray:
 
 
 @term("contact_force", "observation", ContactForce, size=1)
-def contact_force_obs(snap: Snapshot, p: ContactForce) -> np.ndarray:
+def contact_force_obs(snap: SceneReads, p: ContactForce) -> np.ndarray:
     """Sum of contact normal forces between bodies ``a`` and ``b`` this step (N)."""
     return np.array([snap.contact_force(p.a, p.b)])

@@ -16,7 +16,7 @@ from .registry import BodiesRef, BodyRef, Params, ParticlesRef, PointRef, term
 
 if TYPE_CHECKING:
     from ..references import PointHandle
-    from ..runtime.snapshot import Snapshot
+    from .reads import SceneReads
 
 
 class Velocity(Params):
@@ -54,20 +54,20 @@ class Pressure(Params):
     contact_distance_m: float = Field(0.01, gt=0)
 
 
-def _tool_force(snap: Snapshot, tool: list[str], on: list[str], target: PointHandle | None, radius: float) -> float:
+def _tool_force(snap: SceneReads, tool: list[str], on: list[str], target: PointHandle | None, radius: float) -> float:
     if target is None:
         return snap.contact_force(tool, on)
     return snap.contact_force(tool, on, near=target, radius=radius)
 
 
 @term("velocity", "preference", Velocity)
-def velocity(snap: Snapshot, p: Velocity) -> float:
+def velocity(snap: SceneReads, p: Velocity) -> float:
     """C_v = −Σ‖v‖ over the listed points' linear speeds (m/s): move slowly near a person."""
     return -sum(math.hypot(*snap.velocity(point).tolist()) for point in p.of)
 
 
 @term("force_nontarget", "preference", ForceNonTarget)
-def force_nontarget(snap: Snapshot, p: ForceNonTarget) -> float:
+def force_nontarget(snap: SceneReads, p: ForceNonTarget) -> float:
     """C_f = −(F_total − F_target) (N): contact force on the person away from the task target.
 
     F_total pools the contacts of ``by`` on ``onto``. F_target is the force of ``target_tool`` within
@@ -81,32 +81,32 @@ def force_nontarget(snap: Snapshot, p: ForceNonTarget) -> float:
 
 
 @term("high_force", "preference", HighForce)
-def high_force(snap: Snapshot, p: HighForce) -> float:
+def high_force(snap: SceneReads, p: HighForce) -> float:
     """C_hf = −F if the tool's force on the person (near the target) is ≥ threshold, else 0 (N)."""
     force = _tool_force(snap, p.tool, p.onto, p.target, p.target_radius_m)
     return -float(force) if force >= p.threshold_n else 0.0
 
 
 @term("food_hit", "preference", ParticleSet)
-def food_hit(snap: Snapshot, p: ParticleSet) -> float:
+def food_hit(snap: SceneReads, p: ParticleSet) -> float:
     """C_fd = −(particles that first touched the person this step) (count): spills on the person."""
     return -float(snap.particle_events(p.particles).hit)
 
 
 @term("food_velocity", "preference", ParticleSet)
-def food_velocity(snap: Snapshot, p: ParticleSet) -> float:
+def food_velocity(snap: SceneReads, p: ParticleSet) -> float:
     """C_fdv = −Σ speeds of particles consumed this step (m/s): food entering the mouth too fast."""
     return -float(snap.particle_events(p.particles).consumed_speed_sum)
 
 
 @term("dressing_force", "preference", DressingForce)
-def dressing_force(snap: Snapshot, p: DressingForce) -> float:
+def dressing_force(snap: SceneReads, p: DressingForce) -> float:
     """C_d = −Σ‖f‖ of the garment's contact forces on the person (N)."""
     return -float(snap.contact_force(p.cloth, p.onto))
 
 
 @term("pressure", "preference", Pressure)
-def pressure(snap: Snapshot, p: Pressure) -> float:
+def pressure(snap: SceneReads, p: Pressure) -> float:
     """C_p = −Σ_tools F/n (N per contact): force spread over few contacts hurts (0 when n = 0)."""
     cost = 0.0
     for tool in p.tools:

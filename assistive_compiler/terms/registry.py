@@ -1,7 +1,8 @@
 """The term registry: reward terms, observation features and preference costs by name.
 
-A term is a small documented function ``fn(snap: Snapshot, p: ItsParams)`` of the per-step
-:class:`~assistive_compiler.runtime.snapshot.Snapshot` and its parameters. Its parameters are a
+A term is a small documented function ``fn(snap: SceneReads, p: ItsParams)`` of what it may read
+of the scene this step (:class:`~assistive_compiler.terms.reads.SceneReads`, which the runtime's
+snapshot implements) and its parameters. Its parameters are a
 strict pydantic model; fields annotated with a reference kind (:data:`PointRef`, :data:`BodyRef`,
 :data:`JointsRef`, :data:`ParticlesRef`, :data:`FrameRef`, :data:`BodiesRef`, ...) refer to things
 of the task. The model declares what the term *receives*: the handles the runtime binds the

@@ -13,7 +13,7 @@ from ..rotation import quat_rotate, vec_angle
 from .registry import BodiesRef, BodyRef, MarkersRef, NodesRef, Params, ParticlesRef, PointRef, term
 
 if TYPE_CHECKING:
-    from ..runtime.snapshot import Snapshot
+    from .reads import SceneReads
 
 
 class Distance(Params):
@@ -46,7 +46,7 @@ class ContactForce(Params):
 
 
 @term("distance", "reward", Distance)
-def distance(snap: Snapshot, p: Distance) -> float:
+def distance(snap: SceneReads, p: Distance) -> float:
     """Euclidean distance between two points (m)."""
     return math.dist(
         snap.position(p.a).tolist(), snap.position(p.b).tolist()
@@ -54,7 +54,7 @@ def distance(snap: Snapshot, p: Distance) -> float:
 
 
 @term("negative_distance_sum", "reward", DistanceSum)
-def negative_distance_sum(snap: Snapshot, p: DistanceSum) -> float:
+def negative_distance_sum(snap: SceneReads, p: DistanceSum) -> float:
     """−Σᵢ ‖aᵢ − bᵢ‖ over paired points (m; 0 when every pair coincides), e.g. the reference's arm
     manipulation r_h = −‖p_elbow − p_stomach‖ − ‖p_wrist − p_waist‖: a value whose running max a
     success threshold can bound."""
@@ -62,25 +62,25 @@ def negative_distance_sum(snap: Snapshot, p: DistanceSum) -> float:
 
 
 @term("action_norm", "reward", ActionNorm)
-def action_norm(snap: Snapshot, p: ActionNorm) -> float:
+def action_norm(snap: SceneReads, p: ActionNorm) -> float:
     """‖a‖₂ of the raw (unclipped) action of ``agent`` — the paper's action penalty input."""
     return math.hypot(*snap.action(p.agent).tolist())
 
 
 @term("particles_consumed", "reward", ParticleSet)
-def particles_consumed(snap: Snapshot, p: ParticleSet) -> float:
+def particles_consumed(snap: SceneReads, p: ParticleSet) -> float:
     """Particles of the set consumed this step (count), e.g. food that entered the mouth."""
     return float(snap.particle_events(p.particles).consumed)
 
 
 @term("particles_lost", "reward", ParticleSet)
-def particles_lost(snap: Snapshot, p: ParticleSet) -> float:
+def particles_lost(snap: SceneReads, p: ParticleSet) -> float:
     """Particles of the set lost this step (count), e.g. food spilled from the spoon."""
     return float(snap.particle_events(p.particles).lost)
 
 
 @term("contact_force", "reward", ContactForce)
-def contact_force(snap: Snapshot, p: ContactForce) -> float:
+def contact_force(snap: SceneReads, p: ContactForce) -> float:
     """Sum of contact normal forces between bodies ``a`` and ``b`` this step (N)."""
     return float(snap.contact_force(p.a, p.b))
 
@@ -113,7 +113,7 @@ class ContactEventCounter:
     def reset(self) -> None:
         self.last = None
 
-    def __call__(self, snap: Snapshot, p: ContactEvents) -> float:
+    def __call__(self, snap: SceneReads, p: ContactEvents) -> float:
         centre = snap.position(p.target).tolist()
         near = [cp for cp in snap.contacts(p.tool, p.onto) if math.dist(cp[5], centre) <= p.radius_m]
         if not near:
@@ -135,7 +135,7 @@ class Tilt(Params):
 
 
 @term("tilt", "reward", Tilt)
-def tilt(snap: Snapshot, p: Tilt) -> float:
+def tilt(snap: SceneReads, p: Tilt) -> float:
     """Angle between a link axis and a world direction (rad): 0 when a cup stands upright."""
     return vec_angle(quat_rotate(snap.orientation(p.of), p.axis), p.up)
 
@@ -147,7 +147,7 @@ class ClosestDistance(Params):
 
 
 @term("closest_distance", "reward", ClosestDistance)
-def closest_distance(snap: Snapshot, p: ClosestDistance) -> float:
+def closest_distance(snap: SceneReads, p: ClosestDistance) -> float:
     """Smallest distance between the surfaces of body ``a`` and any of ``b`` (m; ≤ 0 when touching)."""
     return snap.closest_distance(p.a, p.b, p.max_m)
 
@@ -157,9 +157,9 @@ class MarkerSet(Params):
 
 
 @term("markers_cleared", "reward", MarkerSet)
-def markers_cleared(snap: Snapshot, p: MarkerSet) -> float:
+def markers_cleared(snap: SceneReads, p: MarkerSet) -> float:
     """Markers of the set cleared this step (count), e.g. spots wiped clean."""
-    return float(snap.events[p.markers])
+    return float(snap.markers_cleared(p.markers))
 
 
 class SleeveProgress(Params):
@@ -210,7 +210,7 @@ class SleeveProgressTerm:
     def reset(self) -> None:
         self.forearm_seen = False
 
-    def __call__(self, snap: Snapshot, p: SleeveProgress) -> float:
+    def __call__(self, snap: SceneReads, p: SleeveProgress) -> float:
         from ..garment import sleeve_progress as r_dress
 
         value = r_dress(

@@ -16,6 +16,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from ..errors import SpecError, UsageError
 from ..paths import display
+from ..run_dir import RunInfo
 from ..yamlsrc import load_located
 
 
@@ -207,3 +208,8 @@ def training_schema() -> dict:
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = "assistive-compiler training config"
     return schema
+
+
+def run_config(info: RunInfo) -> TrainingConfig:
+    """The resolved training config a run directory's ``run.json`` records."""
+    return TrainingConfig.model_validate(info.config)

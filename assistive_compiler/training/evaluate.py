@@ -13,18 +13,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..coop.rollout import both_agents
 from ..episode import rollout
 from ..errors import UsageError
 from ..paths import display
-from .run_dir import RunDir, RunInfo
-
-
-def latest_checkpoint(run: RunDir) -> tuple[int, Path]:
-    found = run.latest_checkpoint()
-    if found is None:
-        raise UsageError(f"{display(run.path)}: the run has no complete checkpoint yet (checkpoints/step_*/COMPLETE)")
-    return found
+from ..policies.checkpoint import latest_checkpoint, load_policy
+from ..policies.pair import both_agents
+from ..run_dir import RunDir, RunInfo
+from .config import run_config
 
 
 def checkpoint_at(run: RunDir, steps: int | None) -> tuple[int, Path]:
@@ -36,17 +31,6 @@ def checkpoint_at(run: RunDir, steps: int | None) -> tuple[int, Path]:
         have = ", ".join(f"{s:,}" for s in done) or "none yet"
         raise UsageError(f"{display(run.path)}: no complete checkpoint at {steps:,} env steps; it has {have}")
     return steps, done[steps]
-
-
-def load_policy(info: RunInfo, checkpoint: Path):
-    """The run's policy as ``obs -> action`` (co-optimised runs: ``(robot_obs, human_obs) -> (a_r, a_h)``)."""
-    if info.engine == "sb3":
-        from .sb3 import SB3Policy
-
-        return SB3Policy(checkpoint, info.training_config.algorithm)
-    from .rllib import RLlibPolicy
-
-    return RLlibPolicy(checkpoint, coop=info.coop, algorithm=info.training_config.algorithm)
 
 
 def _stats(values: list[float]) -> tuple[float, float]:
@@ -163,7 +147,7 @@ def evaluate(
     run = RunDir(run_dir)
     info = run.info()
     steps, checkpoint = checkpoint_at(run, checkpoint_steps)
-    episodes = episodes or info.training_config.eval_episodes
+    episodes = episodes or run_config(info).eval_episodes
     policy = load_policy(info, checkpoint)
     results = play_episodes(run.artifact, policy, info.coop, episodes, seed)
     out = {
@@ -194,7 +178,7 @@ def save_evaluation(run: RunDir, result: dict) -> Path:
     """Write ``evaluation.json`` in the run directory (``table`` reads it)."""
     import json
 
-    from .run_dir import write_atomic
+    from ..run_dir import write_atomic
 
     out = run.path / "evaluation.json"
     write_atomic(out, json.dumps(result, indent=1))

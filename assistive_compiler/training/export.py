@@ -21,7 +21,8 @@ import numpy as np
 from ..errors import UsageError
 from ..paths import display
 from ..policies.mlp import MLPPolicy
-from .run_dir import RunDir
+from ..run_dir import RunDir
+from .config import run_config
 
 #: Unseen seeds of the evaluation: training seeds its envs with the config's seed (0–10 in the
 #: shipped configs, plus the step count on resume) and never resets with a seed after that.
@@ -43,7 +44,7 @@ def _layers(linears) -> list[tuple[np.ndarray, np.ndarray]]:
 
 
 def mlp_from_sb3(loaded, algorithm: str, activation: str) -> MLPPolicy:
-    """The deterministic policy of a loaded SB3 checkpoint (:class:`.sb3.SB3Policy`: SAC's actor
+    """The deterministic policy of a loaded SB3 checkpoint (:class:`~assistive_compiler.policies.checkpoint.SB3Policy`: SAC's actor
     mean through tanh; PPO's Gaussian mean, clipped), with PPO's observation normalisation if it used one."""
     model = loaded.model
     low, high = model.action_space.low, model.action_space.high
@@ -116,7 +117,7 @@ def _default_label(info) -> str:
     """``SAC (sac_laptop)``: the algorithm and the config the run was started with."""
     command = list(info.command)
     config = command[command.index("--config") + 1] if "--config" in command[:-1] else "config"
-    return f"{info.training_config.algorithm.upper()} ({Path(config).stem})"
+    return f"{info.algorithm.upper()} ({Path(config).stem})"
 
 
 def export_run(
@@ -138,17 +139,17 @@ def export_run(
     if found is None:
         raise UsageError(f"{display(run.path)}: the run has no complete checkpoint yet")
     steps, checkpoint = found
-    config = info.training_config
+    config = run_config(info)
     rng = np.random.default_rng(0)
     if info.engine == "sb3":
-        from .sb3 import SB3Policy
+        from ..policies.checkpoint import SB3Policy
 
         original = SB3Policy(checkpoint, config.algorithm)
         policy = mlp_from_sb3(original, config.algorithm, config.network.activation)
         worst = check_same_actions(policy, original, rng.normal(0.0, 1.0, (32, policy.obs_dim)))
     else:
+        from ..policies.checkpoint import SINGLE_MODULE, RLlibPolicy
         from ..policies.pretrained import CoopPolicy
-        from .rllib import SINGLE_MODULE, RLlibPolicy
 
         original = RLlibPolicy(checkpoint, info.coop, config.algorithm)
         parts = {

@@ -11,7 +11,7 @@ import time
 
 import numpy as np
 
-from .run_dir import RunDir
+from ..run_dir import RunDir
 
 CURVE_FIELDS = ("steps", "wall_s", "episodes", "mean_return", "success_rate", "steps_per_s")
 
@@ -89,8 +89,8 @@ class Progress:
         """Wall seconds and episodes of the run before this session (resumed runs). The curve is
         first cut back to the resumed checkpoint: rows written after it (and a row torn by a killed
         process) belong to training that the resumed run does again."""
+        from ..run_dir import write_atomic
         from .curves import read_curve
-        from .run_dir import write_atomic
 
         if not self.run.curve_csv.is_file():
             return 0.0, 0

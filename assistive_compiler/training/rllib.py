@@ -21,16 +21,13 @@ import socket
 import sys
 from pathlib import Path
 
-import numpy as np
-
 from ..errors import UsageError
+from ..run_dir import RunDir
 from .config import TrainingConfig
 from .progress import Progress
-from .run_dir import RunDir
 
 ENV_NAME = "assistive_compiler"
 AGENTS = ("robot", "human")
-SINGLE_MODULE = "default_policy"
 CONNECT_TIMEOUT_S = 3.0
 GCS_WAIT_VAR = "RAY_gcs_server_port_wait_time_s"
 
@@ -378,44 +375,3 @@ def env_runners_lost(algo, config: TrainingConfig) -> str | None:
         f"all {group.num_remote_env_runners()} env runners were lost (the node they ran on died or left the cluster); "
         "checkpoint written: start a worker node again and run the same command with --resume"
     )
-
-
-# --------------------------------------------------------------------------------------------
-# evaluation side
-
-
-class RLlibPolicy:
-    """A trained RLlib run's policies as plain functions (deterministic: the Gaussian's mean).
-
-    Single agent: ``obs -> action``; co-optimised: ``(robot_obs, human_obs) -> (a_robot, a_human)``.
-    Loads the RLModules from the checkpoint alone: no Ray instance is needed."""
-
-    def __init__(self, checkpoint: Path, coop: bool, algorithm: str = "ppo"):
-        from ray.rllib.core.rl_module.rl_module import RLModule
-
-        root = checkpoint / "algo" / "learner_group" / "learner" / "rl_module"
-        names = AGENTS if coop else (SINGLE_MODULE,)
-        self.modules = {name: RLModule.from_checkpoint(str((root / name).resolve())) for name in names}
-        self.coop, self.algorithm = coop, algorithm
-
-    def _act(self, name: str, obs: np.ndarray) -> np.ndarray:
-        import torch
-
-        with torch.no_grad():
-            out = self.modules[name].forward_inference({"obs": torch.as_tensor(obs, dtype=torch.float32)[None]})
-        dist = out["action_dist_inputs"][0].numpy()
-        mean = dist[: dist.shape[0] // 2]  # a diagonal Gaussian's inputs: means, then log-stds
-        space = self.modules[name].action_space
-        if self.algorithm != "sac":  # PPO's mean, clipped to the action bounds as SB3's PPO and the export clip it
-            return np.clip(mean, space.low, space.high).astype(np.float32)
-        # SAC's Gaussian is squashed by tanh into the action bounds.
-        return (space.low + 0.5 * (np.tanh(mean) + 1.0) * (space.high - space.low)).astype(np.float32)
-
-    def agent(self, name: str):
-        """One co-optimised agent's policy, ``obs -> action``."""
-        return lambda obs: self._act(name, obs)
-
-    def __call__(self, obs: np.ndarray, human_obs: np.ndarray | None = None):
-        if self.coop:
-            return self._act("robot", obs), self._act("human", human_obs)
-        return self._act(SINGLE_MODULE, obs)

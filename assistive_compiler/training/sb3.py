@@ -13,29 +13,16 @@ from __future__ import annotations
 import functools
 from pathlib import Path
 
-import numpy as np
-
 from ..episode import EpisodeTally
+from ..policies.checkpoint import algorithm_class
+from ..run_dir import RunDir
 from .config import TrainingConfig
 from .progress import Progress
-from .run_dir import RunDir
 
 ACTIVATIONS = {"tanh": "Tanh", "relu": "ReLU"}
 #: Env steps between two learning-curve rows for SAC, whose "rollouts" are single env steps.
 SAC_LOG_EVERY_STEPS = 2_000
 REPLAY_BUFFER = "replay_buffer.pkl"
-
-
-def algorithm_class(config_or_name):
-    """SB3's class for the config's algorithm (or an algorithm name)."""
-    name = getattr(config_or_name, "algorithm", config_or_name)
-    if name == "sac":
-        from stable_baselines3 import SAC
-
-        return SAC
-    from stable_baselines3 import PPO
-
-    return PPO
 
 
 def make_monitored_env(artifact_dir: str, in_worker: bool = False):
@@ -249,32 +236,3 @@ def train(
         "steps_per_s_including_learning": session_rate,
         "interrupted": interrupted,
     }
-
-
-# --------------------------------------------------------------------------------------------
-# evaluation side
-
-
-class SB3Policy:
-    """A trained SB3 policy as a function of raw observations (normalised as during training)."""
-
-    def __init__(self, checkpoint: Path, algorithm: str = "ppo"):
-        self.algorithm = algorithm
-        self.model = algorithm_class(algorithm).load(
-            str(checkpoint / "model.zip"), device="cpu", custom_objects={"replay_buffer_class": None}
-        )
-        self.obs_rms = None
-        stats = checkpoint / "vecnormalize.pkl"
-        if stats.is_file():
-            import pickle
-
-            with stats.open("rb") as f:
-                vn = pickle.load(f)
-            self.obs_rms = vn.obs_rms if vn.norm_obs else None
-            self.clip, self.eps = vn.clip_obs, vn.epsilon
-
-    def __call__(self, obs: np.ndarray) -> np.ndarray:
-        if self.obs_rms is not None:
-            obs = np.clip((obs - self.obs_rms.mean) / np.sqrt(self.obs_rms.var + self.eps), -self.clip, self.clip)
-        action, _ = self.model.predict(obs.astype(np.float32), deterministic=True)
-        return action

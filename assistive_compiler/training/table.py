@@ -15,8 +15,8 @@ import json
 from pathlib import Path
 
 from ..paths import display
+from ..run_dir import RunDir
 from .paper import PAPER, ROBOT_TITLES, ROBOTS, TASK_TITLES, TASKS
-from .run_dir import RunDir
 
 EVALUATION_FILE = "evaluation.json"
 

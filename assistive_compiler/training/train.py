@@ -15,8 +15,9 @@ from pathlib import Path
 
 from ..errors import UsageError
 from ..paths import display
-from .config import TrainingConfig, load_training_config
-from .run_dir import RunDir, check_resumable, new_run_info
+from ..run_dir import RunDir
+from .config import TrainingConfig, load_training_config, run_config
+from .resume import check_resumable, new_run_info
 
 ENGINES = ("auto", "sb3", "rllib")
 
@@ -89,7 +90,7 @@ def train(
     run = RunDir(out or default_run_dir(manifest.task, robot, coop, config.seed))
     if resume:
         info = check_resumable(run, manifest.content_hash, robot, coop, engine)
-        resumed = info.training_config
+        resumed = run_config(info)
         for flag, given, kept in (("--seed", seed, resumed.seed), ("--envs", envs, resumed.envs)):
             if given is not None and given != kept:
                 raise UsageError(

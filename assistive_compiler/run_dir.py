@@ -1,5 +1,9 @@
 """A run directory: everything one training run needs to be understood, resumed and evaluated.
 
+The on-disk format only, as :mod:`assistive_compiler.artifact` is the compiled task's: training
+writes it (:mod:`assistive_compiler.training`), and policies play its newest checkpoint
+(:mod:`assistive_compiler.policies.checkpoint`) without the training code.
+
 Layout (``runs/<task>-<robot>[-coop]-s<seed>/`` by default)::
 
     run.json          what was trained: spec, robot, co-op, engine, the compiled spec's content
@@ -19,7 +23,6 @@ import json
 import os
 import platform
 import shutil
-import sys
 import time
 from dataclasses import asdict, dataclass
 from importlib import metadata
@@ -27,10 +30,8 @@ from pathlib import Path
 
 import yaml
 
-from ..artifact import Manifest
-from ..errors import SpecError, UsageError
-from ..paths import display
-from .config import TrainingConfig
+from .errors import UsageError
+from .paths import display
 
 RUN_FILE = "run.json"
 PARTIAL = ".partial-"
@@ -79,8 +80,10 @@ class RunInfo:
     created: str
 
     @property
-    def training_config(self) -> TrainingConfig:
-        return TrainingConfig.model_validate(self.config)
+    def algorithm(self) -> str:
+        """The trained algorithm's name (``ppo``, ``sac``); the whole config is
+        :func:`assistive_compiler.training.config.run_config`."""
+        return str(self.config["algorithm"])
 
 
 class RunDir:
@@ -162,50 +165,3 @@ class RunDir:
     # -- results -------------------------------------------------------------------------------
     def write_summary(self, summary: dict) -> None:
         write_atomic(self.summary_json, json.dumps(summary, indent=1))
-
-
-def new_run_info(spec: str, manifest, robot: str, coop: bool, engine: str, config: TrainingConfig) -> RunInfo:
-    return RunInfo(
-        spec=display(Path(spec)),
-        task=manifest.task,
-        robot=robot,
-        coop=coop,
-        engine=engine,
-        content_hash=manifest.content_hash,
-        gym_id=manifest.gym_id + ("" if not coop else " (Human)"),
-        config=config.model_dump(exclude_none=True),
-        versions=package_versions(),
-        command=sys.argv[:],
-        created=time.strftime("%Y-%m-%dT%H:%M:%S"),
-    )
-
-
-def _same_content(run: RunDir, content_hash: str) -> bool:
-    """Whether the run's own, undamaged artifact has ``content_hash`` as today's compiler hashes
-    content (a run recorded before 2026-11-28 holds the older hash, which covered the compiler
-    source: the same task compiled to the same files after any compiler change would not match)."""
-    try:
-        own = Manifest.read(run.artifact)
-    except (OSError, ValueError, SpecError):  # no readable artifact: nothing to compare
-        return False
-    return own.damage(run.artifact) is None and own.hash_of(run.artifact) == content_hash
-
-
-def check_resumable(run: RunDir, content_hash: str, robot: str, coop: bool, engine: str) -> RunInfo:
-    """The run's info, after checking it trains the same compiled task the same way."""
-    info = run.info()
-    where = display(run.path / RUN_FILE)
-    if info.content_hash != content_hash and not _same_content(run, content_hash):
-        raise SpecError.at(
-            where,
-            f"--resume: this run trained a different compiled task (content hash {info.content_hash[:12]}, spec {info.spec}); "
-            f"the spec given compiles to {content_hash[:12]}. Resume with the run's own spec, or start a new run (another --out)",
-        )
-    for what, ours, theirs in (
-        ("robot", robot, info.robot),
-        ("--coop", coop, info.coop),
-        ("engine", engine, info.engine),
-    ):
-        if ours != theirs:
-            raise SpecError.at(where, f"--resume: this run was trained with {what} {theirs!r}, not {ours!r}")
-    return info

@@ -1,0 +1,135 @@
+"""Playing a training run directory's newest checkpoint: Stable-Baselines3 and RLlib checkpoints
+as plain functions of raw observations, deterministic. Needs the ``train`` extra (torch, and SB3
+or Ray); the run directory's format is :mod:`assistive_compiler.run_dir`."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import UsageError
+from ..paths import display
+from ..run_dir import RunDir, RunInfo
+
+#: RLlib's module id of a single-agent run (``ray.rllib.core.DEFAULT_MODULE_ID``).
+SINGLE_MODULE = "default_policy"
+#: A co-optimised run's modules, one per agent: the robot's, then the person's.
+PAIR = ("robot", "human")
+
+
+def algorithm_class(config_or_name):
+    """SB3's class for the config's algorithm (or an algorithm name)."""
+    name = getattr(config_or_name, "algorithm", config_or_name)
+    if name == "sac":
+        from stable_baselines3 import SAC
+
+        return SAC
+    from stable_baselines3 import PPO
+
+    return PPO
+
+
+class SB3Policy:
+    """A trained SB3 policy as a function of raw observations (normalised as during training)."""
+
+    def __init__(self, checkpoint: Path, algorithm: str = "ppo"):
+        self.algorithm = algorithm
+        self.model = algorithm_class(algorithm).load(
+            str(checkpoint / "model.zip"), device="cpu", custom_objects={"replay_buffer_class": None}
+        )
+        self.obs_rms = None
+        stats = checkpoint / "vecnormalize.pkl"
+        if stats.is_file():
+            import pickle
+
+            with stats.open("rb") as f:
+                vn = pickle.load(f)
+            self.obs_rms = vn.obs_rms if vn.norm_obs else None
+            self.clip, self.eps = vn.clip_obs, vn.epsilon
+
+    def __call__(self, obs: np.ndarray) -> np.ndarray:
+        if self.obs_rms is not None:
+            obs = np.clip((obs - self.obs_rms.mean) / np.sqrt(self.obs_rms.var + self.eps), -self.clip, self.clip)
+        action, _ = self.model.predict(obs.astype(np.float32), deterministic=True)
+        return action
+
+
+class RLlibPolicy:
+    """A trained RLlib run's policies as plain functions (deterministic: the Gaussian's mean).
+
+    Single agent: ``obs -> action``; co-optimised: ``(robot_obs, human_obs) -> (a_robot, a_human)``.
+    Loads the RLModules from the checkpoint alone: no Ray instance is needed."""
+
+    def __init__(self, checkpoint: Path, coop: bool, algorithm: str = "ppo"):
+        from ray.rllib.core.rl_module.rl_module import RLModule
+
+        root = checkpoint / "algo" / "learner_group" / "learner" / "rl_module"
+        names = PAIR if coop else (SINGLE_MODULE,)
+        self.modules = {name: RLModule.from_checkpoint(str((root / name).resolve())) for name in names}
+        self.coop, self.algorithm = coop, algorithm
+
+    def _act(self, name: str, obs: np.ndarray) -> np.ndarray:
+        import torch
+
+        with torch.no_grad():
+            out = self.modules[name].forward_inference({"obs": torch.as_tensor(obs, dtype=torch.float32)[None]})
+        dist = out["action_dist_inputs"][0].numpy()
+        mean = dist[: dist.shape[0] // 2]  # a diagonal Gaussian's inputs: means, then log-stds
+        space = self.modules[name].action_space
+        if self.algorithm != "sac":  # PPO's mean, clipped to the action bounds as SB3's PPO and the export clip it
+            return np.clip(mean, space.low, space.high).astype(np.float32)
+        # SAC's Gaussian is squashed by tanh into the action bounds.
+        return (space.low + 0.5 * (np.tanh(mean) + 1.0) * (space.high - space.low)).astype(np.float32)
+
+    def agent(self, name: str):
+        """One co-optimised agent's policy, ``obs -> action``."""
+        return lambda obs: self._act(name, obs)
+
+    def __call__(self, obs: np.ndarray, human_obs: np.ndarray | None = None):
+        if self.coop:
+            return self._act(PAIR[0], obs), self._act(PAIR[1], human_obs)
+        return self._act(SINGLE_MODULE, obs)
+
+
+def latest_checkpoint(run: RunDir) -> tuple[int, Path]:
+    """(env steps, directory) of the run's newest complete checkpoint; a clear error when it has none."""
+    found = run.latest_checkpoint()
+    if found is None:
+        raise UsageError(f"{display(run.path)}: the run has no complete checkpoint yet (checkpoints/step_*/COMPLETE)")
+    return found
+
+
+def load_policy(info: RunInfo, checkpoint: Path):
+    """The run's policy as ``obs -> action`` (co-optimised runs: ``(robot_obs, human_obs) -> (a_r, a_h)``)."""
+    if info.engine == "sb3":
+        return SB3Policy(checkpoint, info.algorithm)
+    return RLlibPolicy(checkpoint, coop=info.coop, algorithm=info.algorithm)
+
+
+def load_run(path: Path, source: str):
+    """``(policy, info)`` of the run directory ``path``'s newest checkpoint (``source``: how the
+    user named it, for messages); ``info`` has ``task``, ``robot``, ``coop``, ``run`` and
+    ``trained_steps``."""
+    import importlib.util
+
+    run = RunDir(path)
+    run_info = run.info()
+    missing = [
+        m
+        for m in ("torch", "stable_baselines3" if run_info.engine == "sb3" else "ray")
+        if importlib.util.find_spec(m) is None
+    ]
+    if missing:
+        raise UsageError(
+            f"--policy {source}: playing a run directory needs its training library ({', '.join(missing)} not "
+            "installed): install the 'train' extra (README: Training), or play its export (assistive-compiler export)"
+        )
+    steps, checkpoint = latest_checkpoint(run)
+    return load_policy(run_info, checkpoint), {
+        "task": run_info.task,
+        "robot": run_info.robot,
+        "coop": run_info.coop,
+        "run": display(path),
+        "trained_steps": steps,
+    }
