@@ -1,7 +1,7 @@
 """The person model's reference page (``docs/person.md``): every link with its collision shape and
 frame, every joint with its axis and limits, per variant where sizes differ.
 
-Written by ``assistive-compiler person-reference``; ``tests/test_person_reference.py`` keeps the
+Written by ``assistive-compiler person-reference``; ``tests/person/test_person_reference.py`` keeps the
 page equal to what the code renders, so link names, frames and limits in the docs are always the
 model's. Everything is read from the person template rendered with each variant's measurements
 (the same URDF the compiler emits), nothing from a table of its own.
@@ -73,7 +73,7 @@ def person_reference_markdown() -> str:
     lines = [
         "# The person model",
         "",
-        "<!-- written by `assistive-compiler person-reference`; tests/test_person_reference.py keeps it equal to the code -->",
+        "<!-- written by `assistive-compiler person-reference`; tests/person/test_person_reference.py keeps it equal to the code -->",
         "",
         "Every link and joint of the person (`templates/person/person.urdf.xacro`, rendered with each",
         "variant's measurements in `specs/people/`), as a spec refers to them: a point is",

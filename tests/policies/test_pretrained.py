@@ -1,0 +1,237 @@
+"""Shipped trained policies (``pretrained/``): each still succeeds on the current code as well as
+when it was exported (the regression check that tells when a physics or runtime change breaks
+one), each is small and says what it is, and every rollout command plays them by name —
+without torch: a shipped policy runs on NumPy."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import FEEDING
+from PIL import Image
+
+from assistive_compiler.cli import main
+from assistive_compiler.episode import rollout
+from assistive_compiler.policies import make_policy
+from assistive_compiler.policies.pretrained import pretrained_dir, shipped_info, shipped_names
+from assistive_compiler.runtime.env import AssistiveEnv
+
+REPO = Path(__file__).resolve().parents[2]
+SHIPPED = shipped_names()
+#: How far a shipped policy's success on its regression seeds may fall below the exported figure
+#: before the test fails: two episodes in ten. Evaluation is deterministic, so on unchanged code
+#: the figure is reproduced exactly; a change of physics or runtime moves single episodes.
+TOLERANCE = 0.2
+MAX_BYTES = 2 * 1024 * 1024
+
+
+def _env(name: str, **kwargs) -> AssistiveEnv:
+    from assistive_compiler.registration import cached_artifact_dir
+    from assistive_compiler.training.evaluate import trained_task_spec
+
+    info = shipped_info(name)
+    spec = trained_task_spec(info)
+    return AssistiveEnv.from_spec(spec, robot=info["robot"], out_dir=cached_artifact_dir(spec, info["robot"]), **kwargs)
+
+
+def test_the_jaco_cells_trained_here_ship():
+    assert {"feeding-jaco", "scratch_itch-jaco"} <= set(SHIPPED)
+    assert (REPO / "pretrained") == pretrained_dir()
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_shipped_policy_is_small_and_says_what_it_is(name):
+    folder = pretrained_dir() / name
+    assert sum(p.stat().st_size for p in folder.iterdir()) <= MAX_BYTES
+    info = shipped_info(name)
+    cell = f"{info['task']}-{info['robot']}" + ("-coop" if info["coop"] else "")
+    assert name == cell or name.startswith(f"{cell}-")  # the cell's policy, or another row of it (e.g. -ppo)
+    assert info["evaluation"]["episodes"] == 100 and info["evaluation"]["seed"] >= 1_000_000  # unseen seeds
+    assert info["trained_steps"] <= 1_000_000 and info["export_max_action_difference"] < 1e-4
+    env = _env(name)
+    if info["coop"]:  # a robot and a human policy, each fitting its agent's spaces
+        from assistive_compiler.coop.parallel import AssistiveParallelEnv
+        from assistive_compiler.policies.pretrained import load_trained
+
+        pair, _ = load_trained(f"pretrained:{name}")
+        coop = AssistiveParallelEnv(env.artifact_dir)
+        for agent in ("robot", "human"):
+            part = pair.agent(agent)
+            assert (part.obs_dim, part.action_dim) == (
+                coop.observation_space(agent).shape[0],
+                coop.action_space(agent).shape[0],
+            )
+        coop.close()
+    else:
+        policy = make_policy(f"pretrained:{name}", env)
+        assert (policy.obs_dim, policy.action_dim) == (env.observation_space.shape[0], env.action_space.shape[0])
+    env.close()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", SHIPPED)
+def test_shipped_policy_still_succeeds_on_the_current_code(name):
+    """Success on the regression seeds may fall by TOLERANCE at most, and the mean return by half
+    the evaluation's episode-to-episode spread (which also guards policies that rarely succeed)."""
+    info = shipped_info(name)
+    reg = info["regression"]
+    env = _env(name)
+    if info["coop"]:  # the pair plays both agents, as export evaluated it
+        from assistive_compiler.policies.pretrained import load_trained
+        from assistive_compiler.training.evaluate import play_episodes
+
+        pair, _ = load_trained(f"pretrained:{name}")
+        runs = play_episodes(env.artifact_dir, pair, True, reg["episodes"], reg["seed"])
+    else:
+        policy = make_policy(f"pretrained:{name}", env)
+        runs = [rollout(env, policy, reg["seed"] + k) for k in range(reg["episodes"])]
+    env.close()
+    seeds = f"seeds {reg['seed']}..{reg['seed'] + reg['episodes'] - 1}"
+    success = float(np.mean([r["success"] for r in runs]))
+    assert success >= reg["success_rate"] - TOLERANCE, (
+        f"pretrained:{name} succeeds on {success:.0%} of {seeds}, exported at {reg['success_rate']:.0%}: a physics or "
+        "runtime change broke it; retrain or re-export it"
+    )
+    mean_return = float(np.mean([r["return"] for r in runs]))
+    floor = reg["mean_return"] - 0.5 * info["evaluation"]["std_return"]
+    assert mean_return >= floor, (
+        f"pretrained:{name} returns {mean_return:.1f} on {seeds}, exported at "
+        f"{reg['mean_return']:.1f} (floor {floor:.1f}): a physics or runtime change broke it"
+    )
+
+
+def test_unknown_or_misfit_pretrained_policies_are_clear_errors(capsys):
+    assert (
+        main(["run", str(FEEDING), "--robot", "jaco", "--policy", "pretrained:feeding-jacco", "--episodes", "1"]) == 2
+    )
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: --policy pretrained:feeding-jacco: no shipped policy of that name; shipped: ")
+    assert err.endswith("(did you mean 'feeding-jaco'?)")
+    assert main(["run", str(FEEDING), "--robot", "pr2", "--policy", "pretrained:feeding-jaco", "--episodes", "1"]) == 2
+    assert (
+        capsys.readouterr()
+        .err.strip()
+        .endswith(
+            "error: --policy pretrained:feeding-jaco: trained for feeding with jaco, but the env is feeding with pr2"
+        )
+    )
+
+
+@pytest.mark.slow
+def test_every_rollout_command_plays_a_shipped_policy(capsys, tmp_path, monkeypatch):
+    """run, render, compare, evaluate, the viewer's episode and collect all play
+    pretrained:feeding-jaco, and agree on its episodes."""
+    name, seed = "feeding-jaco", 1_000_000
+    source = f"pretrained:{name}"
+    assert (
+        main(
+            [
+                "run",
+                str(FEEDING),
+                "--robot",
+                "jaco",
+                "--policy",
+                source,
+                "--episodes",
+                "2",
+                "--seed",
+                str(seed),
+                "--json",
+                "--quiet",
+            ]
+        )
+        == 0
+    )
+    report = json.loads(capsys.readouterr().out)
+    returns = [round(e["return"], 3) for e in report["episodes"]]
+    assert report["policy"] == source and returns == shipped_info(name)["evaluation"]["returns"][:2]
+
+    assert main(["evaluate", "--policy", source, "--episodes", "2", "--seed", str(seed), "--json"]) == 0
+    assert [round(e["return"], 3) for e in json.loads(capsys.readouterr().out)["per_episode"]] == returns
+
+    png = tmp_path / "feeding.png"
+    assert (
+        main(["render", str(FEEDING), "--robot", "jaco", "--policy", source, "--seed", str(seed), "--out", str(png)])
+        == 0
+    )
+    assert f"return {returns[0]:.1f}" in capsys.readouterr().out and Image.open(png).size[0] > 500
+
+    assert (
+        main(
+            [
+                "compare",
+                str(FEEDING),
+                "--robots",
+                "jaco",
+                "--policy",
+                "pretrained",
+                "--episodes",
+                "2",
+                "--seed",
+                str(seed),
+                "--json",
+            ]
+        )
+        == 0
+    )
+    row = json.loads(capsys.readouterr().out)[0]
+    assert row["return"] == round(float(np.mean(returns)), 1)
+
+    from assistive_compiler.viewer import episode_for_view
+
+    _, recording, _ = episode_for_view(str(FEEDING), "jaco", policy=source, seed=seed)
+    assert round(float(recording.arrays["rewards"].sum()), 3) == pytest.approx(returns[0], abs=1e-3)
+
+    pytest.importorskip("minari", reason='needs the "datasets" extra')
+    root = tmp_path / "minari"
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "assistive_compiler.cli",
+            "collect",
+            str(FEEDING),
+            "--robot",
+            "jaco",
+            "--policy",
+            source,
+            "--episodes",
+            "1",
+            "--seed",
+            str(seed),
+            "--out",
+            "assistive_compiler/feeding-jaco/sac-v0",
+            "--root",
+            str(root),
+            "--quiet",
+        ],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert result.returncode == 0, result.stderr
+    import minari
+
+    monkeypatch.setenv("MINARI_DATASETS_PATH", str(root))
+    dataset = minari.load_dataset("assistive_compiler/feeding-jaco/sac-v0")
+    episode = next(dataset.iterate_episodes())
+    assert round(float(episode.rewards.sum()), 3) == pytest.approx(returns[0], abs=1e-3)
+    assert dataset.storage.metadata["assistive_compiler"]["policy"] == source
+
+
+def test_a_shipped_policy_runs_without_torch(tmp_path):
+    code = (
+        "import sys; sys.modules['torch'] = None; sys.modules['stable_baselines3'] = None\n"
+        "from assistive_compiler.cli import main\n"
+        f"sys.exit(main(['run', {str(FEEDING)!r}, '--robot', 'jaco', '--policy', 'pretrained:feeding-jaco', "
+        "'--episodes', '1', '--quiet']))"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=REPO)
+    assert proc.returncode == 0, proc.stderr
+    assert "policy=pretrained:feeding-jaco" in proc.stdout

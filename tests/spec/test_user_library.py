@@ -1,0 +1,137 @@
+"""A user's own library: the README's "Write your own task" walkthrough run through the real CLI
+in a folder outside the package, and the lookup rule (``--library``, ``$ASSISTIVE_COMPILER_LIBRARY``,
+the spec's own library, ``make(..., library=[...])``) with its collision and missing-folder errors."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+from helpers import cli
+
+from assistive_compiler.errors import SpecError
+from assistive_compiler.library import LIBRARY_ENV, Library
+from assistive_compiler.paths import specs_dir
+from assistive_compiler.spec.load import load_spec
+
+README = Path(__file__).resolve().parents[2] / "README.md"
+
+
+def walkthrough_files() -> dict[str, str]:
+    """path -> text of each file the README's walkthrough shows (``<!-- walkthrough file: P -->``)."""
+    text = README.read_text()
+    return {m[1]: m[2] for m in re.finditer(r"<!-- walkthrough file: (\S+) -->\n```\w*\n(.*?)```", text, re.S)}
+
+
+def walkthrough_commands() -> list[list[str]]:
+    block = re.search(r"<!-- walkthrough commands -->\n```bash\n(.*?)```", README.read_text(), re.S)[1]
+    return [line.split()[1:] for line in block.strip().splitlines()]
+
+
+def write_project(root: Path) -> Path:
+    for rel, body in walkthrough_files().items():
+        (root / rel).parent.mkdir(parents=True, exist_ok=True)
+        (root / rel).write_text(body)
+    return root / "myproject"
+
+
+@pytest.mark.slow
+def test_readme_walkthrough_runs_through_the_cli_outside_the_package(tmp_path):
+    write_project(tmp_path)
+    commands = walkthrough_commands()
+    assert [c[0] for c in commands] == ["validate", "compile", "run", "render"]
+    outputs = []
+    for command in commands:
+        status, out, err = cli(*command, cwd=tmp_path)
+        assert status == 0, (command, err)
+        outputs.append(out)
+    assert "ok (task 'long_scratch', robots: jaco, panda)" in outputs[0]
+    assert "long_scratch for jaco" in outputs[1]
+    assert (
+        "long_scratch for jaco  policy=scripted" in outputs[2]
+    )  # a user's spec has no id of its own (it is made as Task-v1)
+    assert (tmp_path / "long_scratch.png").stat().st_size > 10_000
+    tool = tmp_path / "build" / "long_scratch" / "urdf"
+    urdf = next(p for p in tool.glob("*.urdf") if "long_scratcher" in p.read_text())
+    assert '<joint name="tip_joint"' in urdf.read_text()  # the user's template, not the shipped scratcher
+
+
+def test_a_library_outside_the_spec_folder_is_found_with_library_and_the_environment(tmp_path):
+    project = write_project(tmp_path)
+    parts = tmp_path / "elsewhere" / "parts"
+    parts.mkdir(parents=True)
+    shutil.move(project / "specs" / "tools", parts / "tools")
+    shutil.move(project / "templates", tmp_path / "elsewhere" / "templates")
+    spec = str(project / "specs" / "tasks" / "long_scratch.yaml")
+    status, _, err = cli("validate", spec, cwd=tmp_path)
+    assert status == 2 and "unknown tool 'long_scratcher'" in err
+    status, out, err = cli("validate", spec, "--library", str(parts), cwd=tmp_path)
+    assert status == 0, err
+    # One folder too high: the message names the folders it looked in and the one that has tools/.
+    status, _, err = cli("validate", spec, "--library", str(parts.parent), cwd=tmp_path)
+    assert status == 2 and "unknown tool 'long_scratcher'" in err
+    assert (
+        "(looked in elsewhere/tools/ (no such folder), " in err
+        and "; elsewhere/parts/ holds tools/: use it as the library)" in err
+    ), err
+    status, out, err = cli("validate", spec, cwd=tmp_path, env={LIBRARY_ENV: str(parts)})
+    assert status == 0, err
+    status, _, err = cli("validate", spec, "--library", str(tmp_path / "nope"), cwd=tmp_path)
+    assert (
+        status == 2
+        and err.strip()
+        == f"{tmp_path / 'nope'}:1:1: --library: folder not found (expected a folder holding robots/, tools/, furniture/ or people/)"
+    )
+
+
+def test_python_make_finds_the_same_parts(tmp_path, monkeypatch):
+    import assistive_compiler
+
+    project = write_project(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    env = assistive_compiler.make(project / "specs" / "tasks" / "long_scratch.yaml", "jaco", out_dir=tmp_path / "out")
+    assert env.manifest.gym_id == "assistive_compiler/Task-v1" and env.manifest.label == "long_scratch for jaco"
+    assert any(
+        b.name == "scratcher" and "long_scratcher" in (tmp_path / "out" / b.urdf).read_text()
+        for b in env.manifest.bodies
+    )
+    env.close()
+
+
+def test_a_part_name_in_two_libraries_is_an_error_naming_both_files(tmp_path):
+    project = write_project(tmp_path)
+    mine = project / "specs" / "tools" / "scratcher.yaml"
+    mine.write_text((specs_dir() / "tools" / "scratcher.yaml").read_text())
+    spec = project / "specs" / "tasks" / "long_scratch.yaml"
+    spec.write_text(spec.read_text().replace("part: long_scratcher, grip: scratcher", "part: scratcher"))
+    status, _, err = cli("validate", str(spec), cwd=tmp_path)
+    assert status == 2
+    mine = "myproject/specs/tools/scratcher.yaml"  # shown relative to the working directory
+    assert (
+        f"{mine}:1:1: tool 'scratcher' is defined in more than one library: {mine} and {specs_dir() / 'tools' / 'scratcher.yaml'}; "
+        "part names must be unique, rename one" in err
+    )
+
+
+def test_library_roots_are_explicit_then_environment_then_the_spec_own_then_shipped(tmp_path, monkeypatch):
+    project = write_project(tmp_path)
+    extra, from_env = tmp_path / "a", tmp_path / "b"
+    extra.mkdir(), from_env.mkdir()
+    monkeypatch.setenv(LIBRARY_ENV, str(from_env))
+    lib = Library.for_spec(project / "specs" / "tasks" / "long_scratch.yaml", [extra])
+    assert lib.roots == [extra, from_env, (project / "specs").resolve(), specs_dir()]
+    assert Library.for_spec(specs_dir() / "tasks" / "feeding.yaml").roots == [from_env, specs_dir()]
+
+
+def test_a_tool_grip_that_the_robot_lacks_is_located(tmp_path):
+    project = write_project(tmp_path)
+    spec = project / "specs" / "tasks" / "long_scratch.yaml"
+    spec.write_text(spec.read_text().replace("grip: scratcher", "grip: scratchr"))
+    with pytest.raises(SpecError) as info:
+        from assistive_compiler.resolve import validate_all_robots
+
+        validate_all_robots(load_spec(spec))
+    assert "robot 'jaco' has no grip 'scratchr' for tool 'scratcher'" in str(info.value)
+    assert "(did you mean 'scratcher'?)" in str(info.value)

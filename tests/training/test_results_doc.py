@@ -1,0 +1,61 @@
+"""docs/results.md is what ``assistive-compiler results`` writes from the shipped policies: its
+generated block equals the block made from ``pretrained/*/policy.json`` now, and every picture it
+shows exists."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from assistive_compiler.training.results import BEGIN, END, results_block, shipped_records, update_doc
+
+REPO = Path(__file__).resolve().parents[2]
+DOC = REPO / "docs" / "results.md"
+
+
+def test_results_doc_is_regenerated_from_the_shipped_policies():
+    text = DOC.read_text()
+    assert text.count(BEGIN) == 1 and text.count(END) == 1
+    assert update_doc(DOC, shipped_records()) == text, "run `assistive-compiler results` and commit docs/results.md"
+
+
+def test_every_shipped_cell_has_its_curve_and_picture():
+    block = results_block(shipped_records())
+    pictures = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", block)
+    assert len(pictures) == 2 * len(shipped_records())
+    for picture in pictures:
+        assert (DOC.parent / picture).is_file(), picture
+
+
+def test_the_block_reports_the_papers_figures_beside_ours():
+    records = shipped_records()
+    block = results_block(records)
+    feeding = next(r for r in records if r["name"] == "feeding-jaco")
+    e = feeding["evaluation"]
+    row = next(line for line in block.splitlines() if line.startswith("| Feeding | Jaco |"))
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[3] == f"{feeding['trained_steps']:,}"
+    assert cells[6:9] == [
+        f"{e['mean_return']:.1f} ± {e['std_return']:.1f}",
+        f"{100 * e['success_rate']:.0f}%",
+        f"{e['mean_force_on_human_n']:.2f}",
+    ]
+    assert cells[9:11] == ["83.8", "88%"]  # the paper's Table I: Jaco's Feeding return, the best robot's success
+    assert "### Table II (active person, co-optimisation)" in block
+
+
+def test_the_claim_pairs_a_coop_cell_with_the_static_cell_of_its_algorithm():
+    """§V-B: a co-optimised PPO cell is set beside the static PPO cell (not the SAC one), with
+    each cell's budget."""
+    import copy
+
+    records = shipped_records()
+    static_ppo = next(r for r in records if r["name"] == "feeding-jaco-ppo")
+    coop = copy.deepcopy(static_ppo)
+    coop.update(name="feeding-jaco-coop", coop=True, trained_steps=360_000)
+    coop["evaluation"] = {**coop["evaluation"], "success_rate": 0.81}
+    block = results_block(records + [coop])
+    claim = block[block.index("### The paper's claim") : block.index("### Each cell")]
+    static_cell = f"{100 * static_ppo['evaluation']['success_rate']:.0f}% ({static_ppo['trained_steps']:,} steps)"
+    assert f"| Feeding | Jaco | PPO | {static_cell} | 81% (360,000 steps) |" in claim
+    assert "Not measured yet" in results_block([r for r in records if not r["coop"]])

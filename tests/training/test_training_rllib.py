@@ -1,0 +1,275 @@
+"""Ray RLlib: multi-agent PPO (policies robot and human) on a co-optimised task against a local
+Ray instance the test starts — one tiny iteration, a checkpoint, a resume, an evaluation of the
+checkpoint — and an unreachable cluster address failing fast with a message."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+pytest.importorskip("ray", reason='needs the "train" extra (README: Training); CI installs it')
+# Meant to run Ray clusters one at a time on one xdist worker; --dist loadgroup is a no-op under
+# pytest 9.2 with xdist 3.8 (the group never reaches the scheduler), so the clusters do overlap.
+pytestmark = pytest.mark.xdist_group("ray")
+
+from assistive_compiler.cli import main  # noqa: E402 (after the importorskip)
+from assistive_compiler.run_dir import RunDir  # noqa: E402 (after the importorskip)
+from assistive_compiler.training.evaluate import evaluate  # noqa: E402 (after the importorskip)
+from assistive_compiler.training.train import train  # noqa: E402 (after the importorskip)
+
+REPO = Path(__file__).resolve().parents[2]
+FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
+REACH = REPO / "specs" / "examples" / "reach.yaml"
+
+TINY = """\
+algorithm: ppo
+network: {hidden: [32, 32]}
+ppo: {rollout_steps: 200, minibatch_size: 100, epochs: 2, normalize_observations: false, normalize_rewards: false}
+total_steps: 200
+envs: 1
+checkpoint_every_steps: 200
+eval_episodes: 1
+"""
+
+
+@pytest.fixture(scope="module")
+def local_ray():
+    import ray
+
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    yield
+    ray.shutdown()
+
+
+@pytest.mark.slow
+def test_multi_agent_ppo_iteration_checkpoint_resume_evaluate(local_ray, tmp_path):
+    config = tmp_path / "tiny.yaml"
+    config.write_text(TINY)
+    out = tmp_path / "feeding-coop"
+    first = train(str(FEEDING), robot="jaco", config_path=str(config), coop=True, out=str(out), quiet=True)
+    run = RunDir(out)
+    info = run.info()
+    assert (info.engine, info.coop, first["steps"]) == ("rllib", True, 200)
+    steps, checkpoint = run.latest_checkpoint()
+    modules = checkpoint / "algo" / "learner_group" / "learner" / "rl_module"
+    assert steps == 200 and (modules / "robot").is_dir() and (modules / "human").is_dir()
+
+    # A driver killed while writing its next checkpoint leaves a partial directory and a torn curve row.
+    partial = run.checkpoints / ".partial-step_0000000400"
+    (partial / "algo").mkdir(parents=True)
+    (partial / "algo" / "rllib_checkpoint.json").write_text('{"trunc')
+    with (out / "curve.csv").open("a") as f:
+        f.write("400,12.5,")
+    assert run.latest_checkpoint()[0] == 200
+    resumed = train(
+        str(FEEDING), robot="jaco", config_path=str(config), coop=True, out=str(out), resume=True, steps=400, quiet=True
+    )
+    assert not partial.exists()
+    assert resumed["steps"] == 400 and run.latest_checkpoint()[0] == 400
+    rows = (out / "curve.csv").read_text().splitlines()
+    assert [int(r.split(",")[0]) for r in rows[1:]] == [200, 400]
+
+    strip = tmp_path / "coop.png"
+    result = evaluate(out, episodes=1, seed=0, render=str(strip))
+    assert result["engine"] == "rllib" and result["coop"] and result["trained_steps"] == 400
+    assert Image.open(strip).size == (4 * 480, 360)  # a rollout of both trained policies, as a strip of 4 frames
+    assert np.isfinite(result["mean_return"]) and result["per_episode"][0]["seed"] == 0
+    assert evaluate(out, episodes=1, seed=0)["mean_return"] == result["mean_return"]  # deterministic for a seed
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["engine"] == "rllib" and summary["steps"] == 400
+
+    # Deterministic actions are the Gaussian's means clipped to the action bounds (the env clips them
+    # for the motion, but the action penalty sees them raw), and the NumPy export gives the same.
+    import torch
+
+    from assistive_compiler.policies.checkpoint import RLlibPolicy
+    from assistive_compiler.training.export import export_run
+
+    pair = RLlibPolicy(checkpoint.parent / f"step_{400:010d}", coop=True, algorithm="ppo")
+    with torch.no_grad():  # a head whose means leave the bounds
+        for weight in pair.modules["robot"].pi.parameters():
+            weight.mul_(1e3)
+    obs = np.random.default_rng(0).normal(0.0, 1.0, (8, pair.modules["robot"].observation_space.shape[0]))
+    actions = np.array([pair.agent("robot")(o) for o in obs])
+    assert np.abs(actions).max() == 1.0 and (np.abs(actions) == 1.0).mean() > 0.5
+    record = export_run(out, tmp_path / "ppo-pair", episodes=1, seed=0)
+    assert record["coop"] and record["export_max_action_difference"] < 1e-4
+
+
+def test_unreachable_ray_address_fails_fast_with_a_message(tmp_path, capsys):
+    out = tmp_path / "run"
+    t0 = time.perf_counter()
+    code = main(
+        ["train", str(REACH), "--config", "ppo_quick", "--address", "127.0.0.1:1", "--out", str(out), "--quiet"]
+    )
+    elapsed = time.perf_counter() - t0
+    err = capsys.readouterr().err
+    assert code == 2 and elapsed < 20
+    assert "error: --address: no Ray cluster reachable at 127.0.0.1:1" in err
+    assert not out.exists()
+
+
+SAC_TINY = """\
+algorithm: sac
+network: {hidden: [16, 16], activation: relu}
+sac: {learning_starts: 40, buffer_size: 2000, batch_size: 16}
+total_steps: 100
+envs: 1
+checkpoint_every_steps: 100
+eval_episodes: 1
+"""
+
+
+@pytest.mark.slow
+def test_multi_agent_sac_trains_and_exports_a_pair_that_plays_under_coop(local_ray, tmp_path, capsys):
+    """Co-optimisation with SAC on RLlib: robot and human modules learn, the pair exports to NumPy
+    (each agent's actions equal the checkpoint's) and plays both agents from `run --coop`."""
+    from assistive_compiler.training.export import export_run
+
+    config = tmp_path / "sac_tiny.yaml"
+    config.write_text(SAC_TINY)
+    out = tmp_path / "feeding-coop-sac"
+    figures = train(str(FEEDING), robot="jaco", config_path=str(config), coop=True, out=str(out), quiet=True)
+    assert figures["steps"] >= 100 and RunDir(out).info().algorithm == "sac"
+    record = export_run(out, tmp_path / "pair", episodes=1, seed=7)
+    assert record["coop"] and record["export_max_action_difference"] < 1e-4
+    assert {p.name for p in (tmp_path / "pair").iterdir()} >= {"policy.json", "robot", "human"}
+    checkpoint_return = evaluate(out, episodes=1, seed=7)["mean_return"]
+    assert record["evaluation"]["mean_return"] == pytest.approx(
+        checkpoint_return, abs=0.05
+    )  # float64 NumPy vs float32 torch
+    capsys.readouterr()
+    assert (
+        main(
+            [
+                "run",
+                str(FEEDING),
+                "--robot",
+                "jaco",
+                "--coop",
+                "--policy",
+                str(tmp_path / "pair"),
+                "--episodes",
+                "1",
+                "--seed",
+                "7",
+                "--json",
+                "--quiet",
+            ]
+        )
+        == 0
+    )
+    report = json.loads(capsys.readouterr().out)
+    assert report["human_policy"] == str(tmp_path / "pair")  # the pair plays the person too
+    assert report["episodes"][0]["return"] == pytest.approx(record["evaluation"]["returns"][0], abs=1e-3)
+    strip = tmp_path / "pair.png"
+    assert (
+        main(
+            [
+                "render",
+                str(FEEDING),
+                "--robot",
+                "jaco",
+                "--policy",
+                str(tmp_path / "pair"),
+                "--seed",
+                "7",
+                "--out",
+                str(strip),
+            ]
+        )
+        == 0
+    )
+    assert (
+        f"return {record['evaluation']['returns'][0]:.1f}" in capsys.readouterr().out
+    )  # both agents acted, as in run --coop
+
+
+def _free_port() -> int:
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.mark.slow
+def test_a_refused_authentication_token_says_so_and_names_rays_remedy(tmp_path):
+    """A Ray cluster that answers but rejects this machine's token (a stale ~/.ray/auth_token from an
+    earlier local ray.init()) is not 'no cluster': the message says the token was refused and how to
+    fix it. The test starts its own head node (its own HOME and token) and stops it by its id."""
+    import os
+    import signal
+    import socket
+    import subprocess
+    import sys
+
+    port = _free_port()
+    homes = {}
+    for who, token in (("head", "a" * 64), ("driver", "b" * 64)):
+        homes[who] = tmp_path / who
+        (homes[who] / ".ray").mkdir(parents=True)
+        (homes[who] / ".ray" / "auth_token").write_text(token)
+    base = {k: v for k, v in os.environ.items() if not k.startswith("RAY_")}
+    head = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "ray.scripts.scripts",
+            "start",
+            "--head",
+            f"--port={port}",
+            "--num-cpus=0",
+            "--include-dashboard=false",
+            "--block",
+        ],
+        env={**base, "HOME": str(homes["head"]), "RAY_AUTH_MODE": "token"},
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
+    try:
+        deadline = time.time() + 60
+        while time.time() < deadline:
+            try:
+                socket.create_connection(("127.0.0.1", port), timeout=1).close()
+                break
+            except OSError:
+                time.sleep(0.5)
+        proc = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "assistive_compiler.cli",
+                "train",
+                str(REACH),
+                "--config",
+                "ppo_quick",
+                "--address",
+                f"127.0.0.1:{port}",
+                "--out",
+                str(tmp_path / "run"),
+                "--quiet",
+            ],
+            env={**base, "HOME": str(homes["driver"])},
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+    finally:
+        os.killpg(head.pid, signal.SIGTERM)
+        head.wait(timeout=60)
+        from ray_cluster import forget_cluster
+
+        forget_cluster(port)
+    assert proc.returncode == 2
+    assert (
+        f"error: --address: the Ray cluster at 127.0.0.1:{port} refused this machine's authentication token "
+        "(~/.ray/auth_token, $RAY_AUTH_TOKEN or $RAY_AUTH_TOKEN_PATH). Ray's remedy: every machine uses the cluster's token"
+    ) in proc.stderr
+    assert not (tmp_path / "run" / "run.json").exists()  # nothing written for a run that never started
