@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from .record.capture import SceneReader
-from .runtime.world import rotation_matrix
+from .rotation import quat_matrix
 
 AXES = "xyz"
 
@@ -52,7 +52,7 @@ def describe_scene(env) -> dict:
         if entry["shown"]:
             for link in body["links"]:
                 k = reader.links.index([body["name"], link])
-                rot = rotation_matrix(quat[k])
+                rot = quat_matrix(quat[k])
                 entry["links"].append(
                     {
                         "name": link,
@@ -62,7 +62,7 @@ def describe_scene(env) -> dict:
                 )
         bodies.append(entry)
     person_base = next(b for b in reader.bodies if b["name"] == person)["links"][0]  # base link first
-    person_rot = rotation_matrix(quat[reader.links.index([person, person_base])])  # the person faces its base's -y
+    person_rot = quat_matrix(quat[reader.links.index([person, person_base])])  # the person faces its base's -y
     targets = reader.target_positions(pos, quat)
     out = {
         "task": m.task,

@@ -2,8 +2,8 @@
 order viewers use), 3×3 rotation matrices (columns: the rotated frame's axes), URDF's fixed-axis
 roll-pitch-yaw, rotation about an axis, and the frame of a capsule axis. Angles in radians unless
 a name says degrees. Plain numpy, no pybullet, so the term library and the compiler can use it
-without importing the simulator (the runtime reads body orientations as matrices with
-:func:`assistive_compiler.runtime.world.rotation_matrix`, pybullet's own conversion)."""
+without importing the simulator; :func:`quat_matrix` gives bit for bit what pybullet's
+``getMatrixFromQuaternion`` gives, so the runtime reads body orientations as matrices with it too."""
 
 from __future__ import annotations
 
@@ -25,6 +25,25 @@ def quat_rotate(q, v) -> np.ndarray:
             vx + w * tx + (y * tz - z * ty),
             vy + w * ty + (z * tx - x * tz),
             vz + w * tz + (x * ty - y * tx),
+        ]
+    )
+
+
+def quat_matrix(q) -> np.ndarray:
+    """3×3 rotation matrix of a quaternion (x, y, z, w), which need not be of unit length: its
+    columns are the rotated frame's axes. The same operations in the same order as Bullet's
+    ``btMatrix3x3::setRotation`` (pybullet's ``getMatrixFromQuaternion``), so the same doubles."""
+    x, y, z, w = _floats(q)
+    s = 2.0 / (x * x + y * y + z * z + w * w)
+    xs, ys, zs = x * s, y * s, z * s
+    wx, wy, wz = w * xs, w * ys, w * zs
+    xx, xy, xz = x * xs, x * ys, x * zs
+    yy, yz, zz = y * ys, y * zs, z * zs
+    return np.array(
+        [
+            [1.0 - (yy + zz), xy - wz, xz + wy],
+            [xy + wz, 1.0 - (xx + zz), yz - wx],
+            [xz - wy, yz + wx, 1.0 - (xx + yy)],
         ]
     )
 

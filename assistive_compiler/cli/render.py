@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import SpecError
 from ..pictures import check_picture_path, episode_frames, write_picture
+from ..rotation import quat_matrix
 from .common import EXIT_OK, add_library_argument, add_spec_arguments, make_env
 
 
@@ -92,7 +93,7 @@ def render_people(artifact_dir: Path, width: int = 360, height: int = 480) -> np
         # The camera sits in front of the person in the person's own base frame (the person faces
         # its base's -Y, head toward +Z), so a supine person on a bed is seen from above, head up,
         # and a seated one from the front, wherever the furniture stands.
-        rotation = np.asarray(pb.getMatrixFromQuaternion(body.orientation)).reshape(3, 3)
+        rotation = quat_matrix(body.orientation)
         target = np.asarray(body.position) + rotation @ [0.0, 0.0, -0.3]
         eye = target + rotation @ [0.0, -2.6, 0.35]
         view = pb.computeViewMatrix(eye.tolist(), target.tolist(), (rotation @ [0, 0, 1]).tolist(), physicsClientId=c)

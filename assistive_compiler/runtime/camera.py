@@ -93,21 +93,21 @@ AXIS_COLOURS = ((230, 40, 40), (40, 190, 40), (50, 90, 240))
 def labelled_frames(env) -> list[tuple[str, np.ndarray, np.ndarray | None]]:
     """(label, world position m, 3×3 rotation or None) of what a spec refers to most: the robot's
     end effector, each tool's named links, each target (a point: no axes)."""
-    from .world import rotation_matrix
+    from ..rotation import quat_matrix
 
     m, w, snap = env.manifest, env.world, env.snap
     out = []
     ee = m.robot.links.get("end_effector")
     if ee is not None:
         pos, orn = w.link_frame(w.robot, w.robot.links[ee])
-        out.append((f"robot.{ee}", np.asarray(pos), rotation_matrix(orn)))
+        out.append((f"robot.{ee}", np.asarray(pos), quat_matrix(orn)))
     for tool in m.tools:
         handle = w.bodies[tool.body]
         for name, link in sorted(tool.links.items()):
             if name == "base" and list(tool.links.values()).count(link) > 1:
                 continue  # the base is also a named link: drawn once, by its name
             pos, orn = w.link_frame(handle, handle.links[link])
-            out.append((f"{tool.body}.{name}", np.asarray(pos), rotation_matrix(orn)))
+            out.append((f"{tool.body}.{name}", np.asarray(pos), quat_matrix(orn)))
     for name in m.targets:
         out.append((name, np.asarray(snap.position(snap.point(TargetPoint(target=name)))), None))
     return out

@@ -11,9 +11,10 @@ from __future__ import annotations
 import numpy as np
 import pybullet as pb
 
+from ..rotation import quat_matrix
 from .component import Episode, EpisodeComponent
 from .snapshot import Snapshot
-from .world import World, rotation_matrix
+from .world import World
 
 MARKER_RADIUS_M = 0.008
 """Radius of a marker's dot in renders, m."""
@@ -50,7 +51,7 @@ class MarkerSystem(EpisodeComponent):
         snap = self.snap
         out = np.empty((len(self.remaining[name]), 3))
         for slot, index, offsets in self._groups[name]:
-            out[index] = snap.pos[slot] + offsets @ rotation_matrix(snap.orn[slot]).T
+            out[index] = snap.pos[slot] + offsets @ quat_matrix(snap.orn[slot]).T
         return out
 
     def after_step(self) -> None:

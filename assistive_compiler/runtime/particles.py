@@ -48,11 +48,11 @@ import pybullet as pb
 
 from ..artifact import Container, ParticleSet
 from ..references import PointHandle, TargetPoint
-from ..rotation import vec_angle
+from ..rotation import quat_matrix, vec_angle
 from ..terms.reads import ParticleEvents
 from .component import EnvStep, Episode, EpisodeComponent
 from .snapshot import Snapshot
-from .world import PARK, World, rotation_matrix
+from .world import PARK, World
 
 _AXIS = np.array([0.0, 0.0, 1.0])  # a container's axis in its frame, towards its opening
 
@@ -106,7 +106,7 @@ class ParticleSystem(EpisodeComponent):
         else:  # one query: the link's URDF frame (what link_frame reads), its centre of mass and velocities
             s = pb.getLinkState(holder.id, link, computeLinkVelocity=1, computeForwardKinematics=1, physicsClientId=c)
             pos, orn, com, lin, ang = s[4], s[5], s[0], s[6], s[7]
-        return np.asarray(pos), rotation_matrix(orn), np.asarray(com), np.asarray(lin), np.asarray(ang)
+        return np.asarray(pos), quat_matrix(orn), np.asarray(com), np.asarray(lin), np.asarray(ang)
 
     def _apparent_up(self, name: str, rot: np.ndarray, lin: np.ndarray) -> np.ndarray:
         """The apparent up −(g − a) of a container, a its acceleration over the last env step, as a
@@ -321,7 +321,7 @@ class ParticleSystem(EpisodeComponent):
                 box = ps.outside_of
                 holder = w.bodies[box.body]
                 fpos, forn = w.link_frame(holder, holder.links[box.link])
-                inside = self._inside(box, (positions - np.asarray(fpos)) @ rotation_matrix(forn))
+                inside = self._inside(box, (positions - np.asarray(fpos)) @ quat_matrix(forn))
             to_centre = np.linalg.norm(positions - centre, axis=1) if centre is not None else None
             to_anchor = np.linalg.norm(positions - anchor, axis=1) if anchor is not None else None
             for j, k in enumerate(idx):

@@ -19,9 +19,9 @@ import numpy as np
 import pybullet as pb
 
 from ..references import JointGroup, JointsHandle, NodeSet, NodesHandle, Point, PointHandle, TargetPoint
-from ..rotation import quat_conj, quat_mul, quat_rotate  # noqa: F401  (re-exported)
+from ..rotation import quat_conj, quat_matrix, quat_mul, quat_rotate  # noqa: F401  (re-exported)
 from ..terms.reads import ContactPoint, ParticleEvents, SceneReads
-from .world import BodyHandle, World, rotation_matrix
+from .world import BodyHandle, World
 
 CLOSEST_SLACK_M = (
     0.05  # closest_distance first looks this far beyond its last answer (m); any value gives the same result
@@ -170,7 +170,7 @@ class Snapshot:
 
     def set_frame(self, name: str, pos: Sequence[float], orn: Sequence[float]) -> None:
         """Fix an observation frame for the episode (the robot's and the person's bases do not move)."""
-        rot = rotation_matrix(orn)
+        rot = quat_matrix(orn)
         self.frames[name] = (np.asarray(pos, dtype=float), np.asarray(orn, dtype=float), rot.T)
 
     # -- what terms read ----------------------------------------------------------------------

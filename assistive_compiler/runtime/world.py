@@ -37,6 +37,7 @@ import pybullet as pb
 
 from ..artifact import Manifest
 from ..bullet import connect, use_contact_breaking_threshold
+from ..rotation import quat_matrix
 
 PARK = (
     0.0,
@@ -44,11 +45,6 @@ PARK = (
     50.0,
 )  # where inactive bodies (other person variants, removed particles) wait: far away, beyond the floor's edge, m
 FLOOR_HALF_M = 20.0  # the floor slab's half width, m: the scene sits near the origin
-
-
-def rotation_matrix(orn) -> np.ndarray:
-    """3×3 rotation matrix of a quaternion (x, y, z, w): its columns are the frame's axes in world coordinates."""
-    return np.asarray(pb.getMatrixFromQuaternion(orn), dtype=float).reshape(3, 3)
 
 
 @dataclass
@@ -366,7 +362,7 @@ class World:
         for g in self.garments:
             pos, orn = self.held_pose(g)
             pb.resetBasePositionAndOrientation(g.anchor_id, pos, orn, physicsClientId=c)
-            rot = rotation_matrix(orn)
+            rot = quat_matrix(orn)
             world = g.nodes_in_held @ rot.T + np.asarray(pos)
             pb.resetMeshData(g.soft_id, vertices=world.tolist(), physicsClientId=c)
             pb.resetBaseVelocity(g.soft_id, (0, 0, 0), (0, 0, 0), physicsClientId=c)

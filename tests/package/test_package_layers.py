@@ -1,5 +1,8 @@
 """The package's layering: no two of its subpackages (or top-level modules) import each other,
-counting every import — at module level, inside functions and under ``TYPE_CHECKING``."""
+counting every import — at module level, inside functions and under ``TYPE_CHECKING``.
+
+The package's own ``__init__`` is left out: it is the facade over every part (``make``,
+``compile_task``, ... import lazily) and holds ``__version__``, which parts read."""
 
 from __future__ import annotations
 
@@ -14,6 +17,11 @@ def _unit(module: str) -> str:
     """The layer a module belongs to: its subpackage, or the top-level module itself."""
     parts = module.split(".")
     return parts[1] if len(parts) > 1 else "<package>"
+
+
+def _is_module(package: str, name: str) -> bool:
+    folder = PACKAGE.parent.joinpath(*package.split("."))
+    return (folder / f"{name}.py").is_file() or (folder / name / "__init__.py").is_file()
 
 
 def package_imports() -> dict[tuple[str, str], list[str]]:
@@ -31,14 +39,18 @@ def package_imports() -> dict[tuple[str, str], list[str]]:
                     base = ".".join(here[: len(here) - node.level + 1] + ([node.module] if node.module else []))
                 else:
                     base = node.module or ""
-                targets = [f"{base}.{a.name}" if node.module is None else base for a in node.names]
+                # ``from .. import name``: a submodule, or else a name defined in the package itself
+                targets = [
+                    base if node.module is not None else f"{base}.{a.name}" if _is_module(base, a.name) else base
+                    for a in node.names
+                ]
             elif isinstance(node, ast.Import):
                 targets = [a.name for a in node.names]
             for target in targets:
                 if target.split(".")[0] != "assistive_compiler":
                     continue
                 a, b = _unit(module), _unit(target)
-                if a != b:
+                if a != b and "<package>" not in (a, b):
                     edges[(a, b)].append(f"{file.relative_to(PACKAGE.parent)}:{node.lineno}")
     return edges
 

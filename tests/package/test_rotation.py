@@ -14,6 +14,7 @@ from assistive_compiler.rotation import (
     quat_about,
     quat_angle,
     quat_from_rpy,
+    quat_matrix,
     quat_rotate,
     quat_towards,
     rpy_matrix,
@@ -72,3 +73,17 @@ def test_axis_rotation_is_the_quaternion_about_the_axis():
 
 def test_wxyz_reorders_for_viewers():
     assert wxyz((0.1, 0.2, 0.3, 0.9)).tolist() == [0.9, 0.1, 0.2, 0.3]
+
+
+def test_quat_matrix_is_pybullets_bit_for_bit():
+    """The runtime reads orientations as matrices with quat_matrix instead of pybullet's
+    getMatrixFromQuaternion: the same doubles, so no episode changes (unit and non-unit
+    quaternions; the columns are the rotated axes)."""
+    rng = np.random.default_rng(7)
+    for k in range(2000):
+        q = rng.normal(size=4)
+        q = q / np.linalg.norm(q) * (1.0 if k % 2 else 1.0 + 1e-6 * rng.normal())
+        expected = np.asarray(pb.getMatrixFromQuaternion(q), dtype=float).reshape(3, 3)
+        assert np.array_equal(quat_matrix(q), expected)
+    quarter_turn_about_z = (0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4))
+    assert np.allclose(quat_matrix(quarter_turn_about_z)[:, 0], [0.0, 1.0, 0.0], atol=1e-15)

@@ -15,7 +15,7 @@ import numpy as np
 from ...artifact import Garment
 from ...bullet import connect
 from ...resolve import ResolvedTask
-from ...rotation import quat_from_rpy_deg
+from ...rotation import quat_from_rpy_deg, quat_matrix
 from ..task import fail, rounded
 
 
@@ -32,7 +32,7 @@ def settle_garment(rt: ResolvedTask, name: str, g, out_tmp: Path, grip, held_orn
     spec, shape, phys = rt.spec, g.shape, g.physics
     verts, faces = sleeve_mesh(shape.length_m, shape.radius_open_m, shape.radius_end_m, shape.rings, shape.segments)
     pose_q = quat_from_rpy_deg(g.held.rpy_deg)
-    rot = np.asarray(pb.getMatrixFromQuaternion(pose_q)).reshape(3, 3)
+    rot = quat_matrix(pose_q)
     held_verts = verts @ rot.T + np.asarray(g.held.offset_m)
     obj = out_tmp / "garments" / f"{name}.obj"
     obj.parent.mkdir(exist_ok=True)
@@ -66,7 +66,7 @@ def settle_garment(rt: ResolvedTask, name: str, g, out_tmp: Path, grip, held_orn
         )
     finally:
         pb.disconnect(c)
-    inv_rot = np.asarray(pb.getMatrixFromQuaternion(held_orn)).reshape(3, 3).T
+    inv_rot = quat_matrix(held_orn).T
     local = (world - np.asarray(held_pos)) @ inv_rot.T
     if not np.all(np.isfinite(local)) or np.abs(local).max() > 5 * (shape.length_m + shape.radius_open_m):
         raise fail(
