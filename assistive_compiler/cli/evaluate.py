@@ -27,6 +27,13 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         )
         return EXIT_BAD_INPUT
     if source.startswith(PREFIX) or (Path(source) / POLICY_FILE).is_file():  # shipped or exported: NumPy only
+        if args.stochastic:
+            print(
+                f"evaluate: --stochastic samples a run's actions as training did; {source} is an exported policy, "
+                "which keeps only the deterministic action (the distribution's mean): evaluate its run directory",
+                file=sys.stderr,
+            )
+            return EXIT_BAD_INPUT
         if args.checkpoint is not None:
             print(
                 f"evaluate: --checkpoint picks a checkpoint of a run directory; {source} is an exported policy (one checkpoint)",
@@ -42,10 +49,15 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     from ..training.evaluate import evaluate, save_evaluation
 
     result = evaluate(
-        source, episodes=args.episodes, seed=args.seed, render=args.render, checkpoint_steps=args.checkpoint
+        source,
+        episodes=args.episodes,
+        seed=args.seed,
+        render=args.render,
+        checkpoint_steps=args.checkpoint,
+        stochastic=args.stochastic,
     )
-    if args.checkpoint is None or args.checkpoint == run.latest_checkpoint()[0]:
-        save_evaluation(run, result)  # evaluation.json (what `table` reads) is always the newest checkpoint's
+    if not args.stochastic and (args.checkpoint is None or args.checkpoint == run.latest_checkpoint()[0]):
+        save_evaluation(run, result)  # evaluation.json (what `table` reads): the newest checkpoint, deterministic
     print(json.dumps(result, indent=1) if args.json else format_report(result))
     return EXIT_OK
 
@@ -68,6 +80,12 @@ def add_commands(sub) -> None:
         metavar="STEPS",
         help="a run's checkpoint at this many env steps (default: the "
         "newest), e.g. to compare two runs at the same budget",
+    )
+    p.add_argument(
+        "--stochastic",
+        action="store_true",
+        help="a run directory's actions sampled as in training (seeded by --seed) instead of deterministic; "
+        "the run's evaluation.json is left as it is",
     )
     p.add_argument("--json", action="store_true", help="print JSON (with every episode)")
     p.set_defaults(func=cmd_evaluate)

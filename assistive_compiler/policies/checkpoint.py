@@ -31,10 +31,15 @@ def algorithm_class(config_or_name):
 
 
 class SB3Policy:
-    """A trained SB3 policy as a function of raw observations (normalised as during training)."""
+    """A trained SB3 policy as a function of raw observations (normalised as during training):
+    the distribution's mode, or with ``stochastic`` a sample of it as in training (seeded)."""
 
-    def __init__(self, checkpoint: Path, algorithm: str = "ppo"):
-        self.algorithm = algorithm
+    def __init__(self, checkpoint: Path, algorithm: str = "ppo", stochastic: bool = False, seed: int = 0):
+        self.algorithm, self.stochastic = algorithm, stochastic
+        if stochastic:  # SB3 samples with torch's generator: seeded, the same seed gives the same episodes
+            import torch
+
+            torch.manual_seed(seed)
         self.model = algorithm_class(algorithm).load(
             str(checkpoint / "model.zip"), device="cpu", custom_objects={"replay_buffer_class": None}
         )
@@ -51,23 +56,25 @@ class SB3Policy:
     def __call__(self, obs: np.ndarray) -> np.ndarray:
         if self.obs_rms is not None:
             obs = np.clip((obs - self.obs_rms.mean) / np.sqrt(self.obs_rms.var + self.eps), -self.clip, self.clip)
-        action, _ = self.model.predict(obs.astype(np.float32), deterministic=True)
+        action, _ = self.model.predict(obs.astype(np.float32), deterministic=not self.stochastic)
         return action
 
 
 class RLlibPolicy:
-    """A trained RLlib run's policies as plain functions (deterministic: the Gaussian's mean).
+    """A trained RLlib run's policies as plain functions (by default deterministic: the Gaussian's mean).
 
     Single agent: ``obs -> action``; co-optimised: ``(robot_obs, human_obs) -> (a_robot, a_human)``.
+    With ``stochastic``, a sample of the Gaussian (seeded), squashed or clipped as the mean is.
     Loads the RLModules from the checkpoint alone: no Ray instance is needed."""
 
-    def __init__(self, checkpoint: Path, coop: bool, algorithm: str = "ppo"):
+    def __init__(self, checkpoint: Path, coop: bool, algorithm: str = "ppo", stochastic: bool = False, seed: int = 0):
         from ray.rllib.core.rl_module.rl_module import RLModule
 
         root = checkpoint / "algo" / "learner_group" / "learner" / "rl_module"
         names = PAIR if coop else (SINGLE_MODULE,)
         self.modules = {name: RLModule.from_checkpoint(str((root / name).resolve())) for name in names}
         self.coop, self.algorithm = coop, algorithm
+        self.rng = np.random.default_rng(seed) if stochastic else None
 
     def _act(self, name: str, obs: np.ndarray) -> np.ndarray:
         import torch
@@ -75,7 +82,10 @@ class RLlibPolicy:
         with torch.no_grad():
             out = self.modules[name].forward_inference({"obs": torch.as_tensor(obs, dtype=torch.float32)[None]})
         dist = out["action_dist_inputs"][0].numpy()
-        mean = dist[: dist.shape[0] // 2]  # a diagonal Gaussian's inputs: means, then log-stds
+        half = dist.shape[0] // 2
+        mean = dist[:half]  # a diagonal Gaussian's inputs: means, then log-stds
+        if self.rng is not None:  # a sample, as in training
+            mean = mean + np.exp(dist[half:]) * self.rng.standard_normal(half)
         space = self.modules[name].action_space
         if self.algorithm != "sac":  # PPO's mean, clipped to the action bounds as SB3's PPO and the export clip it
             return np.clip(mean, space.low, space.high).astype(np.float32)
@@ -100,11 +110,13 @@ def latest_checkpoint(run: RunDir) -> tuple[int, Path]:
     return found
 
 
-def load_policy(info: RunInfo, checkpoint: Path):
-    """The run's policy as ``obs -> action`` (co-optimised runs: ``(robot_obs, human_obs) -> (a_r, a_h)``)."""
+def load_policy(info: RunInfo, checkpoint: Path, stochastic: bool = False, seed: int = 0):
+    """The run's policy as ``obs -> action`` (co-optimised runs: ``(robot_obs, human_obs) -> (a_r, a_h)``):
+    deterministic, or with ``stochastic`` sampling its actions as training did (from a generator
+    seeded with ``seed``)."""
     if info.engine == "sb3":
-        return SB3Policy(checkpoint, info.algorithm)
-    return RLlibPolicy(checkpoint, coop=info.coop, algorithm=info.algorithm)
+        return SB3Policy(checkpoint, info.algorithm, stochastic=stochastic, seed=seed)
+    return RLlibPolicy(checkpoint, coop=info.coop, algorithm=info.algorithm, stochastic=stochastic, seed=seed)
 
 
 def load_run(path: Path, source: str):

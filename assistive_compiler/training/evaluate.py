@@ -18,7 +18,7 @@ from ..errors import UsageError
 from ..paths import display
 from ..policies.checkpoint import latest_checkpoint, load_policy
 from ..policies.pair import both_agents
-from ..run_dir import RunDir, RunInfo
+from ..run_dir import RunDir
 from .config import run_config
 
 
@@ -141,14 +141,17 @@ def evaluate(
     seed: int = 0,
     render: str | None = None,
     checkpoint_steps: int | None = None,
+    stochastic: bool = False,
 ) -> dict:
     """Evaluate the run's checkpoint at ``checkpoint_steps`` env steps (None: the newest); optionally
-    write a rollout (``render``: .gif or .png)."""
+    write a rollout (``render``: .gif or .png). Actions are deterministic, as the paper evaluates;
+    ``stochastic`` samples them as training did (seeded with ``seed``), to see how much of a training
+    curve's success the policy's noise makes."""
     run = RunDir(run_dir)
     info = run.info()
     steps, checkpoint = checkpoint_at(run, checkpoint_steps)
     episodes = episodes or run_config(info).eval_episodes
-    policy = load_policy(info, checkpoint)
+    policy = load_policy(info, checkpoint, stochastic=stochastic, seed=seed)
     results = play_episodes(run.artifact, policy, info.coop, episodes, seed)
     out = {
         "run": display(run.path),
@@ -161,17 +164,14 @@ def evaluate(
         "trained_steps": steps,
         "episodes": episodes,
         "seed": seed,
+        "actions": "stochastic" if stochastic else "deterministic",
         **_figures(results),
         "per_episode": results,
     }
     if render:
-        out["render"] = render_rollout(run, info, checkpoint, seed, Path(render))
+        picture = load_policy(info, checkpoint, stochastic=stochastic, seed=seed)
+        out["render"] = write_rollout(run.artifact, picture, info.coop, seed, Path(render))
     return out
-
-
-def render_rollout(run: RunDir, info: RunInfo, checkpoint: Path, seed: int, out: Path, every: int = 2) -> str:
-    """Write one rollout of the run's trained policy as a GIF (or a PNG strip); returns a line saying so."""
-    return write_rollout(run.artifact, load_policy(info, checkpoint), info.coop, seed, out, every)
 
 
 def save_evaluation(run: RunDir, result: dict) -> Path:
@@ -190,7 +190,8 @@ def format_report(result: dict) -> str:
     return "\n".join(
         [
             f"{result['gym_id']}  {result['engine']}  checkpoint {result['checkpoint']} ({result['trained_steps']:,} steps)",
-            f"episodes {result['episodes']} (seeds {result['seed']}..{result['seed'] + result['episodes'] - 1}), deterministic actions",
+            f"episodes {result['episodes']} (seeds {result['seed']}..{result['seed'] + result['episodes'] - 1}), "
+            f"{result.get('actions', 'deterministic')} actions",
             f"return          {result['mean_return']:9.2f} ± {result['std_return']:.2f}",
             f"success rate    {result['success_rate']:9.2f} ± {result['std_success']:.2f}",
             f"force on person {result['mean_force_on_human_n']:9.2f} ± {result['std_force_on_human_n']:.2f} N (per-episode mean)",

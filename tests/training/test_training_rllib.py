@@ -100,6 +100,16 @@ def test_multi_agent_ppo_iteration_checkpoint_resume_evaluate(local_ray, tmp_pat
     record = export_run(out, tmp_path / "ppo-pair", episodes=1, seed=0)
     assert record["coop"] and record["export_max_action_difference"] < 1e-4
 
+    # --stochastic samples each agent's Gaussian from a seeded generator: the same seed, the same
+    # actions; not the means.
+    ckpt = checkpoint.parent / f"step_{400:010d}"
+    sampled = [RLlibPolicy(ckpt, coop=True, algorithm="ppo", stochastic=True, seed=3) for _ in range(2)]
+    mean = RLlibPolicy(ckpt, coop=True, algorithm="ppo")
+    human_obs = np.zeros(mean.modules["human"].observation_space.shape[0])
+    first, again = (p(obs[0], human_obs) for p in sampled)
+    assert all(np.array_equal(a, b) for a, b in zip(first, again, strict=True))
+    assert not np.array_equal(first[0], mean(obs[0], human_obs)[0])
+
 
 def test_unreachable_ray_address_fails_fast_with_a_message(tmp_path, capsys):
     out = tmp_path / "run"

@@ -97,6 +97,26 @@ def test_evaluation_is_deterministic_for_a_seed(reach_run):
     assert [e["return"] for e in first["per_episode"]] != [e["return"] for e in other["per_episode"]]
 
 
+def test_stochastic_evaluation_samples_as_training_did_and_is_seeded(reach_run, capsys):
+    """--stochastic samples the policy's actions (the same seed, the same episodes; not the
+    deterministic ones) and leaves the run's evaluation.json alone; an exported policy, which
+    keeps only the mean, refuses it."""
+    saved = (reach_run / "evaluation.json").read_text() if (reach_run / "evaluation.json").is_file() else None
+    deterministic = evaluate(reach_run, episodes=2, seed=5)
+    sampled = evaluate(reach_run, episodes=2, seed=5, stochastic=True)
+    assert sampled["actions"] == "stochastic" and deterministic["actions"] == "deterministic"
+    assert sampled["per_episode"] == evaluate(reach_run, episodes=2, seed=5, stochastic=True)["per_episode"]
+    assert [e["return"] for e in sampled["per_episode"]] != [e["return"] for e in deterministic["per_episode"]]
+    assert main(["evaluate", str(reach_run), "--episodes", "1", "--seed", "5", "--stochastic"]) == 0
+    assert "stochastic actions" in capsys.readouterr().out
+    assert ((reach_run / "evaluation.json").read_text() if saved is not None else None) == saved
+    assert main(["evaluate", "--policy", "pretrained:feeding-jaco", "--stochastic"]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "evaluate: --stochastic samples a run's actions as training did; pretrained:feeding-jaco is an exported "
+        "policy, which keeps only the deterministic action (the distribution's mean): evaluate its run directory"
+    )
+
+
 def test_evaluate_command_json_and_render(reach_run, tmp_path, capsys):
     gif = tmp_path / "reach.gif"
     assert main(["evaluate", str(reach_run), "--episodes", "2", "--seed", "3", "--json", "--render", str(gif)]) == 0
