@@ -26,6 +26,7 @@ def cmd_export(args: argparse.Namespace) -> int:
         seed=args.seed,
         label=args.label or "",
         progress=lambda line: print(line, file=sys.stderr),
+        checkpoint_steps=args.checkpoint,
     )
     e = record["evaluation"]
     where = display(Path(args.out)) if args.out else f"pretrained/{record['name']}"
@@ -74,6 +75,13 @@ def add_commands(sub) -> None:
         help=f"first evaluation seed (default {EVAL_SEED:,}: never used in training)",
     )
     p.add_argument("--label", help="the table row's name (default: the algorithm and its config's description)")
+    p.add_argument(
+        "--checkpoint",
+        type=int,
+        metavar="STEPS",
+        help="the run's checkpoint at this many env steps (default: the newest), e.g. to ship a cell at "
+        "the budget of the cell it is compared with",
+    )
     p.set_defaults(func=cmd_export)
 
     p = sub.add_parser(

@@ -18,11 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import UsageError
-from ..paths import display
 from ..policies.mlp import MLPPolicy
 from ..run_dir import RunDir
 from .config import run_config
+from .evaluate import checkpoint_at
 
 #: Unseen seeds of the evaluation: training seeds its envs with the config's seed (0–10 in the
 #: shipped configs, plus the step count on resume) and never resets with a seed after that.
@@ -128,17 +127,16 @@ def export_run(
     seed: int = EVAL_SEED,
     label: str = "",
     progress=None,
+    checkpoint_steps: int | None = None,
 ) -> dict:
-    """Export the run's newest checkpoint to ``out`` and evaluate the exported policy there;
-    returns its ``policy.json``. ``label`` names the table row (e.g. ``"PPO (paper) baseline"``)."""
+    """Export the run's checkpoint at ``checkpoint_steps`` env steps (None: the newest) to ``out``
+    and evaluate the exported policy there; returns its ``policy.json``. ``label`` names the table
+    row (e.g. ``"PPO (paper) baseline"``). The learning curve goes with it up to that checkpoint."""
     from ..policies.pretrained import pretrained_dir
 
     run = RunDir(run_dir)
     info = run.info()
-    found = run.latest_checkpoint()
-    if found is None:
-        raise UsageError(f"{display(run.path)}: the run has no complete checkpoint yet")
-    steps, checkpoint = found
+    steps, checkpoint = checkpoint_at(run, checkpoint_steps)
     config = run_config(info)
     rng = np.random.default_rng(0)
     if info.engine == "sb3":
@@ -204,6 +202,7 @@ def export_run(
         (out / "policy.json").write_text(json.dumps(record, indent=1) + "\n")
     else:
         policy.save(out, record)
-    if run.curve_csv.is_file():
-        shutil.copy(run.curve_csv, out / "curve.csv")
+    if run.curve_csv.is_file():  # the curve up to the exported checkpoint
+        lines = run.curve_csv.read_text().splitlines(keepends=True)
+        (out / "curve.csv").write_text(lines[0] + "".join(r for r in lines[1:] if int(r.split(",")[0]) <= steps))
     return json.loads((out / "policy.json").read_text())

@@ -331,7 +331,7 @@ def test_food_starts_in_the_spoon_and_stays_while_still(env):
     for _ in range(30):
         _, _, _, _, info = env.step(np.zeros(7))
         assert info["terms"]["food_spilled"] == 0
-    assert env.particles.remaining("food") == 8
+    assert int(env.particle_state("food")[1].sum()) == 8
 
 
 def test_tipping_the_spoon_spills_the_food(env):
@@ -346,7 +346,7 @@ def test_tipping_the_spoon_spills_the_food(env):
         _, _, _, _, info = env.step(np.zeros(7))
         spilled += info["terms"]["food_spilled"]
     assert spilled >= 6
-    assert env.particles.remaining("food") == 8 - spilled
+    assert int(env.particle_state("food")[1].sum()) == 8 - spilled
 
 
 # ---------------------------------------------------------------------------------------------
@@ -379,8 +379,8 @@ def test_food_at_the_mouth_is_eaten_and_rewarded(env):
     assert terms["preference_food_velocity"] < 0  # it arrived moving
     assert reward == sum(t.weight * terms[t.name] for t in m.reward)
     # gone from play: inactive, far away, not eaten twice
-    assert not env.particles.active["food"][0]
-    assert env.particles.remaining("food") == 7
+    assert not env.particle_state("food")[1][0]
+    assert int(env.particle_state("food")[1].sum()) == 7
     far = np.asarray(pb.getBasePositionAndOrientation(pid, physicsClientId=c)[0])
     assert np.linalg.norm(far - mouth) > 10.0
     _, _, _, _, info = env.step(np.zeros(7))

@@ -117,6 +117,27 @@ def test_stochastic_evaluation_samples_as_training_did_and_is_seeded(reach_run, 
     )
 
 
+def test_export_ships_a_chosen_checkpoint_with_its_curve_up_to_it(reach_run, tmp_path, capsys):
+    """export --checkpoint ships an earlier checkpoint (e.g. at the budget of the cell it is
+    compared with): its steps, its evaluation, the learning curve cut at it; a missing one is a
+    clear error naming those there are."""
+    done = list(RunDir(reach_run).complete_checkpoints())
+    first, out = done[0], tmp_path / "early"
+    assert len(done) >= 2
+    args = ["export", str(reach_run), "--out", str(out), "--checkpoint", str(first), "--episodes", "2"]
+    assert main(args) == 0
+    record = json.loads((out / "policy.json").read_text())
+    assert record["trained_steps"] == first and record["evaluation"]["episodes"] == 2
+    with (out / "curve.csv").open() as f:
+        steps = [int(row["steps"]) for row in csv.DictReader(f)]
+    assert steps and max(steps) <= first
+    capsys.readouterr()
+    assert main(["export", str(reach_run), "--out", str(tmp_path / "none"), "--checkpoint", "7"]) == 2
+    have = ", ".join(f"{s:,}" for s in done)
+    assert capsys.readouterr().err.strip().endswith(f"no complete checkpoint at 7 env steps; it has {have}")
+    assert not (tmp_path / "none").exists()
+
+
 def test_evaluate_command_json_and_render(reach_run, tmp_path, capsys):
     gif = tmp_path / "reach.gif"
     assert main(["evaluate", str(reach_run), "--episodes", "2", "--seed", "3", "--json", "--render", str(gif)]) == 0
