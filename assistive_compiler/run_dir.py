@@ -63,6 +63,11 @@ def package_versions() -> dict[str, str | None]:
     return out
 
 
+def engine_modules(engine: str) -> tuple[str, ...]:
+    """The modules a training engine (``sb3``, ``rllib``) needs to train, or to play its checkpoints."""
+    return ("torch", "stable_baselines3" if engine == "sb3" else "ray")
+
+
 @dataclass(frozen=True)
 class RunInfo:
     """What a run trains; written once to ``run.json`` when the run starts."""

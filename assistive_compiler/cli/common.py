@@ -81,8 +81,3 @@ def require_extra(*modules: str) -> bool:
     if missing:
         print(f"error: {', '.join(missing)} not installed; {TRAIN_EXTRA_HINT}", file=sys.stderr)
     return not missing
-
-
-def engine_modules(engine: str) -> tuple[str, ...]:
-    """The modules a training engine needs."""
-    return ("torch", "stable_baselines3" if engine == "sb3" else "ray")

@@ -10,7 +10,8 @@ import json
 import sys
 from pathlib import Path
 
-from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, engine_modules, require_extra
+from ..run_dir import engine_modules
+from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, require_extra
 
 
 def cmd_evaluate(args: argparse.Namespace) -> int:

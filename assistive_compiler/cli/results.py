@@ -8,7 +8,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from .common import EXIT_FAILED, EXIT_OK, engine_modules, require_extra
+from ..run_dir import engine_modules
+from .common import EXIT_FAILED, EXIT_OK, require_extra
 
 
 def cmd_export(args: argparse.Namespace) -> int:

@@ -11,7 +11,8 @@ import json
 import sys
 from pathlib import Path
 
-from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, add_library_argument, engine_modules, require_extra
+from ..run_dir import engine_modules
+from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, add_library_argument, require_extra
 
 SHIPPED_CONFIGS = "sac_laptop, ppo_paper, ppo_laptop, ppo_quick, ppo_rllib_reference"
 

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import UsageError
 from ..paths import display
-from ..run_dir import RunDir, RunInfo
+from ..run_dir import RunDir, RunInfo, engine_modules
 
 #: RLlib's module id of a single-agent run (``ray.rllib.core.DEFAULT_MODULE_ID``).
 SINGLE_MODULE = "default_policy"
@@ -127,11 +127,7 @@ def load_run(path: Path, source: str):
 
     run = RunDir(path)
     run_info = run.info()
-    missing = [
-        m
-        for m in ("torch", "stable_baselines3" if run_info.engine == "sb3" else "ray")
-        if importlib.util.find_spec(m) is None
-    ]
+    missing = [m for m in engine_modules(run_info.engine) if importlib.util.find_spec(m) is None]
     if missing:
         raise UsageError(
             f"--policy {source}: playing a run directory needs its training library ({', '.join(missing)} not "

@@ -1,9 +1,14 @@
-"""Learning curves: reading a run's ``curve.csv`` and plotting one or more runs (matplotlib, Agg)."""
+"""Learning curves: a run's ``curve.csv`` (its columns, reading it, cutting it at a checkpoint) and
+plotting one or more runs (matplotlib, Agg)."""
 
 from __future__ import annotations
 
 import csv
 from pathlib import Path
+
+from ..run_dir import write_atomic
+
+CURVE_FIELDS = ("steps", "wall_s", "episodes", "mean_return", "success_rate", "steps_per_s")
 
 
 def read_curve(path: Path) -> list[dict[str, float]]:
@@ -11,13 +16,30 @@ def read_curve(path: Path) -> list[dict[str, float]]:
     short by a killed process (the last one) is left out."""
     if not Path(path).is_file():
         return []
-    rows = []
     with Path(path).open() as f:
-        for row in csv.DictReader(f):
-            try:
-                rows.append({k: float(v) for k, v in row.items()})
-            except (TypeError, ValueError):  # a torn row: None or '' fields
-                continue
+        return [row for row in map(_numbers, csv.DictReader(f)) if row is not None]
+
+
+def _numbers(row: dict) -> dict[str, float] | None:
+    """A curve row's values as numbers; None for a row torn by a killed process (None or '' fields)."""
+    try:
+        return {k: float(v) for k, v in row.items()}
+    except (TypeError, ValueError):
+        return None
+
+
+def cut_curve(src: Path, dst: Path, steps: float) -> list[dict[str, float]]:
+    """Write the rows of ``src`` at or before ``steps`` env steps to ``dst`` as they are written
+    (atomically; ``dst`` may be ``src``), a torn row left out; returns those rows."""
+    header, *lines = Path(src).read_text().splitlines()
+    kept, rows = [header], []
+    for line in lines:
+        parsed = next(csv.DictReader([header, line]), None)  # as read_curve reads it: short rows get None
+        row = _numbers(parsed) if parsed is not None else None
+        if row is not None and row["steps"] <= steps:
+            kept.append(line)
+            rows.append(row)
+    write_atomic(Path(dst), "\n".join(kept) + "\n")
     return rows
 
 

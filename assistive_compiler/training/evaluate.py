@@ -169,7 +169,8 @@ def evaluate(
         "per_episode": results,
     }
     if render:
-        picture = load_policy(info, checkpoint, stochastic=stochastic, seed=seed)
+        # the first episode again: a sampling policy starts over from its seed, a deterministic one as it is
+        picture = load_policy(info, checkpoint, stochastic=True, seed=seed) if stochastic else policy
         out["render"] = write_rollout(run.artifact, picture, info.coop, seed, Path(render))
     return out
 

@@ -21,6 +21,7 @@ import numpy as np
 from ..policies.mlp import MLPPolicy
 from ..run_dir import RunDir
 from .config import run_config
+from .curves import cut_curve
 from .evaluate import checkpoint_at
 
 #: Unseen seeds of the evaluation: training seeds its envs with the config's seed (0–10 in the
@@ -203,6 +204,5 @@ def export_run(
     else:
         policy.save(out, record)
     if run.curve_csv.is_file():  # the curve up to the exported checkpoint
-        lines = run.curve_csv.read_text().splitlines(keepends=True)
-        (out / "curve.csv").write_text(lines[0] + "".join(r for r in lines[1:] if int(r.split(",")[0]) <= steps))
+        cut_curve(run.curve_csv, out / "curve.csv", steps)
     return json.loads((out / "policy.json").read_text())

@@ -12,8 +12,7 @@ import time
 import numpy as np
 
 from ..run_dir import RunDir
-
-CURVE_FIELDS = ("steps", "wall_s", "episodes", "mean_return", "success_rate", "steps_per_s")
+from .curves import CURVE_FIELDS, cut_curve
 
 
 def print_reward_table(weights: dict[str, float], title: str, out=sys.stderr) -> None:
@@ -23,11 +22,6 @@ def print_reward_table(weights: dict[str, float], title: str, out=sys.stderr) ->
     print(f"  {'term':<{width}}  weight", file=out)
     for name, weight in weights.items():
         print(f"  {name:<{width}}  {weight:+g}", file=out)
-
-
-def _cell(value: float) -> str:
-    """A curve value as written: integers without a decimal point."""
-    return str(int(value)) if float(value).is_integer() else repr(float(value))
 
 
 class TrainingBar:
@@ -89,14 +83,9 @@ class Progress:
         """Wall seconds and episodes of the run before this session (resumed runs). The curve is
         first cut back to the resumed checkpoint: rows written after it (and a row torn by a killed
         process) belong to training that the resumed run does again."""
-        from ..run_dir import write_atomic
-        from .curves import read_curve
-
         if not self.run.curve_csv.is_file():
             return 0.0, 0
-        rows = [r for r in read_curve(self.run.curve_csv) if r["steps"] <= self.start_steps]
-        lines = [",".join(CURVE_FIELDS)] + [",".join(_cell(r[k]) for k in CURVE_FIELDS) for r in rows]
-        write_atomic(self.run.curve_csv, "\n".join(lines) + "\n")
+        rows = cut_curve(self.run.curve_csv, self.run.curve_csv, self.start_steps)
         return (rows[-1]["wall_s"], int(rows[-1]["episodes"])) if rows else (0.0, 0)
 
     def episode(self, ret: float, success: bool, term_sums: dict[str, float]) -> None:
