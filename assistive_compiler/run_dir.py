@@ -15,6 +15,8 @@ Layout (``runs/<task>-<robot>[-coop]-s<seed>/`` by default)::
     curve.csv         the learning curve: env steps, wall seconds, mean return, success rate
     learning_curve.png
     summary.json      the run's final figures (steps, wall time, throughput, last returns)
+    demonstrations.json   a run started from demonstrations: the dataset and how the start went
+                      (episodes, steps cloned, the cloning error before and after, steps replayed)
 """
 
 from __future__ import annotations
@@ -104,6 +106,7 @@ class RunDir:
     curve_csv = property(lambda self: self.path / "curve.csv")
     curve_png = property(lambda self: self.path / "learning_curve.png")
     summary_json = property(lambda self: self.path / "summary.json")
+    demonstrations_json = property(lambda self: self.path / "demonstrations.json")
 
     def exists(self) -> bool:
         return (self.path / RUN_FILE).is_file()
@@ -170,3 +173,7 @@ class RunDir:
     # -- results -------------------------------------------------------------------------------
     def write_summary(self, summary: dict) -> None:
         write_atomic(self.summary_json, json.dumps(summary, indent=1))
+
+    def demonstrations(self) -> dict | None:
+        """How a run started from demonstrations did so (``demonstrations.json``); None for pure RL."""
+        return json.loads(self.demonstrations_json.read_text()) if self.demonstrations_json.is_file() else None

@@ -65,6 +65,8 @@ def cmd_train(args: argparse.Namespace) -> int:
             resume=args.resume,
             address=args.address,
             quiet=args.quiet,
+            demonstrations=args.demonstrations,
+            demonstrations_root=args.demonstrations_root,
         )
     print(json.dumps(summary, indent=1) if args.json else _summary_line(summary))
     if summary["interrupted"]:
@@ -98,6 +100,15 @@ def add_commands(sub) -> None:
     p.add_argument("--envs", type=int, help="env processes (overrides the config's)")
     p.add_argument("--out", help="run directory (default: runs/<task>-<robot>[-coop]-s<seed>)")
     p.add_argument("--resume", action="store_true", help="continue the run in --out from its newest checkpoint")
+    p.add_argument(
+        "--demonstrations",
+        metavar="DATASET",
+        help="start a new SAC run from a Minari dataset of this task (collect): clone its successful episodes' "
+        "actions, then put all its transitions in the replay buffer (needs the datasets extra)",
+    )
+    p.add_argument(
+        "--demonstrations-root", metavar="DIR", help="datasets directory of --demonstrations (as collect --root)"
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar or reward table")
     p.add_argument("--json", action="store_true", help="print the run's summary as JSON")
     p.set_defaults(func=cmd_train)

@@ -111,6 +111,47 @@ class SAC(Strict):
         return self
 
 
+class Demonstrations(Strict):
+    """Start a new run from demonstrations: a Minari dataset that ``collect`` wrote on the same
+    compiled task (:mod:`.demonstrations`). Before the first env step, the actor is fitted to the
+    successful episodes' actions (behaviour cloning) and every demonstrated transition goes into
+    the replay buffer. Results from such a run are labelled as starting from demonstrations."""
+
+    dataset: str | None = Field(
+        None,
+        min_length=1,
+        description="Minari dataset id, e.g. assistive_compiler/drinking-jaco/scripted-v0 (None: the one "
+        "train --demonstrations names; a run cannot start without one).",
+    )
+    root: str | None = Field(
+        None, description="Datasets directory (None: $MINARI_DATASETS_PATH, else Minari's ~/.minari/datasets)."
+    )
+    clone_epochs: int = Field(
+        50, ge=0, le=10_000, description="Passes of behaviour cloning over the successful episodes' steps (0: none)."
+    )
+    clone_batch_size: int = Field(256, ge=1, description="Demonstrated steps per behaviour-cloning gradient step.")
+    clone_learning_rate: float = Field(1e-3, gt=0, le=1, description="Adam learning rate of behaviour cloning.")
+    replay: bool = Field(
+        True, description="Put every demonstrated transition (failed episodes too) into the replay buffer first."
+    )
+    critic_warmup_steps: int = Field(
+        5_000,
+        ge=0,
+        le=1_000_000,
+        description="Gradient steps of the critics alone on the demonstrations (the cloned actor held) before SAC "
+        "starts, so its first actor updates follow critics that have seen the demonstrated returns (0: none).",
+    )
+
+    @model_validator(mode="after")
+    def _warmup_needs_replay(self) -> Demonstrations:
+        if self.critic_warmup_steps and not self.replay:
+            raise ValueError(
+                "@critic_warmup_steps: the critics warm up on the demonstrations in the replay buffer; "
+                "set replay: true or critic_warmup_steps: 0"
+            )
+        return self
+
+
 ALGORITHM_SECTIONS = {"ppo": "PPO", "sac": "SAC"}
 
 
@@ -136,6 +177,10 @@ class TrainingConfig(Strict):
         ge=1, description="Env steps between checkpoints (a checkpoint is also written at the end and on Ctrl-C)."
     )
     eval_episodes: int = Field(100, ge=1, description="Episodes `evaluate` runs by default (the paper: 100 rollouts).")
+    demonstrations: Demonstrations | None = Field(
+        None,
+        description="Start from a demonstration dataset (train --demonstrations DATASET); SAC only. None: pure RL.",
+    )
 
     @model_validator(mode="after")
     def _one_algorithm_section(self) -> TrainingConfig:
@@ -162,6 +207,20 @@ class TrainingConfig(Strict):
             )
         return self
 
+    @model_validator(mode="after")
+    def _demonstrations_need_sac(self) -> TrainingConfig:
+        if self.demonstrations is not None and self.algorithm != "sac":
+            raise ValueError(
+                f"@demonstrations: starting from demonstrations fits SAC's actor and fills its replay buffer; "
+                f"algorithm is '{self.algorithm}' (use a SAC config, e.g. sac_laptop)"
+            )
+        if self.demonstrations is not None and self.envs != 1:
+            raise ValueError(
+                f"@demonstrations: starting from demonstrations needs envs: 1 (the replay buffer is filled as one "
+                f"env process's), got envs: {self.envs}"
+            )
+        return self
+
     @property
     def batch_size(self) -> int:
         """Env steps per update, over all env processes (PPO: rollout_steps × envs; SAC: train_freq × envs)."""
@@ -175,13 +234,26 @@ class TrainingConfig(Strict):
         return (self.ppo or self.sac).gamma
 
     def with_overrides(
-        self, *, steps: int | None = None, seed: int | None = None, envs: int | None = None
+        self,
+        *,
+        steps: int | None = None,
+        seed: int | None = None,
+        envs: int | None = None,
+        demonstrations: str | None = None,
+        demonstrations_root: str | None = None,
     ) -> TrainingConfig:
-        """This config with command-line overrides applied, validated again."""
+        """This config with command-line overrides applied, validated again. ``demonstrations``
+        names the dataset (the config's other ``demonstrations`` settings, or their defaults, kept)."""
         data = self.model_dump()
         for key, value in (("total_steps", steps), ("seed", seed), ("envs", envs)):
             if value is not None:
                 data[key] = value
+        if demonstrations is not None:
+            data["demonstrations"] = {**(data.get("demonstrations") or {}), "dataset": demonstrations}
+            if demonstrations_root is not None:
+                data["demonstrations"]["root"] = demonstrations_root
+        elif demonstrations_root is not None:
+            raise UsageError("--demonstrations-root: give the dataset too (--demonstrations DATASET)")
         try:
             return TrainingConfig.model_validate(data)
         except ValidationError as exc:

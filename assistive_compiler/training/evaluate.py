@@ -165,6 +165,7 @@ def evaluate(
         "episodes": episodes,
         "seed": seed,
         "actions": "stochastic" if stochastic else "deterministic",
+        "demonstrations": run.demonstrations() is not None,  # started from demonstrations, not the reward alone
         **_figures(results),
         "per_episode": results,
     }

@@ -114,7 +114,8 @@ def _wall_at(run: RunDir, steps: int) -> float | None:
 
 
 def _default_label(info) -> str:
-    """``SAC (sac_laptop)``: the algorithm and the config the run was started with."""
+    """``SAC (sac_laptop)``: the algorithm and the config the run was started with (``results``
+    adds "(demonstrations)" to a run that started from them)."""
     command = list(info.command)
     config = command[command.index("--config") + 1] if "--config" in command[:-1] else "config"
     return f"{info.algorithm.upper()} ({Path(config).stem})"
@@ -185,7 +186,8 @@ def export_run(
         "content_hash": info.content_hash,
         "engine": info.engine,
         "algorithm": config.algorithm,
-        "demonstrations": False,
+        # False for pure RL; a run started from demonstrations: its dataset and how the start went
+        "demonstrations": run.demonstrations() or False,
         "config": config.model_dump(exclude_none=True),
         "trained_steps": steps,
         "wall_s": wall,

@@ -36,6 +36,15 @@ def _hours(seconds: float | None) -> str:
     return f"{seconds / 3600:.1f} h" if seconds >= 3600 else f"{seconds / 60:.0f} min"
 
 
+def _started_from(demonstrations: dict | bool) -> str:
+    """What a row started from, when not from the reward alone: always said in the table."""
+    if not demonstrations:
+        return ""
+    if isinstance(demonstrations, dict):
+        return f" from {demonstrations['episodes']} {demonstrations['policy']} demonstrations ({demonstrations['steps']:,} steps)"
+    return " (demonstrations)"
+
+
 def _row(r: dict, paper: dict, paper_success: dict) -> list[str]:
     e = r["evaluation"]
     paper_return = paper.get(r["task"], {}).get(r["robot"])
@@ -44,7 +53,7 @@ def _row(r: dict, paper: dict, paper_success: dict) -> list[str]:
     return [
         TASK_TITLES.get(r["task"], r["task"]),
         ROBOT_TITLES.get(r["robot"], r["robot"]),
-        r["label"] + (" (demonstrations)" if r["demonstrations"] else ""),
+        r["label"] + _started_from(r["demonstrations"]),
         f"{r['trained_steps']:,}",
         _hours(r.get("wall_s")),
         "—" if not r.get("steps_per_s_including_learning") else f"{r['steps_per_s_including_learning']:.0f}",

@@ -182,9 +182,20 @@ def _callback(run: RunDir, progress: Progress, config: TrainingConfig, n_envs: i
 
 
 def train(
-    run: RunDir, config: TrainingConfig, weights: dict[str, float], *, resume: bool, quiet: bool = False, stop=None
+    run: RunDir,
+    config: TrainingConfig,
+    weights: dict[str, float],
+    *,
+    resume: bool,
+    quiet: bool = False,
+    stop=None,
+    demonstrations=None,
 ) -> dict:
     """Train (or continue) the run to ``config.total_steps``; returns the session's figures.
+
+    A new run given ``demonstrations`` (:class:`.demonstrations.DemonstrationData`) starts from
+    them: its actor cloned, its replay buffer filled, and a checkpoint at step 0 of just that
+    (the cloned policy, before any env step), before it learns.
 
     A stop request (``stop``, set by Ctrl-C or SIGTERM: :func:`.train.stop_on_signals`) ends
     training after the current env step; a checkpoint is written and the figures come back with
@@ -209,6 +220,15 @@ def train(
             model.load_replay_buffer(str(latest[1] / REPLAY_BUFFER))
     else:
         model = _new_model(venv, config, run)
+    if demonstrations is not None and config.demonstrations is not None:
+        import json
+
+        from ..run_dir import write_atomic
+        from .demonstrations import start_from
+
+        started_from = start_from(model, demonstrations, config.demonstrations, config.seed)
+        save_checkpoint(run, model, 0)
+        write_atomic(run.demonstrations_json, json.dumps(started_from, indent=1))
     progress = Progress(run, weights, config.total_steps, start_steps, quiet=quiet)
     interrupted = False
     try:

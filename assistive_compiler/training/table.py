@@ -19,6 +19,8 @@ from ..run_dir import RunDir
 from .paper import PAPER, ROBOT_TITLES, ROBOTS, TASK_TITLES, TASKS
 
 EVALUATION_FILE = "evaluation.json"
+#: Marks a cell whose run started from demonstrations (train --demonstrations), not from the reward alone.
+DEMONSTRATIONS_MARK = " †"
 
 
 def run_figures(run_dir: str | Path, episodes: int | None = None, seed: int = 0) -> dict:
@@ -62,7 +64,8 @@ def table_rows(best: dict, coop: bool) -> tuple[list[str], list[list[str]], list
         for robot in robots:
             paper_value = paper.get(task, {}).get(robot)
             mine = ours[robot]
-            cells.append(f"{_fmt(mine['mean_return'] if mine else None)} ({_fmt(paper_value)})")
+            mark = DEMONSTRATIONS_MARK if mine and mine.get("demonstrations") else ""
+            cells.append(f"{_fmt(mine['mean_return'] if mine else None)}{mark} ({_fmt(paper_value)})")
             records.append(
                 {
                     "table": "II" if coop else "I",
@@ -74,6 +77,7 @@ def table_rows(best: dict, coop: bool) -> tuple[list[str], list[list[str]], list
                     "episodes": mine["episodes"] if mine else None,
                     "trained_steps": mine["trained_steps"] if mine else None,
                     "run": mine["run"] if mine else None,
+                    "demonstrations": bool(mine.get("demonstrations")) if mine else None,
                     "paper_mean_return": paper_value,
                 }
             )
@@ -117,6 +121,8 @@ def make_tables(run_dirs: list[str], out: str | None = None, episodes: int | Non
         + "; ".join(f"`{run}` ({steps:,} steps, {n} episodes from seed {s})" for run, n, steps, s in used)
         + "\n"
     )
+    if any(r.get("demonstrations") for r in best.values()):
+        parts.append(f"{DEMONSTRATIONS_MARK.strip()} started from demonstrations (`train --demonstrations`).\n")
     text = "\n".join(parts)
     if out:
         out_md = Path(out)

@@ -77,10 +77,22 @@ def train(
     resume: bool = False,
     address: str | None = None,
     quiet: bool = False,
+    demonstrations: str | None = None,
+    demonstrations_root: str | None = None,
 ) -> dict:
-    """Train a policy for ``spec`` and ``robot`` as ``config_path`` says; returns the run's summary."""
+    """Train a policy for ``spec`` and ``robot`` as ``config_path`` says; returns the run's summary.
+    ``demonstrations``: a Minari dataset id of the same task to start a new SAC run from
+    (:mod:`.demonstrations`)."""
     engine = choose_engine(engine, coop, address)
-    config: TrainingConfig = load_training_config(config_path).with_overrides(steps=steps, seed=seed, envs=envs)
+    if demonstrations is not None and resume:
+        raise UsageError(
+            "--demonstrations starts a new run; --resume continues one with the demonstrations it started from"
+        )
+    if demonstrations is not None and engine != "sb3":
+        raise UsageError("--demonstrations: starting from demonstrations is for single-agent SB3 SAC (--engine sb3)")
+    config: TrainingConfig = load_training_config(config_path).with_overrides(
+        steps=steps, seed=seed, envs=envs, demonstrations=demonstrations, demonstrations_root=demonstrations_root
+    )
     result, robot = compile_for_run(spec, robot, coop)
     if engine == "rllib":
         from .rllib import init_ray
@@ -101,7 +113,17 @@ def train(
         raise UsageError(
             f"{display(run.path)}: the run directory already holds a run; pass --resume to continue it, or choose another --out"
         )
-    else:
+    demo_data = None
+    if config.demonstrations is not None and not resume:  # read and checked before the run directory is written
+        from .demonstrations import load_demonstrations
+
+        if config.demonstrations.dataset is None:
+            raise UsageError(
+                f"{display(Path(config_path))}: this config starts from demonstrations; "
+                "name the dataset with --demonstrations DATASET (a `collect` dataset of this task)"
+            )
+        demo_data = load_demonstrations(config.demonstrations, manifest.content_hash)
+    if not resume:
         run.create(new_run_info(spec, manifest, robot, coop, engine, config), result.out_dir)
     weights = reward_weights(manifest)
     if not quiet:
@@ -117,7 +139,7 @@ def train(
         if engine == "sb3":
             from . import sb3
 
-            figures = sb3.train(run, config, weights, resume=resume, quiet=quiet, stop=stop)
+            figures = sb3.train(run, config, weights, resume=resume, quiet=quiet, stop=stop, demonstrations=demo_data)
         else:
             from . import rllib
 
@@ -180,6 +202,9 @@ def finish(run: RunDir, manifest, engine: str, config: TrainingConfig, figures: 
         "final_success_rate": sum(r["success_rate"] for r in tail) / len(tail) if tail else None,
         "checkpoint": display(run.latest_checkpoint()[1]) if run.latest_checkpoint() else None,
     }
+    started_from = run.demonstrations()
+    if started_from is not None:
+        summary["demonstrations"] = started_from
     if curve:
         plot_curves({run.path.name: curve}, run.curve_png, title=manifest.label)
         summary["learning_curve"] = display(run.curve_png)

@@ -191,3 +191,16 @@ def test_the_reach_example_is_not_a_registered_id():
     from assistive_compiler.registration import shipped_ids
 
     assert not [i for i in shipped_ids() if "Reach" in i]
+
+
+def test_sac_demos_is_the_recipe_started_from_demonstrations():
+    """sac_demos: sac_laptop's SAC without the phase of random actions (the demonstrations fill the
+    buffer), with the start's settings spelled out and the dataset left to --demonstrations."""
+    demos = load_training_config(REPO / "specs" / "training" / "sac_demos.yaml")
+    recipe = load_training_config(REPO / "specs" / "training" / "sac_laptop.yaml")
+    assert demos.sac.learning_starts == 0 and recipe.sac.learning_starts == 5000
+    assert demos.sac.model_copy(update={"learning_starts": 5000}) == recipe.sac
+    assert (demos.network, demos.total_steps, demos.envs) == (recipe.network, recipe.total_steps, recipe.envs)
+    d = demos.demonstrations
+    assert d is not None and d.dataset is None and d.replay and d.critic_warmup_steps == 5000
+    assert demos.with_overrides(demonstrations="a/b-v0").demonstrations == d.model_copy(update={"dataset": "a/b-v0"})

@@ -149,10 +149,28 @@ def test_multi_agent_sac_trains_and_exports_a_pair_that_plays_under_coop(local_r
     record = export_run(out, tmp_path / "pair", episodes=1, seed=7)
     assert record["coop"] and record["export_max_action_difference"] < 1e-4
     assert {p.name for p in (tmp_path / "pair").iterdir()} >= {"policy.json", "robot", "human"}
-    checkpoint_return = evaluate(out, episodes=1, seed=7)["mean_return"]
-    assert record["evaluation"]["mean_return"] == pytest.approx(
-        checkpoint_return, abs=0.05
-    )  # float64 NumPy vs float32 torch
+    # On the observations of a real co-optimised episode (not only the export's random ones), each
+    # exported agent acts as the checkpoint's, to float32 precision. (Their episode returns may
+    # still differ by a point: the food's contacts amplify a 1e-6 action difference.)
+    from assistive_compiler.policies.checkpoint import load_policy
+    from assistive_compiler.policies.pretrained import load_trained
+    from assistive_compiler.training.evaluate import play_episodes
+
+    run = RunDir(out)
+    checkpoint_pair = load_policy(run.info(), run.latest_checkpoint()[1])
+    exported, _ = load_trained(str(tmp_path / "pair"))
+    seen: dict[str, list] = {"robot": [], "human": []}
+
+    class Recorded:
+        def agent(self, name):
+            act = checkpoint_pair.agent(name)
+            return lambda obs: (seen[name].append(obs), act(obs))[1]
+
+    play_episodes(run.artifact, Recorded(), True, 1, 7)
+    for name, observations in seen.items():
+        assert len(observations) > 50
+        worst = max(np.abs(exported.agent(name)(o) - checkpoint_pair.agent(name)(o)).max() for o in observations)
+        assert worst < 1e-4, (name, worst)
     capsys.readouterr()
     assert (
         main(

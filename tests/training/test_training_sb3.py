@@ -553,3 +553,143 @@ def test_a_driver_killed_outright_leaves_a_resumable_run(tmp_path):
     rows = list(csv.DictReader((out / "curve.csv").open()))
     steps = [int(r["steps"]) for r in rows]
     assert steps == sorted(set(steps)) and steps[-1] == target  # no row repeated from before the kill
+
+
+# --------------------------------------------------------------------------------------------
+# Starting a SAC run from demonstrations (train --demonstrations: a Minari dataset of the task)
+
+DEMOS = "assistive_compiler/reach-jaco/scripted-v0"
+SAC_FROM_DEMOS = SAC_TINY.replace("total_steps: 600", "total_steps: 200")
+
+
+@pytest.fixture(scope="module")
+def demos_root(tmp_path_factory) -> Path:
+    """8 episodes of the scripted policy on reach × Jaco (every one reaches), as `collect` writes them."""
+    pytest.importorskip("minari", reason='needs the "datasets" extra')
+    from assistive_compiler.datasets import collect
+
+    root = tmp_path_factory.mktemp("demos")
+    collect(str(REACH), "jaco", DEMOS, episodes=8, seed=0, root=root, out=str(root / "artifact"))
+    return root
+
+
+@pytest.fixture(scope="module")
+def demo_run(demos_root) -> Path:
+    config = demos_root / "sac_from_demos.yaml"
+    config.write_text(SAC_FROM_DEMOS)
+    out = demos_root / "reach-sac-demos"
+    args = ["train", str(REACH), "--robot", "jaco", "--config", str(config), "--out", str(out), "--quiet"]
+    assert main([*args, "--demonstrations", DEMOS, "--demonstrations-root", str(demos_root)]) == 0
+    return out
+
+
+def test_a_run_from_demonstrations_starts_from_the_cloned_policy_and_replays_every_step(demo_run, demos_root):
+    import minari
+
+    run = RunDir(demo_run)
+    dataset = minari.load_dataset(DEMOS)
+    assert sorted(int(p.name.split("_")[1]) for p in run.checkpoints.glob("step_*")) == [0, 200]
+    started = json.loads((demo_run / "demonstrations.json").read_text())
+    assert (started["dataset"], started["policy"], started["episodes"], started["successful_episodes"]) == (
+        DEMOS,
+        "scripted",
+        8,
+        8,
+    )
+    assert started["steps"] == started["cloned_steps"] == started["replayed_steps"] == dataset.total_steps
+    assert started["clone_mse_after"] < 0.5 * started["clone_mse_before"]
+    assert json.loads(run.summary_json.read_text())["demonstrations"] == started
+    assert run.info().config["demonstrations"]["dataset"] == DEMOS  # the run says what it started from
+    # Behaviour: the step-0 checkpoint (cloned, no env step yet) reaches far better than random
+    # actions on the same unseen seeds.
+    cloned = evaluate(demo_run, episodes=10, seed=EVAL_SEED, checkpoint_steps=0)
+    assert cloned["trained_steps"] == 0
+    env = AssistiveEnv(run.artifact)
+    policy = make_policy("random", env, seed=EVAL_SEED)
+    random_return = float(np.mean([rollout(env, policy, EVAL_SEED + k)["return"] for k in range(10)]))
+    env.close()
+    assert cloned["mean_return"] > random_return + 4.0, (cloned["mean_return"], random_return)
+    # The critics warmed up on the demonstrations: their value of each demonstrated (state, action)
+    # follows its discounted return to go, at its scale (untrained ones: std ~0.02 against the
+    # returns' ~1.7, correlation ~0.88 from the observations alone).
+    import torch
+    from stable_baselines3 import SAC
+
+    assert started["critic_warmup_steps"] == 5000
+    model = SAC.load(str(run.checkpoint_dir(0) / "model.zip"), device="cpu")
+    values, to_go = [], []
+    for episode in dataset.iterate_episodes():
+        rewards = np.asarray(episode.rewards)
+        to_go += [sum(0.99**k * r for k, r in enumerate(rewards[t:])) for t in range(len(rewards))]
+        obs = torch.as_tensor(np.asarray(episode.observations[:-1], dtype=np.float32))
+        act = torch.as_tensor(model.policy.scale_action(np.asarray(episode.actions)), dtype=torch.float32)
+        with torch.no_grad():
+            values += torch.min(*model.critic(obs, act)).ravel().tolist()
+    assert np.corrcoef(values, to_go)[0, 1] > 0.95 and np.std(values) > 0.5 * np.std(to_go)
+
+
+def _train_from_demos(demos_root: Path, out: Path, *extra: str) -> int:
+    config = demos_root / "sac_from_demos.yaml"
+    config.write_text(SAC_FROM_DEMOS)
+    return main(
+        ["train", str(REACH), "--config", str(config), "--out", str(out), "--quiet", "--demonstrations-root"]
+        + [str(demos_root), *extra]
+    )
+
+
+def test_demonstrations_of_another_task_or_robot_are_refused_before_the_run_is_written(demos_root, tmp_path, capsys):
+    out = tmp_path / "panda-from-jaco-demos"
+    assert _train_from_demos(demos_root, out, "--robot", "panda", "--demonstrations", DEMOS) == 2
+    err = capsys.readouterr().err
+    jaco_hash = Manifest.read(demos_root / "artifact").content_hash
+    assert f"--demonstrations {DEMOS}: collected on reach × jaco, compiled task {jaco_hash[:12]}; " in err
+    assert "Collect demonstrations on this task and robot (assistive-compiler collect SPEC --robot ROBOT)" in err
+    assert not out.exists()
+
+
+def test_a_missing_dataset_names_those_there_are(demos_root, tmp_path, capsys):
+    out = tmp_path / "missing"
+    assert _train_from_demos(demos_root, out, "--robot", "jaco", "--demonstrations", DEMOS.replace("v0", "v9")) == 2
+    err = capsys.readouterr().err
+    assert f"--demonstrations {DEMOS.replace('v0', 'v9')}: no such Minari dataset under {demos_root}" in err
+    assert f"datasets there: {DEMOS}" in err
+    assert not out.exists()
+
+
+def test_demonstrations_need_sac_on_one_env_and_a_new_run(demos_root, demo_run, tmp_path, capsys):
+    args = ["train", str(REACH), "--robot", "jaco", "--quiet", "--demonstrations", DEMOS]
+    assert main([*args, "--config", "ppo_quick", "--out", str(tmp_path / "ppo")]) == 2
+    assert (
+        "@demonstrations: starting from demonstrations fits SAC's actor and fills its replay buffer; algorithm is 'ppo'"
+        in (capsys.readouterr().err)
+    )
+    assert main([*args, "--config", "sac_laptop", "--envs", "2", "--out", str(tmp_path / "two")]) == 2
+    assert "starting from demonstrations needs envs: 1" in capsys.readouterr().err
+    assert main([*args, "--config", str(demo_run / "config.yaml"), "--out", str(demo_run), "--resume"]) == 2
+    assert "--demonstrations starts a new run; --resume continues one with the demonstrations it started from" in (
+        capsys.readouterr().err
+    )
+    assert not (tmp_path / "ppo").exists() and not (tmp_path / "two").exists()
+    # The shipped config for such runs needs the dataset named.
+    assert main(["train", str(REACH), "--robot", "jaco", "--config", "sac_demos", "--out", str(tmp_path / "none")]) == 2
+    assert (
+        "specs/training/sac_demos.yaml: this config starts from demonstrations; name the dataset with "
+        "--demonstrations DATASET (a `collect` dataset of this task)" in capsys.readouterr().err
+    )
+    assert not (tmp_path / "none").exists()
+
+
+def test_results_from_demonstrations_say_so_in_every_table(demo_run, tmp_path):
+    """`table` marks the cell, an exported policy records the dataset, and the results doc's row
+    names what the run started from: a demonstration start is never passed off as pure RL."""
+    from assistive_compiler.training.export import export_run
+    from assistive_compiler.training.results import results_block
+    from assistive_compiler.training.table import make_tables
+
+    copy = tmp_path / "run"
+    shutil.copytree(demo_run, copy)
+    text = make_tables([str(copy)], episodes=2, seed=EVAL_SEED)
+    assert " † (" in text and "† started from demonstrations (`train --demonstrations`)." in text
+    record = export_run(copy, tmp_path / "exported", episodes=2, seed=EVAL_SEED)
+    assert record["demonstrations"]["dataset"] == DEMOS and record["demonstrations"]["episodes"] == 8
+    assert f"{record['label']} from 8 scripted demonstrations (320 steps)" in results_block([record])

@@ -1,0 +1,225 @@
+"""Start a SAC run from demonstrations: a Minari dataset that ``collect`` wrote on the same task.
+
+Before the first env step of a new run (never on ``--resume``):
+
+1. **Behaviour cloning.** The actor's deterministic action (its squashed mean, in the policy's
+   [-1, 1] action scale) is fitted to the actions of the dataset's *successful* episodes by mean
+   squared error, ``clone_epochs`` passes of Adam (``clone_learning_rate``) in shuffled batches of
+   ``clone_batch_size`` steps. The actor's log-std is left as it is, so SAC still explores.
+2. **Replay.** Every demonstrated transition, failed episodes too, goes into the replay buffer with
+   the reward it was recorded with; an episode's last step is terminal only where the episode
+   terminated (a truncation at the time limit is not: SB3 bootstraps it).
+3. **Critic warm-up.** ``critic_warmup_steps`` gradient steps of SAC's critic update alone (soft
+   Bellman targets of the cloned actor, target critics following by Polyak averaging), on batches
+   of the buffer. Untrained critics would otherwise steer the first actor updates away from the
+   cloned behaviour before they know what it is worth.
+
+The dataset must have been collected on the run's compiled task (the same content hash): a
+dataset of another task, robot or task version is refused with what it was collected on.
+Everything here is seeded from the run's seed, so the same dataset and config start the same.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import UsageError
+from .config import Demonstrations
+
+
+@dataclass(frozen=True)
+class DemonstrationData:
+    """The transitions of a dataset's episodes, concatenated in episode order."""
+
+    dataset: str
+    observations: np.ndarray  # (N, O) float32, the observation each action was taken in
+    next_observations: np.ndarray  # (N, O) float32, the observation after it
+    actions: np.ndarray  # (N, A) in the env's action space
+    rewards: np.ndarray  # (N,)
+    terminations: np.ndarray  # (N,) bool
+    truncations: np.ndarray  # (N,) bool
+    successful: np.ndarray  # (N,) bool: the step belongs to an episode that succeeded
+    episodes: int
+    successes: int
+    policy: str
+
+
+def load_demonstrations(settings: Demonstrations, content_hash: str) -> DemonstrationData:
+    """Read the dataset ``settings.dataset`` and check it was collected on ``content_hash``."""
+    if settings.dataset is None:
+        raise UsageError("starting from demonstrations needs a dataset: --demonstrations DATASET")
+    try:
+        import minari
+    except ImportError:
+        raise UsageError(
+            'train --demonstrations: Minari datasets need the "datasets" extra: pip install "assistive-compiler[datasets]"'
+        ) from None
+    if settings.root is not None:
+        os.environ["MINARI_DATASETS_PATH"] = str(Path(settings.root).resolve())
+    where = settings.root or os.environ.get("MINARI_DATASETS_PATH", "~/.minari/datasets")
+    try:
+        dataset = minari.load_dataset(settings.dataset)
+    except (FileNotFoundError, ValueError) as exc:
+        local = []
+        try:
+            local = sorted(minari.list_local_datasets())
+        except Exception:  # noqa: BLE001 — only for the message
+            pass
+        there = f"; datasets there: {', '.join(local)}" if local else "; there are none there"
+        raise UsageError(
+            f"--demonstrations {settings.dataset}: no such Minari dataset under {where} ({exc}){there}"
+        ) from None
+    meta = dataset.storage.metadata.get("assistive_compiler")
+    if not isinstance(meta, dict) or "content_hash" not in meta:
+        raise UsageError(
+            f"--demonstrations {settings.dataset}: not a dataset written by `assistive-compiler collect` "
+            "(its metadata has no assistive_compiler.content_hash), so it cannot be checked against the task"
+        )
+    if meta["content_hash"] != content_hash:
+        raise UsageError(
+            f"--demonstrations {settings.dataset}: collected on {meta.get('task')} × {meta.get('robot')}, "
+            f"compiled task {str(meta['content_hash'])[:12]}; this run trains compiled task {content_hash[:12]}. "
+            "Collect demonstrations on this task and robot (assistive-compiler collect SPEC --robot ROBOT)"
+        )
+    parts: dict[str, list[np.ndarray]] = {k: [] for k in ("obs", "next", "act", "rew", "term", "trunc", "ok")}
+    successes = 0
+    for episode in dataset.iterate_episodes():
+        obs = np.asarray(episode.observations, dtype=np.float32)
+        steps = len(episode.actions)
+        success = bool(np.asarray(episode.infos["task_success"])[-1])
+        successes += success
+        parts["obs"].append(obs[:-1])
+        parts["next"].append(obs[1:])
+        parts["act"].append(np.asarray(episode.actions, dtype=np.float32))
+        parts["rew"].append(np.asarray(episode.rewards, dtype=np.float32))
+        parts["term"].append(np.asarray(episode.terminations, dtype=bool))
+        parts["trunc"].append(np.asarray(episode.truncations, dtype=bool))
+        parts["ok"].append(np.full(steps, success))
+    if settings.clone_epochs and not successes:
+        raise UsageError(
+            f"--demonstrations {settings.dataset}: none of its {len(parts['obs'])} episodes succeeded, so there is "
+            "nothing to clone; collect more episodes, or set demonstrations.clone_epochs: 0 to use it for replay only"
+        )
+    return DemonstrationData(
+        dataset=settings.dataset,
+        observations=np.concatenate(parts["obs"]),
+        next_observations=np.concatenate(parts["next"]),
+        actions=np.concatenate(parts["act"]),
+        rewards=np.concatenate(parts["rew"]),
+        terminations=np.concatenate(parts["term"]),
+        truncations=np.concatenate(parts["trunc"]),
+        successful=np.concatenate(parts["ok"]),
+        episodes=len(parts["obs"]),
+        successes=successes,
+        policy=str(meta.get("policy", "?")),
+    )
+
+
+def clone(model, data: DemonstrationData, settings: Demonstrations, seed: int) -> dict:
+    """Fit ``model``'s (SB3 SAC) actor to the successful episodes' actions; returns the figures
+    (steps cloned, epochs, the mean squared error before and after, in the [-1, 1] action scale)."""
+    import torch
+
+    keep = data.successful
+    figures = {"cloned_steps": int(keep.sum()), "clone_epochs": settings.clone_epochs}
+    if settings.clone_epochs == 0:
+        return figures
+    policy = model.policy
+    obs = torch.as_tensor(data.observations[keep])
+    target = torch.as_tensor(policy.scale_action(data.actions[keep]).clip(-1.0, 1.0), dtype=torch.float32)
+    actor = model.actor
+    optimiser = torch.optim.Adam(actor.parameters(), lr=settings.clone_learning_rate)
+    rng = np.random.default_rng(seed)
+    n, batch = len(obs), min(settings.clone_batch_size, len(obs))
+
+    def error() -> float:
+        with torch.no_grad():
+            return float(torch.mean((actor(obs, deterministic=True) - target) ** 2))
+
+    figures["clone_mse_before"] = error()
+    actor.train()
+    for _ in range(settings.clone_epochs):
+        order = rng.permutation(n)
+        for start in range(0, n - batch + 1, batch):
+            idx = torch.as_tensor(order[start : start + batch])
+            loss = torch.mean((actor(obs[idx], deterministic=True) - target[idx]) ** 2)
+            optimiser.zero_grad()
+            loss.backward()
+            optimiser.step()
+    actor.train(False)
+    figures["clone_mse_after"] = error()
+    return figures
+
+
+def fill_replay(model, data: DemonstrationData) -> int:
+    """Add every demonstrated transition to ``model``'s replay buffer (one env: SB3 adds per env
+    process); returns how many."""
+    buffer = model.replay_buffer
+    actions = model.policy.scale_action(data.actions).clip(-1.0, 1.0)
+    for k in range(len(actions)):
+        terminated, truncated = bool(data.terminations[k]), bool(data.truncations[k])
+        buffer.add(
+            data.observations[k : k + 1],
+            data.next_observations[k : k + 1],
+            actions[k : k + 1],
+            data.rewards[k : k + 1],
+            np.array([terminated or truncated]),
+            [{"TimeLimit.truncated": truncated and not terminated}],
+        )
+    return len(actions)
+
+
+def warm_critic(model, steps: int) -> dict:
+    """``steps`` of SAC's critic update alone on ``model``'s replay buffer (the actor and the
+    temperature held); returns the mean critic loss of the first and the last 100 steps."""
+    import torch
+    import torch.nn.functional as F
+    from stable_baselines3.common.utils import polyak_update
+
+    if steps == 0:
+        return {"critic_warmup_steps": 0}
+    critic, target, actor = model.critic, model.critic_target, model.actor
+    temperature = torch.exp(model.log_ent_coef.detach()) if model.log_ent_coef is not None else model.ent_coef_tensor
+    losses = []
+    critic.set_training_mode(True)
+    for step in range(steps):
+        batch = model.replay_buffer.sample(model.batch_size)
+        with torch.no_grad():
+            next_actions, next_log_prob = actor.action_log_prob(batch.next_observations)
+            next_q = torch.min(torch.cat(target(batch.next_observations, next_actions), dim=1), dim=1, keepdim=True)[0]
+            next_q = next_q - temperature * next_log_prob.reshape(-1, 1)
+            goal = batch.rewards + (1 - batch.dones) * model.gamma * next_q
+        loss = 0.5 * sum(F.mse_loss(q, goal) for q in critic(batch.observations, batch.actions))
+        critic.optimizer.zero_grad()
+        loss.backward()
+        critic.optimizer.step()
+        if step % model.target_update_interval == 0:
+            polyak_update(critic.parameters(), target.parameters(), model.tau)
+            polyak_update(model.batch_norm_stats, model.batch_norm_stats_target, 1.0)
+        losses.append(float(loss))
+    critic.set_training_mode(False)
+    return {
+        "critic_warmup_steps": steps,
+        "critic_loss_first_100": float(np.mean(losses[:100])),
+        "critic_loss_last_100": float(np.mean(losses[-100:])),
+    }
+
+
+def start_from(model, data: DemonstrationData, settings: Demonstrations, seed: int) -> dict:
+    """Behaviour cloning, then the replay buffer (:func:`clone`, :func:`fill_replay`) of a new
+    run's model; returns what ``summary.json`` records as the run's ``demonstrations``."""
+    figures = {
+        "dataset": data.dataset,
+        "policy": data.policy,
+        "episodes": data.episodes,
+        "successful_episodes": data.successes,
+        "steps": int(len(data.actions)),
+    }
+    figures.update(clone(model, data, settings, seed))
+    figures["replayed_steps"] = fill_replay(model, data) if settings.replay else 0
+    figures.update(warm_critic(model, settings.critic_warmup_steps))
+    return figures
