@@ -40,6 +40,11 @@ from .references import JointGroup, LinkPoint, ParamValue, TargetPoint
 #: from ``sim.ground_friction`` and ``Body.position_noise`` (format 1 is read and migrated).
 FORMAT_VERSION = 2
 
+#: The agents of a co-optimised task, in order: the robot and the person. They are the manifest's
+#: observation groups, the PettingZoo agent ids (``coop``), the RLlib policy ids (``training``) and
+#: the parts of a shipped pair (``policies``).
+AGENTS = ("robot", "human")
+
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
 

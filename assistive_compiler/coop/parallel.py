@@ -29,13 +29,11 @@ import gymnasium as gym
 import numpy as np
 from pettingzoo import ParallelEnv
 
+from ..artifact import AGENTS
 from ..errors import Problem, SpecError, did_you_mean
 from ..runtime.env import AssistiveEnv
 
 __all__ = ["AGENTS", "AssistiveParallelEnv", "parallel_env", "check_coop_spec", "coop_name"]
-
-#: The agents, in the order of ``possible_agents``.
-AGENTS = ("robot", "human")
 
 
 def coop_name(gym_id: str) -> str:

@@ -8,14 +8,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ..artifact import AGENTS
 from ..errors import UsageError
 from ..paths import display
 from ..run_dir import RunDir, RunInfo, engine_modules
 
 #: RLlib's module id of a single-agent run (``ray.rllib.core.DEFAULT_MODULE_ID``).
 SINGLE_MODULE = "default_policy"
-#: A co-optimised run's modules, one per agent: the robot's, then the person's.
-PAIR = ("robot", "human")
 
 
 def algorithm_class(config_or_name):
@@ -71,7 +70,7 @@ class RLlibPolicy:
         from ray.rllib.core.rl_module.rl_module import RLModule
 
         root = checkpoint / "algo" / "learner_group" / "learner" / "rl_module"
-        names = PAIR if coop else (SINGLE_MODULE,)
+        names = AGENTS if coop else (SINGLE_MODULE,)
         self.modules = {name: RLModule.from_checkpoint(str((root / name).resolve())) for name in names}
         self.coop, self.algorithm = coop, algorithm
         self.rng = np.random.default_rng(seed) if stochastic else None
@@ -98,7 +97,7 @@ class RLlibPolicy:
 
     def __call__(self, obs: np.ndarray, human_obs: np.ndarray | None = None):
         if self.coop:
-            return self._act(PAIR[0], obs), self._act(PAIR[1], human_obs)
+            return self._act(AGENTS[0], obs), self._act(AGENTS[1], human_obs)
         return self._act(SINGLE_MODULE, obs)
 
 

@@ -21,13 +21,13 @@ import socket
 import sys
 from pathlib import Path
 
+from ..artifact import AGENTS
 from ..errors import UsageError
 from ..run_dir import RunDir
 from .config import TrainingConfig
 from .progress import Progress
 
 ENV_NAME = "assistive_compiler"
-AGENTS = ("robot", "human")
 CONNECT_TIMEOUT_S = 3.0
 GCS_WAIT_VAR = "RAY_gcs_server_port_wait_time_s"
 
