@@ -4,8 +4,8 @@ Before the first env step of a new run (never on ``--resume``):
 
 1. **Behaviour cloning.** The actor's deterministic action (its squashed mean, in the policy's
    [-1, 1] action scale) is fitted to the actions of the dataset's *successful* episodes by mean
-   squared error, ``clone_epochs`` passes of Adam (``clone_learning_rate``) in shuffled batches of
-   ``clone_batch_size`` steps. The actor's log-std is left as it is, so SAC still explores.
+   squared error, and its log-std by the likelihood of its misses, ``clone_epochs`` passes
+   of Adam (``clone_learning_rate``) in shuffled batches of ``clone_batch_size`` steps.
 2. **Replay.** Every demonstrated transition, failed episodes too, goes into the replay buffer with
    the reward it was recorded with; an episode's last step is terminal only where the episode
    terminated (a truncation at the time limit is not: SB3 bootstraps it).
@@ -121,7 +121,13 @@ def load_demonstrations(settings: Demonstrations, content_hash: str) -> Demonstr
 
 def clone(model, data: DemonstrationData, settings: Demonstrations, seed: int) -> dict:
     """Fit ``model``'s (SB3 SAC) actor to the successful episodes' actions; returns the figures
-    (steps cloned, epochs, the mean squared error before and after, in the [-1, 1] action scale)."""
+    (steps cloned, epochs, the deterministic action's mean squared error before and after in the
+    [-1, 1] action scale, and the policy's mean standard deviation before the squashing after).
+
+    The deterministic action (the squashed mean) is fitted by mean squared error; the log-std, by
+    a Gaussian likelihood of the mean's misses (the mean held), so the cloned policy
+    explores as far as it misses the demonstrations, not with the initial noise (σ ≈ 1 before the
+    squashing, which would throw the cloned behaviour away at the first sampled step)."""
     import torch
 
     keep = data.successful
@@ -136,22 +142,32 @@ def clone(model, data: DemonstrationData, settings: Demonstrations, seed: int) -
     rng = np.random.default_rng(seed)
     n, batch = len(obs), min(settings.clone_batch_size, len(obs))
 
-    def error() -> float:
-        with torch.no_grad():
-            return float(torch.mean((actor(obs, deterministic=True) - target) ** 2))
+    def loss_of(o: torch.Tensor, a: torch.Tensor) -> torch.Tensor:
+        mean, log_std, _ = actor.get_action_dist_params(o)
+        miss = torch.tanh(mean) - a
+        # σ: a Gaussian's maximum likelihood of the misses of the (held) mean, in the action scale
+        # (before the squashing it is then at most as wide where tanh' < 1; a likelihood through
+        # the squashing would blow σ up on the demonstrations' saturated ±1 actions).
+        spread = torch.mean(0.5 * (miss.detach() / log_std.exp()) ** 2 + log_std)
+        return torch.mean(miss**2) + spread
 
-    figures["clone_mse_before"] = error()
+    def measured() -> tuple[float, float]:
+        with torch.no_grad():
+            _, log_std, _ = actor.get_action_dist_params(obs)
+            return float(torch.mean((actor(obs, deterministic=True) - target) ** 2)), float(log_std.exp().mean())
+
+    figures["clone_mse_before"], figures["clone_std_before"] = measured()
     actor.train()
     for _ in range(settings.clone_epochs):
         order = rng.permutation(n)
         for start in range(0, n - batch + 1, batch):
             idx = torch.as_tensor(order[start : start + batch])
-            loss = torch.mean((actor(obs[idx], deterministic=True) - target[idx]) ** 2)
+            loss = loss_of(obs[idx], target[idx])
             optimiser.zero_grad()
             loss.backward()
             optimiser.step()
     actor.train(False)
-    figures["clone_mse_after"] = error()
+    figures["clone_mse_after"], figures["clone_std_after"] = measured()
     return figures
 
 
@@ -200,7 +216,7 @@ def warm_critic(model, steps: int) -> dict:
         if step % model.target_update_interval == 0:
             polyak_update(critic.parameters(), target.parameters(), model.tau)
             polyak_update(model.batch_norm_stats, model.batch_norm_stats_target, 1.0)
-        losses.append(float(loss))
+        losses.append(loss.item())
     critic.set_training_mode(False)
     return {
         "critic_warmup_steps": steps,
