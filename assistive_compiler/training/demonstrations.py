@@ -129,6 +129,7 @@ def clone(model, data: DemonstrationData, settings: Demonstrations, seed: int) -
     explores as far as it misses the demonstrations, not with the initial noise (σ ≈ 1 before the
     squashing, which would throw the cloned behaviour away at the first sampled step)."""
     import torch
+    from stable_baselines3.sac.policies import LOG_STD_MAX, LOG_STD_MIN
 
     keep = data.successful
     figures = {"cloned_steps": int(keep.sum()), "clone_epochs": settings.clone_epochs}
@@ -143,7 +144,10 @@ def clone(model, data: DemonstrationData, settings: Demonstrations, seed: int) -
     n, batch = len(obs), min(settings.clone_batch_size, len(obs))
 
     def loss_of(o: torch.Tensor, a: torch.Tensor) -> torch.Tensor:
-        mean, log_std, _ = actor.get_action_dist_params(o)
+        latent = actor.latent_pi(actor.extract_features(o, actor.features_extractor))
+        mean = actor.mu(latent)
+        # the log-std head reads the shared layers without training them: they serve the mean's fit
+        log_std = torch.clamp(actor.log_std(latent.detach()), LOG_STD_MIN, LOG_STD_MAX)
         miss = torch.tanh(mean) - a
         # σ: a Gaussian's maximum likelihood of the misses of the (held) mean, in the action scale
         # (before the squashing it is then at most as wide where tanh' < 1; a likelihood through
