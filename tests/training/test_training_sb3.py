@@ -562,7 +562,7 @@ DEMOS = "assistive_compiler/reach-jaco/scripted-v0"
 # A fixed, small temperature: the critics' soft values are then the returns (the test reads them)
 SAC_FROM_DEMOS = SAC_TINY.replace("total_steps: 600", "total_steps: 200").replace(
     "batch_size: 32}", "batch_size: 32, ent_coef: 0.001}"
-)
+) + "demonstrations: {clone_epochs: 200, clone_batch_size: 32}\n"
 
 
 @pytest.fixture(scope="module")
