@@ -45,6 +45,25 @@ def _started_from(demonstrations: dict | bool) -> str:
     return " (demonstrations)"
 
 
+def _start_sentence(demonstrations: dict | bool) -> str:
+    """How a run that started from demonstrations did so, for its cell's paragraph."""
+    if not isinstance(demonstrations, dict):
+        return ""
+    d = demonstrations
+    cloned = (
+        f"the actor cloned on the {d['cloned_steps']:,} steps of the successful ones (squared error of its "
+        f"actions {d['clone_mse_before']:.3f} → {d['clone_mse_after']:.4f})"
+        if "clone_mse_after" in d
+        else "no cloning"
+    )
+    return (
+        f" Started from `{d['dataset']}`: {d['episodes']} episodes of the {d['policy']} policy "
+        f"({d['successful_episodes']} successful, {d['steps']:,} steps); {cloned}, "
+        f"{d['replayed_steps']:,} steps in the replay buffer, the critics warmed up for "
+        f"{d.get('critic_warmup_steps', 0):,} gradient steps."
+    )
+
+
 def _row(r: dict, paper: dict, paper_success: dict) -> list[str]:
     e = r["evaluation"]
     paper_return = paper.get(r["task"], {}).get(r["robot"])
@@ -155,9 +174,10 @@ def results_block(records: list[dict]) -> str:
             f"({_hours(r.get('wall_s'))}), evaluated on {e['episodes']} episodes, seeds {e['seed']:,}–"
             f"{e['seed'] + e['episodes'] - 1:,} (never used in training), deterministic actions: success "
             f"{100 * e['success_rate']:.0f}%, return {e['mean_return']:.1f} ± {e['std_return']:.1f}. "
-            f"Trained on the compiled task {r['content_hash'][:12]}.\n"
+            f"Trained on the compiled task {r['content_hash'][:12]}.{_start_sentence(r['demonstrations'])}\n"
         )
-        parts.append(f"![{r['name']} learning curve]({PICTURES}/{r['name']}-curve.png)\n")
+        if r["trained_steps"] > 0:  # a policy shipped before its first env step has no curve
+            parts.append(f"![{r['name']} learning curve]({PICTURES}/{r['name']}-curve.png)\n")
         parts.append(f"![{r['name']} rollout, seed {e['seed']:,}]({PICTURES}/{r['name']}.png)\n")
     parts.append(END)
     return "\n".join(parts)

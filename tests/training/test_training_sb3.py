@@ -560,9 +560,12 @@ def test_a_driver_killed_outright_leaves_a_resumable_run(tmp_path):
 
 DEMOS = "assistive_compiler/reach-jaco/scripted-v0"
 # A fixed, small temperature: the critics' soft values are then the returns (the test reads them)
-SAC_FROM_DEMOS = SAC_TINY.replace("total_steps: 600", "total_steps: 200").replace(
-    "batch_size: 32}", "batch_size: 32, ent_coef: 0.001}"
-) + "demonstrations: {clone_epochs: 200, clone_batch_size: 32}\n"
+SAC_FROM_DEMOS = (
+    SAC_TINY.replace("total_steps: 600", "total_steps: 200").replace(
+        "batch_size: 32}", "batch_size: 32, ent_coef: 0.001}"
+    )
+    + "demonstrations: {clone_epochs: 200, clone_batch_size: 32}\n"
+)
 
 
 @pytest.fixture(scope="module")
@@ -700,4 +703,7 @@ def test_results_from_demonstrations_say_so_in_every_table(demo_run, tmp_path):
     assert " † (" in text and "† started from demonstrations (`train --demonstrations`)." in text
     record = export_run(copy, tmp_path / "exported", episodes=2, seed=EVAL_SEED)
     assert record["demonstrations"]["dataset"] == DEMOS and record["demonstrations"]["episodes"] == 8
-    assert f"{record['label']} from 8 scripted demonstrations (320 steps)" in results_block([record])
+    block = results_block([record])
+    assert f"{record['label']} from 8 scripted demonstrations (320 steps)" in block
+    assert f"Started from `{DEMOS}`: 8 episodes of the scripted policy (8 successful, 320 steps); the actor " in block
+    assert "320 steps in the replay buffer, the critics warmed up for 5,000 gradient steps." in block
