@@ -114,8 +114,9 @@ class SAC(Strict):
 class Demonstrations(Strict):
     """Start a new run from demonstrations: a Minari dataset that ``collect`` wrote on the same
     compiled task (:mod:`.demonstrations`). Before the first env step, the actor is fitted to the
-    successful episodes' actions (behaviour cloning) and every demonstrated transition goes into
-    the replay buffer. Results from such a run are labelled as starting from demonstrations."""
+    successful episodes' actions (behaviour cloning), every demonstrated transition goes into the
+    replay buffer and the critics warm up on them. Results from such a run are labelled as
+    starting from demonstrations."""
 
     dataset: str | None = Field(
         None,

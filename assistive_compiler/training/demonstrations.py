@@ -230,8 +230,9 @@ def warm_critic(model, steps: int) -> dict:
 
 
 def start_from(model, data: DemonstrationData, settings: Demonstrations, seed: int) -> dict:
-    """Behaviour cloning, then the replay buffer (:func:`clone`, :func:`fill_replay`) of a new
-    run's model; returns what ``summary.json`` records as the run's ``demonstrations``."""
+    """Behaviour cloning, the replay buffer and the critic warm-up (:func:`clone`,
+    :func:`fill_replay`, :func:`warm_critic`) of a new run's model; returns what
+    ``demonstrations.json`` (and ``summary.json``) record as the run's ``demonstrations``."""
     figures = {
         "dataset": data.dataset,
         "policy": data.policy,

@@ -115,7 +115,7 @@ def _wall_at(run: RunDir, steps: int) -> float | None:
 
 def _default_label(info) -> str:
     """``SAC (sac_laptop)``: the algorithm and the config the run was started with (``results``
-    adds "(demonstrations)" to a run that started from them)."""
+    adds what a run that started from demonstrations started from)."""
     command = list(info.command)
     config = command[command.index("--config") + 1] if "--config" in command[:-1] else "config"
     return f"{info.algorithm.upper()} ({Path(config).stem})"

@@ -37,12 +37,12 @@ def _hours(seconds: float | None) -> str:
 
 
 def _started_from(demonstrations: dict | bool) -> str:
-    """What a row started from, when not from the reward alone: always said in the table."""
-    if not demonstrations:
+    """What a row started from, when not from the reward alone (``export`` records False or the
+    run's ``demonstrations.json``): always said in the table."""
+    if not isinstance(demonstrations, dict):
         return ""
-    if isinstance(demonstrations, dict):
-        return f" from {demonstrations['episodes']} {demonstrations['policy']} demonstrations ({demonstrations['steps']:,} steps)"
-    return " (demonstrations)"
+    d = demonstrations
+    return f" from {d['episodes']} {d['policy']} demonstrations ({d['steps']:,} steps)"
 
 
 def _start_sentence(demonstrations: dict | bool) -> str:
@@ -60,7 +60,7 @@ def _start_sentence(demonstrations: dict | bool) -> str:
         f" Started from `{d['dataset']}`: {d['episodes']} episodes of the {d['policy']} policy "
         f"({d['successful_episodes']} successful, {d['steps']:,} steps); {cloned}, "
         f"{d['replayed_steps']:,} steps in the replay buffer, the critics warmed up for "
-        f"{d.get('critic_warmup_steps', 0):,} gradient steps."
+        f"{d['critic_warmup_steps']:,} gradient steps."
     )
 
 

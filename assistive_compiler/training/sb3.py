@@ -194,8 +194,8 @@ def train(
     """Train (or continue) the run to ``config.total_steps``; returns the session's figures.
 
     A new run given ``demonstrations`` (:class:`.demonstrations.DemonstrationData`) starts from
-    them: its actor cloned, its replay buffer filled, and a checkpoint at step 0 of just that
-    (the cloned policy, before any env step), before it learns.
+    them: its actor cloned, its replay buffer filled, its critics warmed up and a checkpoint
+    written at step 0 (the cloned policy, before any env step), before it learns.
 
     A stop request (``stop``, set by Ctrl-C or SIGTERM: :func:`.train.stop_on_signals`) ends
     training after the current env step; a checkpoint is written and the figures come back with
@@ -220,12 +220,13 @@ def train(
             model.load_replay_buffer(str(latest[1] / REPLAY_BUFFER))
     else:
         model = _new_model(venv, config, run)
-    if demonstrations is not None and config.demonstrations is not None:
+    if demonstrations is not None:  # train.train reads them only for a config that has a demonstrations block
         import json
 
         from ..run_dir import write_atomic
         from .demonstrations import start_from
 
+        assert config.demonstrations is not None
         started_from = start_from(model, demonstrations, config.demonstrations, config.seed)
         save_checkpoint(run, model, 0)
         write_atomic(run.demonstrations_json, json.dumps(started_from, indent=1))
