@@ -100,7 +100,9 @@ def authentication_refused(address: str) -> str | None:
 
 
 def init_ray(address: str | None, envs: int) -> None:
-    """Attach to ``address``, or start a local Ray instance (unless one is already running)."""
+    """Attach to the cluster at ``address``; without one, start a private local Ray instance
+    (unless this process already runs one). Never a cluster that merely runs on this machine:
+    Ray's own default (``ray.init()``) joins the latest ``ray start`` cluster it finds here."""
     import ray
 
     if address:
@@ -128,7 +130,7 @@ def init_ray(address: str | None, envs: int) -> None:
             else:
                 os.environ[GCS_WAIT_VAR] = previous
     else:
-        ray.init(num_cpus=max(2, envs + 1), include_dashboard=False, log_to_driver=False)
+        ray.init(address="local", num_cpus=max(2, envs + 1), include_dashboard=False, log_to_driver=False)
 
 
 def _callbacks_class():

@@ -4,6 +4,7 @@ checkpoint — and an unreachable cluster address failing fast with a message.""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import time
 from pathlib import Path
@@ -41,7 +42,8 @@ eval_episodes: 1
 def local_ray():
     import ray
 
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    # "local": a private instance, even while a multi-node test's cluster runs on this machine
+    ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False)
     yield
     ray.shutdown()
 
@@ -226,23 +228,27 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-@pytest.mark.slow
-def test_a_refused_authentication_token_says_so_and_names_rays_remedy(tmp_path):
-    """A Ray cluster that answers but rejects this machine's token (a stale ~/.ray/auth_token from an
-    earlier local ray.init()) is not 'no cluster': the message says the token was refused and how to
-    fix it. The test starts its own head node (its own HOME and token) and stops it by its id."""
+def _ray_home(where: Path, token: str) -> Path:
+    """A HOME whose ~/.ray/auth_token is ``token`` (64 characters)."""
+    (where / ".ray").mkdir(parents=True)
+    (where / ".ray" / "auth_token").write_text(token)
+    return where
+
+
+@contextlib.contextmanager
+def _head_node(home: Path):
+    """A head node without CPUs, as a user's plain ``ray start --head`` runs it (Ray's default temp
+    folder, so it becomes this machine's "latest cluster"), with ``home``'s token; yields its
+    port and stops it by its process group, forgetting it as the latest cluster."""
     import os
     import signal
     import socket
     import subprocess
     import sys
 
+    from ray_cluster import forget_cluster
+
     port = _free_port()
-    homes = {}
-    for who, token in (("head", "a" * 64), ("driver", "b" * 64)):
-        homes[who] = tmp_path / who
-        (homes[who] / ".ray").mkdir(parents=True)
-        (homes[who] / ".ray" / "auth_token").write_text(token)
     base = {k: v for k, v in os.environ.items() if not k.startswith("RAY_")}
     head = subprocess.Popen(
         [
@@ -256,7 +262,7 @@ def test_a_refused_authentication_token_says_so_and_names_rays_remedy(tmp_path):
             "--include-dashboard=false",
             "--block",
         ],
-        env={**base, "HOME": str(homes["head"]), "RAY_AUTH_MODE": "token"},
+        env={**base, "HOME": str(home), "RAY_AUTH_MODE": "token"},
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
         start_new_session=True,
@@ -269,6 +275,59 @@ def test_a_refused_authentication_token_says_so_and_names_rays_remedy(tmp_path):
                 break
             except OSError:
                 time.sleep(0.5)
+        latest = Path("/tmp/ray/ray_current_cluster")  # written once the head is up, after its port opens
+        while time.time() < deadline and not (latest.is_file() and f":{port}" in latest.read_text()):
+            time.sleep(0.5)
+        yield port
+    finally:
+        os.killpg(head.pid, signal.SIGTERM)
+        head.wait(timeout=60)
+        forget_cluster(port)
+
+
+@pytest.mark.slow
+def test_local_training_starts_its_own_ray_while_a_cluster_runs_here(tmp_path):
+    """Without --address, training starts a private Ray instance with the CPUs it asks for. Ray's
+    own default (a plain ``ray.init()``) joins the latest ``ray start`` cluster on this machine and
+    then refuses the CPU count ("When connecting to an existing cluster, num_cpus ... must not be
+    provided"): a cluster started here must not break local training."""
+    import os
+    import subprocess
+    import sys
+
+    home = _ray_home(tmp_path / "home", "c" * 64)
+    probe = (
+        "import ray\n"
+        "from assistive_compiler.training.rllib import init_ray\n"
+        "init_ray(None, 2)\n"
+        "print(ray.get_runtime_context().gcs_address, ray.cluster_resources().get('CPU'))\n"
+    )
+    with _head_node(home) as port:
+        result = subprocess.run(
+            [sys.executable, "-c", probe],
+            env={**{k: v for k, v in os.environ.items() if not k.startswith("RAY_")}, "HOME": str(home)},
+            capture_output=True,
+            text=True,
+            timeout=120,
+            cwd=REPO,
+        )
+    assert result.returncode == 0, result.stderr[-3000:]
+    gcs, cpus = result.stdout.split()[-2:]
+    assert not gcs.endswith(f":{port}") and float(cpus) == 3.0  # its own instance, max(2, envs + 1) CPUs
+
+
+@pytest.mark.slow
+def test_a_refused_authentication_token_says_so_and_names_rays_remedy(tmp_path):
+    """A Ray cluster that answers but rejects this machine's token (a stale ~/.ray/auth_token from an
+    earlier local ray.init()) is not 'no cluster': the message says the token was refused and how to
+    fix it. The test starts its own head node (its own HOME and token) and stops it by its id."""
+    import os
+    import subprocess
+    import sys
+
+    head_home = _ray_home(tmp_path / "head", "a" * 64)
+    driver_home = _ray_home(tmp_path / "driver", "b" * 64)
+    with _head_node(head_home) as port:
         proc = subprocess.run(
             [
                 sys.executable,
@@ -284,17 +343,11 @@ def test_a_refused_authentication_token_says_so_and_names_rays_remedy(tmp_path):
                 str(tmp_path / "run"),
                 "--quiet",
             ],
-            env={**base, "HOME": str(homes["driver"])},
+            env={**{k: v for k, v in os.environ.items() if not k.startswith("RAY_")}, "HOME": str(driver_home)},
             capture_output=True,
             text=True,
             timeout=120,
         )
-    finally:
-        os.killpg(head.pid, signal.SIGTERM)
-        head.wait(timeout=60)
-        from ray_cluster import forget_cluster
-
-        forget_cluster(port)
     assert proc.returncode == 2
     assert (
         f"error: --address: the Ray cluster at 127.0.0.1:{port} refused this machine's authentication token "
