@@ -115,8 +115,8 @@ class Demonstrations(Strict):
     """Start a new run from demonstrations: a Minari dataset that ``collect`` wrote on the same
     compiled task (:mod:`.demonstrations`). Before the first env step, the actor is fitted to the
     successful episodes' actions (behaviour cloning), every demonstrated transition goes into the
-    replay buffer and the critics warm up on them. Results from such a run are labelled as
-    starting from demonstrations."""
+    replay buffer and the critics warm up on them; optionally a cloning term stays in the actor's
+    loss while SAC learns. Results from such a run are labelled as starting from demonstrations."""
 
     dataset: str | None = Field(
         None,
@@ -141,6 +141,17 @@ class Demonstrations(Strict):
         le=1_000_000,
         description="Gradient steps of the critics alone on the demonstrations (the cloned actor held) before SAC "
         "starts, so its first actor updates follow critics that have seen the demonstrated returns (0: none).",
+    )
+
+    clone_weight: float = Field(
+        0.0,
+        ge=0,
+        le=100,
+        description="Weight of a behaviour-cloning term kept in SAC's actor loss while it learns: at each actor "
+        "update, clone_weight × the mean |Q| of a batch of demonstrated (state, action) pairs × the mean squared "
+        "miss of the deterministic action on them (TD3+BC's scaling: the term's pull does not depend on how large "
+        "the task's returns are). It keeps the actor near the demonstrations where its critics know little. "
+        "0: after the start, SAC's own actor loss alone.",
     )
 
     @model_validator(mode="after")

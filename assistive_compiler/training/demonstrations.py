@@ -14,6 +14,11 @@ Before the first env step of a new run (never on ``--resume``):
    of the buffer. Untrained critics would otherwise steer the first actor updates away from the
    cloned behaviour before they know what it is worth.
 
+While SAC learns (``clone_weight`` > 0, on ``--resume`` too), the cloning stays in the actor's
+loss as a term (:class:`KeepCloning`), as offline-to-online methods (TD3+BC, AWAC) anchor the
+actor: without it, SAC's first actor updates follow critics that know the demonstrated actions
+only, and a Drinking actor cloned to 15 % success lost it within 13,000 env steps.
+
 The dataset must have been collected on the run's compiled task (the same content hash): a
 dataset of another task, robot or task version is refused with what it was collected on.
 Everything here is seeded from the run's seed, so the same dataset and config start the same.
@@ -99,10 +104,11 @@ def load_demonstrations(settings: Demonstrations, content_hash: str) -> Demonstr
         parts["term"].append(np.asarray(episode.terminations, dtype=bool))
         parts["trunc"].append(np.asarray(episode.truncations, dtype=bool))
         parts["ok"].append(np.full(steps, success))
-    if settings.clone_epochs and not successes:
+    if (settings.clone_epochs or settings.clone_weight) and not successes:
         raise UsageError(
             f"--demonstrations {settings.dataset}: none of its {len(parts['obs'])} episodes succeeded, so there is "
-            "nothing to clone; collect more episodes, or set demonstrations.clone_epochs: 0 to use it for replay only"
+            "nothing to clone; collect more episodes, or set demonstrations.clone_epochs: 0 and clone_weight: 0 "
+            "to use it for replay only"
         )
     return DemonstrationData(
         dataset=settings.dataset,
@@ -131,13 +137,10 @@ def clone(model, data: DemonstrationData, settings: Demonstrations, seed: int) -
     import torch
     from stable_baselines3.sac.policies import LOG_STD_MAX, LOG_STD_MIN
 
-    keep = data.successful
-    figures = {"cloned_steps": int(keep.sum()), "clone_epochs": settings.clone_epochs}
+    figures = {"cloned_steps": int(data.successful.sum()), "clone_epochs": settings.clone_epochs}
     if settings.clone_epochs == 0:
         return figures
-    policy = model.policy
-    obs = torch.as_tensor(data.observations[keep])
-    target = torch.as_tensor(policy.scale_action(data.actions[keep]).clip(-1.0, 1.0), dtype=torch.float32)
+    obs, target = _cloning_targets(model, data)
     actor = model.actor
     optimiser = torch.optim.Adam(actor.parameters(), lr=settings.clone_learning_rate)
     rng = np.random.default_rng(seed)
@@ -229,6 +232,62 @@ def warm_critic(model, steps: int) -> dict:
     }
 
 
+def _cloning_targets(model, data: DemonstrationData):
+    """The successful episodes' observations and actions (in the policy's [-1, 1] scale), as tensors."""
+    import torch
+
+    keep = data.successful
+    obs = torch.as_tensor(data.observations[keep])
+    target = torch.as_tensor(model.policy.scale_action(data.actions[keep]).clip(-1.0, 1.0), dtype=torch.float32)
+    return obs, target
+
+
+class KeepCloning:
+    """SAC's actor optimiser with a behaviour-cloning term added to the actor's loss.
+
+    SB3's SAC computes its actor loss (temperature × log π − min Q), back-propagates it and calls
+    ``actor.optimizer.step()``. In its place this object first adds the gradient of
+
+        clone_weight × mean |min Q(s, a)| × mean ‖μ(s) − a‖²
+
+    on a batch of the successful demonstrations' steps (s, a) — μ the deterministic (squashed
+    mean) action, |Q| of the demonstrated pairs taken without gradient, as TD3+BC scales its
+    cloning term — and then steps. The sum is the actor loss of SAC plus that term; nothing else of
+    SAC changes. Everything else (``zero_grad``, ``state_dict``, ``param_groups``: SB3 saves and
+    schedules through them) is the wrapped optimiser's."""
+
+    def __init__(self, model, data: DemonstrationData, weight: float, seed: int):
+        import torch
+
+        self.optimizer = model.actor.optimizer
+        self._model, self._weight = model, weight
+        self._obs, self._target = _cloning_targets(model, data)
+        self._generator = torch.Generator().manual_seed(seed)
+
+    def step(self, closure=None):
+        import torch
+
+        model = self._model
+        idx = torch.randint(len(self._obs), (model.batch_size,), generator=self._generator)
+        obs, target = self._obs[idx], self._target[idx]
+        with torch.no_grad():
+            q_scale = torch.min(torch.cat(model.critic(obs, target), dim=1), dim=1)[0].abs().mean()
+        miss = torch.mean((model.actor(obs, deterministic=True) - target) ** 2)
+        (self._weight * q_scale * miss).backward()
+        model.logger.record_mean("train/clone_miss", miss.item())
+        model.logger.record_mean("train/clone_q_scale", q_scale.item())
+        return self.optimizer.step(closure)
+
+    def __getattr__(self, name: str):
+        return getattr(self.__dict__["optimizer"], name)
+
+
+def keep_cloning(model, data: DemonstrationData, settings: Demonstrations, seed: int) -> None:
+    """Keep the cloning term in ``model``'s actor loss from now on (``settings.clone_weight`` > 0)."""
+    if settings.clone_weight > 0 and not isinstance(model.actor.optimizer, KeepCloning):
+        model.actor.optimizer = KeepCloning(model, data, settings.clone_weight, seed)
+
+
 def start_from(model, data: DemonstrationData, settings: Demonstrations, seed: int) -> dict:
     """Behaviour cloning, the replay buffer and the critic warm-up (:func:`clone`,
     :func:`fill_replay`, :func:`warm_critic`) of a new run's model; returns what
@@ -243,4 +302,5 @@ def start_from(model, data: DemonstrationData, settings: Demonstrations, seed: i
     figures.update(clone(model, data, settings, seed))
     figures["replayed_steps"] = fill_replay(model, data) if settings.replay else 0
     figures.update(warm_critic(model, settings.critic_warmup_steps))
+    figures["clone_weight"] = settings.clone_weight
     return figures

@@ -114,7 +114,8 @@ def train(
             f"{display(run.path)}: the run directory already holds a run; pass --resume to continue it, or choose another --out"
         )
     demo_data = None
-    if config.demonstrations is not None and not resume:  # read and checked before the run directory is written
+    # read and checked before the run directory is written; a resumed run reads them again to keep cloning
+    if config.demonstrations is not None and (not resume or config.demonstrations.clone_weight > 0):
         from .demonstrations import load_demonstrations
 
         if config.demonstrations.dataset is None:

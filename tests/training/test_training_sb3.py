@@ -639,6 +639,50 @@ def test_a_run_from_demonstrations_starts_from_the_cloned_policy_and_replays_eve
     assert np.mean(values) < -2.0 and np.std(values) > 0.1, (np.mean(values), np.std(values))
 
 
+def _demonstrated_miss(checkpoint: Path, demos_root: Path) -> float:
+    """Mean squared miss of the checkpoint's deterministic action on the dataset's steps ([-1, 1] scale)."""
+    import minari
+    from stable_baselines3 import SAC
+
+    model = SAC.load(str(checkpoint / "model.zip"), device="cpu")
+    dataset = minari.load_dataset(DEMOS)
+    obs = np.concatenate([np.asarray(e.observations[:-1], dtype=np.float32) for e in dataset.iterate_episodes()])
+    actions = np.concatenate([np.asarray(e.actions) for e in dataset.iterate_episodes()])
+    chosen, _ = model.predict(obs, deterministic=True)
+    target = model.policy.scale_action(np.clip(actions, model.action_space.low, model.action_space.high))
+    return float(np.mean((model.policy.scale_action(chosen) - target) ** 2))
+
+
+def test_a_cloning_term_kept_in_the_actors_loss_holds_it_to_the_demonstrations_new_or_resumed(demos_root, tmp_path):
+    """demonstrations.clone_weight > 0 keeps behaviour cloning in SAC's actor loss. With a large
+    fixed temperature SAC's own actor loss drives the cloned actor away from the demonstrations
+    within a few hundred steps; with the term it stays on them, after a --resume too."""
+    config = (
+        SAC_TINY.replace("total_steps: 600", "total_steps: 300")
+        .replace("learning_starts: 100", "learning_starts: 0")
+        .replace("batch_size: 32}", "batch_size: 32, ent_coef: 1.0}")
+    )
+    misses = {}
+    for weight in (0, 10):
+        path = tmp_path / f"weight{weight}.yaml"
+        path.write_text(
+            config + f"demonstrations: {{clone_epochs: 200, clone_batch_size: 32, clone_weight: {weight}}}\n"
+        )
+        out = tmp_path / f"run{weight}"
+        args = ["train", str(REACH), "--robot", "jaco", "--config", str(path), "--out", str(out), "--quiet"]
+        assert main([*args, "--demonstrations", DEMOS, "--demonstrations-root", str(demos_root)]) == 0
+        run = RunDir(out)
+        misses[weight] = [_demonstrated_miss(run.checkpoint_dir(s), demos_root) for s in (0, 300)]
+        assert json.loads(run.demonstrations_json.read_text())["clone_weight"] == weight
+    assert misses[0][0] == misses[10][0] < 0.02  # the same start: cloned alike
+    assert misses[0][1] > 0.2 and misses[10][1] < 0.02, misses  # SAC alone left the demonstrations
+    # a resumed run reads the dataset again and keeps the term (it is not in the checkpoint)
+    out = tmp_path / "run10"
+    resume = ["train", str(REACH), "--robot", "jaco", "--config", str(tmp_path / "weight10.yaml"), "--out", str(out)]
+    assert main([*resume, "--resume", "--steps", "450", "--quiet"]) == 0
+    assert _demonstrated_miss(RunDir(out).checkpoint_dir(450), demos_root) < 0.02
+
+
 def _train_from_demos(demos_root: Path, out: Path, *extra: str) -> int:
     config = demos_root / "sac_from_demos.yaml"
     config.write_text(SAC_FROM_DEMOS)
