@@ -100,6 +100,14 @@ class SAC(Strict):
     ent_coef: float | Literal["auto"] = Field(
         "auto", description="Entropy temperature α: a number, or 'auto' to learn it toward target_entropy."
     )
+    initial_ent_coef: float = Field(
+        1.0,
+        gt=0,
+        le=10,
+        description="The temperature α that ent_coef 'auto' starts from (SB3's default 1.0). A policy that starts "
+        "narrow (cloned from demonstrations) needs a small one: at α = 1 the entropy term outweighs what the critics "
+        "know and widens it into noise within the first thousand steps.",
+    )
     target_entropy: float | Literal["auto"] = Field(
         "auto", description="Target policy entropy (nats) with ent_coef 'auto'; 'auto' is −(action dimensions)."
     )
@@ -108,6 +116,11 @@ class SAC(Strict):
     def _positive_temperature(self) -> SAC:
         if not isinstance(self.ent_coef, str) and self.ent_coef <= 0:
             raise ValueError(f"@ent_coef: the entropy temperature must be > 0 (or 'auto'), got {self.ent_coef}")
+        if not isinstance(self.ent_coef, str) and self.initial_ent_coef != 1.0:
+            raise ValueError(
+                f"@initial_ent_coef: the temperature α is fixed at ent_coef {self.ent_coef:g}; a starting value "
+                "is for ent_coef: auto only"
+            )
         return self
 
 

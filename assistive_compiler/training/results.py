@@ -42,7 +42,8 @@ def _started_from(demonstrations: dict | bool) -> str:
     if not isinstance(demonstrations, dict):
         return ""
     d = demonstrations
-    return f" from {d['episodes']} {d['policy']} demonstrations ({d['steps']:,} steps)"
+    kept = f", cloning kept in the actor's loss (weight {d['clone_weight']:g})" if d.get("clone_weight") else ""
+    return f" from {d['episodes']} {d['policy']} demonstrations ({d['steps']:,} steps){kept}"
 
 
 def _start_sentence(demonstrations: dict | bool) -> str:
@@ -60,7 +61,13 @@ def _start_sentence(demonstrations: dict | bool) -> str:
         f" Started from `{d['dataset']}`: {d['episodes']} episodes of the {d['policy']} policy "
         f"({d['successful_episodes']} successful, {d['steps']:,} steps); {cloned}, "
         f"{d['replayed_steps']:,} steps in the replay buffer, the critics warmed up for "
-        f"{d['critic_warmup_steps']:,} gradient steps."
+        f"{d['critic_warmup_steps']:,} gradient steps"
+        + (
+            f"; then SAC learned with the cloning term kept in its actor loss (weight {d['clone_weight']:g} × the "
+            "demonstrated pairs' mean |Q|)."
+            if d.get("clone_weight")
+            else "."
+        )
     )
 
 

@@ -214,6 +214,7 @@ def build_sac_config(run: RunDir, config: TrainingConfig, weights: dict[str, flo
             train_batch_size_per_learner=s.batch_size,
             num_steps_sampled_before_learning_starts=s.learning_starts,
             target_entropy=s.target_entropy,
+            initial_alpha=s.initial_ent_coef,
             n_step=1,
             twin_q=True,
             training_intensity=s.batch_size * updates_per_step,

@@ -88,7 +88,7 @@ def _new_model(venv, config: TrainingConfig, run: RunDir):
             gamma=s.gamma,
             train_freq=s.train_freq,
             gradient_steps=s.gradient_steps,
-            ent_coef=s.ent_coef,
+            ent_coef=f"auto_{s.initial_ent_coef:g}" if s.ent_coef == "auto" else s.ent_coef,
             target_entropy=s.target_entropy,
             policy_kwargs=policy_kwargs(config),
             tensorboard_log=str(run.tb),

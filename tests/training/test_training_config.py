@@ -124,6 +124,16 @@ def test_algorithm_and_its_section_must_agree(tmp_path):
     assert [str(p) for p in err.value.problems] == [
         f"{path}:{at(text, '-0.1')}: sac.ent_coef: the entropy temperature must be > 0 (or 'auto'), got -0.1"
     ]
+    text = (
+        "algorithm: sac\nsac: {ent_coef: 0.2, initial_ent_coef: 0.01}\ntotal_steps: 100\ncheckpoint_every_steps: 50\n"
+    )
+    path.write_text(text)
+    with pytest.raises(SpecError) as err:
+        load_training_config(path)
+    assert [str(p) for p in err.value.problems] == [
+        f"{path}:{at(text, '0.01')}: sac.initial_ent_coef: the temperature α is fixed at ent_coef 0.2; "
+        "a starting value is for ent_coef: auto only"
+    ]
     text = "algorithm: sac\nppo: {rollout_steps: 10, minibatch_size: 8, epochs: 1}\nsac: {}\ntotal_steps: 100\ncheckpoint_every_steps: 50\n"
     path.write_text(text)
     with pytest.raises(SpecError) as err:
@@ -199,7 +209,9 @@ def test_sac_demos_is_the_recipe_started_from_demonstrations():
     demos = load_training_config(REPO / "specs" / "training" / "sac_demos.yaml")
     recipe = load_training_config(REPO / "specs" / "training" / "sac_laptop.yaml")
     assert demos.sac.learning_starts == 0 and recipe.sac.learning_starts == 5000
-    assert demos.sac.model_copy(update={"learning_starts": 5000}) == recipe.sac
+    # the temperature starts small: the cloned policy is narrow, and α = 1 widens it into noise
+    assert demos.sac.initial_ent_coef == 0.01 and recipe.sac.initial_ent_coef == 1.0
+    assert demos.sac.model_copy(update={"learning_starts": 5000, "initial_ent_coef": 1.0}) == recipe.sac
     assert (demos.network, demos.total_steps, demos.envs) == (recipe.network, recipe.total_steps, recipe.envs)
     d = demos.demonstrations
     assert d is not None and d.dataset is None and d.replay and d.critic_warmup_steps == 5000

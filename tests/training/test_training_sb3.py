@@ -342,6 +342,27 @@ def test_sac_run_checkpoints_with_its_replay_buffer_and_resumes(sac_run, tmp_pat
     assert model.replay_buffer.size() == 800  # the resumed run kept the first 600 transitions
 
 
+@pytest.mark.parametrize(("engine", "alpha"), [("sb3", 1.0), ("sb3", 0.01), ("rllib", 0.01)])
+def test_a_learned_temperature_starts_where_the_config_says(sac_run, tmp_path, engine, alpha):
+    """sac.initial_ent_coef: the α that ent_coef 'auto' starts from (SB3's and RLlib's default 1.0)."""
+    from assistive_compiler.training import sb3
+    from assistive_compiler.training.config import load_training_config
+
+    path = tmp_path / "sac.yaml"
+    path.write_text(SAC_TINY.replace("batch_size: 32}", f"batch_size: 32, initial_ent_coef: {alpha}}}"))
+    config = load_training_config(path)
+    if engine == "sb3":
+        venv = sb3.make_vec_env(RunDir(sac_run).artifact, 1, 0)
+        model = sb3._new_model(venv, config, RunDir(tmp_path / "run"))
+        venv.close()
+        assert float(model.log_ent_coef.exp()) == pytest.approx(alpha)
+    else:
+        pytest.importorskip("ray")
+        from assistive_compiler.training.rllib import build_sac_config
+
+        assert build_sac_config(RunDir(sac_run), config, {}, False).initial_alpha == alpha
+
+
 def test_sac_resume_without_the_replay_buffer_is_refused(sac_run, tmp_path, capsys):
     copy = tmp_path / "no-buffer"
     shutil.copytree(sac_run, copy)
@@ -751,3 +772,8 @@ def test_results_from_demonstrations_say_so_in_every_table(demo_run, tmp_path):
     assert f"{record['label']} from 8 scripted demonstrations (320 steps)" in block
     assert f"Started from `{DEMOS}`: 8 episodes of the scripted policy (8 successful, 320 steps); the actor " in block
     assert "320 steps in the replay buffer, the critics warmed up for 5,000 gradient steps." in block
+    # a run that kept the cloning term in SAC's actor loss says so in its row and its paragraph
+    record["demonstrations"]["clone_weight"] = 0.4
+    block = results_block([record])
+    assert "(320 steps), cloning kept in the actor's loss (weight 0.4)" in block
+    assert "then SAC learned with the cloning term kept in its actor loss (weight 0.4 × the demonstrated" in block
