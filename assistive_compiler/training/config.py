@@ -104,9 +104,9 @@ class SAC(Strict):
         1.0,
         gt=0,
         le=10,
-        description="The temperature α that ent_coef 'auto' starts from (SB3's default 1.0). A policy that starts "
-        "narrow (cloned from demonstrations) needs a small one: at α = 1 the entropy term outweighs what the critics "
-        "know and widens it into noise within the first thousand steps.",
+        description="The temperature α that ent_coef 'auto' starts from (SB3's and RLlib's default 1.0). A policy "
+        "that starts narrow (cloned from demonstrations: log π ≫ 0) needs a small one, or the entropy term of the "
+        "soft targets outweighs the rewards.",
     )
     target_entropy: float | Literal["auto"] = Field(
         "auto", description="Target policy entropy (nats) with ent_coef 'auto'; 'auto' is −(action dimensions)."
