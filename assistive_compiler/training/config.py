@@ -108,8 +108,11 @@ class SAC(Strict):
         "that starts narrow (cloned from demonstrations: log π ≫ 0) needs a small one, or the entropy term of the "
         "soft targets outweighs the rewards.",
     )
-    target_entropy: float | Literal["auto"] = Field(
-        "auto", description="Target policy entropy (nats) with ent_coef 'auto'; 'auto' is −(action dimensions)."
+    target_entropy: float | Literal["auto", "cloned"] = Field(
+        "auto",
+        description="Target policy entropy (nats) with ent_coef 'auto'; 'auto' is −(action dimensions); 'cloned' "
+        "(a run started from demonstrations) is the cloned policy's own entropy on the demonstrations, so SAC "
+        "explores as widely as the clone misses them instead of widening it to −(action dimensions).",
     )
 
     @model_validator(mode="after")
@@ -230,6 +233,20 @@ class TrainingConfig(Strict):
                 f"@ppo.minibatch_size: minibatch_size {self.ppo.minibatch_size} is larger than the batch "
                 f"rollout_steps × envs = {self.ppo.rollout_steps} × {self.envs} = {batch}"
             )
+        return self
+
+    @model_validator(mode="after")
+    def _cloned_entropy_needs_cloning(self) -> TrainingConfig:
+        if self.sac is not None and self.sac.target_entropy == "cloned":
+            if self.demonstrations is None or self.demonstrations.clone_epochs == 0:
+                raise ValueError(
+                    "@sac.target_entropy: 'cloned' is the entropy of the policy cloned from demonstrations; "
+                    "add a demonstrations block with clone_epochs > 0, or give a number or 'auto'"
+                )
+            if self.sac.ent_coef != "auto":
+                raise ValueError(
+                    "@sac.target_entropy: 'cloned' is what a learned temperature tunes toward; set ent_coef: auto"
+                )
         return self
 
     @model_validator(mode="after")

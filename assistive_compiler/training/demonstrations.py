@@ -288,9 +288,24 @@ def keep_cloning(model, data: DemonstrationData, settings: Demonstrations, seed:
         model.actor.optimizer = KeepCloning(model, data, settings.clone_weight, seed)
 
 
-def start_from(model, data: DemonstrationData, settings: Demonstrations, seed: int) -> dict:
+def cloned_entropy(model, data: DemonstrationData, seed: int) -> float:
+    """The entropy (nats, −E[log π(a|s)] with a sampled) of ``model``'s policy over the successful
+    demonstrations' states: what ``sac.target_entropy: cloned`` holds SAC's exploration to."""
+    import torch
+
+    obs, _ = _cloning_targets(model, data)
+    with torch.random.fork_rng(), torch.no_grad():
+        torch.manual_seed(seed)
+        _, log_prob = model.actor.action_log_prob(obs)
+    return float(-log_prob.mean())
+
+
+def start_from(
+    model, data: DemonstrationData, settings: Demonstrations, seed: int, target_entropy: float | str = "auto"
+) -> dict:
     """Behaviour cloning, the replay buffer and the critic warm-up (:func:`clone`,
-    :func:`fill_replay`, :func:`warm_critic`) of a new run's model; returns what
+    :func:`fill_replay`, :func:`warm_critic`) of a new run's model, its target entropy set to the
+    clone's (:func:`cloned_entropy`) where the config's ``target_entropy`` is ``cloned``; returns what
     ``demonstrations.json`` (and ``summary.json``) record as the run's ``demonstrations``."""
     figures = {
         "dataset": data.dataset,
@@ -300,6 +315,8 @@ def start_from(model, data: DemonstrationData, settings: Demonstrations, seed: i
         "steps": int(len(data.actions)),
     }
     figures.update(clone(model, data, settings, seed))
+    if target_entropy == "cloned":
+        figures["target_entropy"] = model.target_entropy = cloned_entropy(model, data, seed)
     figures["replayed_steps"] = fill_replay(model, data) if settings.replay else 0
     figures.update(warm_critic(model, settings.critic_warmup_steps))
     figures["clone_weight"] = settings.clone_weight

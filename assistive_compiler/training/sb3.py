@@ -89,7 +89,7 @@ def _new_model(venv, config: TrainingConfig, run: RunDir):
             train_freq=s.train_freq,
             gradient_steps=s.gradient_steps,
             ent_coef=f"auto_{s.initial_ent_coef:g}" if s.ent_coef == "auto" else s.ent_coef,
-            target_entropy=s.target_entropy,
+            target_entropy="auto" if s.target_entropy == "cloned" else s.target_entropy,  # cloned: set on cloning
             policy_kwargs=policy_kwargs(config),
             tensorboard_log=str(run.tb),
             seed=config.seed,
@@ -229,7 +229,10 @@ def train(
 
         assert config.demonstrations is not None
         if not latest:
-            started_from = start_from(model, demonstrations, config.demonstrations, config.seed)
+            assert config.sac is not None
+            started_from = start_from(
+                model, demonstrations, config.demonstrations, config.seed, config.sac.target_entropy
+            )
             save_checkpoint(run, model, 0)
             write_atomic(run.demonstrations_json, json.dumps(started_from, indent=1))
         keep_cloning(model, demonstrations, config.demonstrations, config.seed + start_steps)

@@ -203,6 +203,28 @@ def test_the_reach_example_is_not_a_registered_id():
     assert not [i for i in shipped_ids() if "Reach" in i]
 
 
+def test_a_cloned_target_entropy_needs_a_clone_and_a_learned_temperature(tmp_path):
+    path = tmp_path / "cloned.yaml"
+    for sac, extra, expected in (
+        (
+            "{target_entropy: cloned}",
+            "",
+            "'cloned' is the entropy of the policy cloned from demonstrations; add a demonstrations block with "
+            "clone_epochs > 0, or give a number or 'auto'",
+        ),
+        (
+            "{target_entropy: cloned, ent_coef: 0.1}",
+            "demonstrations: {}\n",
+            "'cloned' is what a learned temperature tunes toward; set ent_coef: auto",
+        ),
+    ):
+        text = f"algorithm: sac\nsac: {sac}\ntotal_steps: 100\ncheckpoint_every_steps: 50\n{extra}"
+        path.write_text(text)
+        with pytest.raises(SpecError) as err:
+            load_training_config(path)
+        assert [str(p) for p in err.value.problems] == [f"{path}:{at(text, 'cloned')}: sac.target_entropy: {expected}"]
+
+
 def test_sac_demos_is_the_recipe_started_from_demonstrations():
     """sac_demos: sac_laptop's SAC without the phase of random actions (the demonstrations fill the
     buffer), with the start's settings spelled out and the dataset left to --demonstrations."""

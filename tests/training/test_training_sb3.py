@@ -704,6 +704,42 @@ def test_a_cloning_term_kept_in_the_actors_loss_holds_it_to_the_demonstrations_n
     assert _demonstrated_miss(RunDir(out).checkpoint_dir(450), demos_root) < 0.02
 
 
+def test_a_cloned_target_entropy_is_the_clones_own_and_stays_with_the_run(demos_root, tmp_path):
+    """sac.target_entropy: cloned — SAC tunes its temperature toward the cloned policy's entropy on
+    the demonstrations (measured after cloning, recorded in demonstrations.json), kept in every
+    checkpoint and on --resume, instead of −(action dimensions)."""
+    import torch
+    from stable_baselines3 import SAC
+
+    config = tmp_path / "cloned.yaml"
+    config.write_text(
+        SAC_FROM_DEMOS.replace("ent_coef: 0.001}", "initial_ent_coef: 0.01, target_entropy: cloned}").replace(
+            "total_steps: 200", "total_steps: 100"
+        )
+    )
+    out = tmp_path / "run"
+    args = ["train", str(REACH), "--robot", "jaco", "--config", str(config), "--out", str(out), "--quiet"]
+    assert main([*args, "--demonstrations", DEMOS, "--demonstrations-root", str(demos_root)]) == 0
+    assert main([*args, "--resume", "--steps", "150"]) == 0
+    run = RunDir(out)
+    target = json.loads(run.demonstrations_json.read_text())["target_entropy"]
+    cloned = SAC.load(str(run.checkpoint_dir(0) / "model.zip"), device="cpu")
+    # the clone's entropy, estimated again with other samples of its actions
+    import minari
+
+    obs = torch.as_tensor(
+        np.concatenate(
+            [np.asarray(e.observations[:-1], dtype=np.float32) for e in minari.load_dataset(DEMOS).iterate_episodes()]
+        )
+    )
+    with torch.no_grad():
+        log_probs = torch.cat([cloned.actor.action_log_prob(obs)[1] for _ in range(20)])
+    assert target == pytest.approx(float(-log_probs.mean()), abs=0.5)  # a sampled estimate over 320 steps
+    assert abs(target - (-7.0)) > 1.0  # not the 'auto' target of the 7 joints
+    for steps in (0, 100, 150):
+        assert SAC.load(str(run.checkpoint_dir(steps) / "model.zip"), device="cpu").target_entropy == target
+
+
 def _train_from_demos(demos_root: Path, out: Path, *extra: str) -> int:
     config = demos_root / "sac_from_demos.yaml"
     config.write_text(SAC_FROM_DEMOS)
