@@ -125,6 +125,25 @@ def load_demonstrations(settings: Demonstrations, content_hash: str) -> Demonstr
     )
 
 
+def cloning_loss(actor, obs, target):
+    """``(miss, spread)``: the behaviour-cloning loss of an SB3 SAC ``actor`` on demonstrated steps
+    (``target``: actions in the [-1, 1] scale). ``miss``: the mean squared error of the
+    deterministic action (the squashed mean). ``spread``: a Gaussian's negative log-likelihood of
+    those misses (the mean held) under the actor's σ, so σ is as wide as the clone misses, per
+    action dimension — in the action scale: before the squashing σ is then at most as wide where
+    tanh' < 1 (a likelihood through the squashing would blow σ up on the demonstrations' saturated
+    ±1 actions). The log-std head reads the shared layers without training them: they serve the
+    mean's fit."""
+    import torch
+    from stable_baselines3.sac.policies import LOG_STD_MAX, LOG_STD_MIN
+
+    latent = actor.latent_pi(actor.extract_features(obs, actor.features_extractor))
+    log_std = torch.clamp(actor.log_std(latent.detach()), LOG_STD_MIN, LOG_STD_MAX)
+    miss = torch.tanh(actor.mu(latent)) - target
+    spread = torch.mean(0.5 * (miss.detach() / log_std.exp()) ** 2 + log_std)
+    return torch.mean(miss**2), spread
+
+
 def clone(model, data: DemonstrationData, settings: Demonstrations, seed: int) -> dict:
     """Fit ``model``'s (SB3 SAC) actor to the successful episodes' actions; returns the figures
     (steps cloned, epochs, the deterministic action's mean squared error before and after in the
@@ -135,7 +154,6 @@ def clone(model, data: DemonstrationData, settings: Demonstrations, seed: int) -
     explores as far as it misses the demonstrations, not with the initial noise (σ ≈ 1 before the
     squashing, which would throw the cloned behaviour away at the first sampled step)."""
     import torch
-    from stable_baselines3.sac.policies import LOG_STD_MAX, LOG_STD_MIN
 
     figures = {"cloned_steps": int(data.successful.sum()), "clone_epochs": settings.clone_epochs}
     if settings.clone_epochs == 0:
@@ -145,18 +163,6 @@ def clone(model, data: DemonstrationData, settings: Demonstrations, seed: int) -
     optimiser = torch.optim.Adam(actor.parameters(), lr=settings.clone_learning_rate)
     rng = np.random.default_rng(seed)
     n, batch = len(obs), min(settings.clone_batch_size, len(obs))
-
-    def loss_of(o: torch.Tensor, a: torch.Tensor) -> torch.Tensor:
-        latent = actor.latent_pi(actor.extract_features(o, actor.features_extractor))
-        mean = actor.mu(latent)
-        # the log-std head reads the shared layers without training them: they serve the mean's fit
-        log_std = torch.clamp(actor.log_std(latent.detach()), LOG_STD_MIN, LOG_STD_MAX)
-        miss = torch.tanh(mean) - a
-        # σ: a Gaussian's maximum likelihood of the misses of the (held) mean, in the action scale
-        # (before the squashing it is then at most as wide where tanh' < 1; a likelihood through
-        # the squashing would blow σ up on the demonstrations' saturated ±1 actions).
-        spread = torch.mean(0.5 * (miss.detach() / log_std.exp()) ** 2 + log_std)
-        return torch.mean(miss**2) + spread
 
     def measured() -> tuple[float, float]:
         with torch.no_grad():
@@ -169,7 +175,7 @@ def clone(model, data: DemonstrationData, settings: Demonstrations, seed: int) -
         order = rng.permutation(n)
         for start in range(0, n - batch + 1, batch):
             idx = torch.as_tensor(order[start : start + batch])
-            loss = loss_of(obs[idx], target[idx])
+            loss = sum(cloning_loss(actor, obs[idx], target[idx]))
             optimiser.zero_grad()
             loss.backward()
             optimiser.step()
@@ -248,11 +254,14 @@ class KeepCloning:
     SB3's SAC computes its actor loss (temperature × log π − min Q), back-propagates it and calls
     ``actor.optimizer.step()``. In its place this object first adds the gradient of
 
-        clone_weight × mean |min Q(s, a)| × mean ‖μ(s) − a‖²
+        clone_weight × mean |min Q(s, a)| × (miss + spread)
 
-    on a batch of the successful demonstrations' steps (s, a) — μ the deterministic (squashed
-    mean) action, |Q| of the demonstrated pairs taken without gradient, as TD3+BC scales its
-    cloning term — and then steps. The sum is the actor loss of SAC plus that term; nothing else of
+    on a batch of the successful demonstrations' steps (s, a) — the cloning loss itself
+    (:func:`cloning_loss`: the deterministic action's squared miss, and σ's likelihood of it),
+    |Q| of the demonstrated pairs taken without gradient, as TD3+BC scales its cloning term — and
+    then steps. σ is held too: SAC's entropy estimate rewards a squashed Gaussian whose σ runs to
+    its bound on a few action dimensions while the others narrow (Drinking: σ up to e² on
+    some joints after 5,000 steps at the clone's total entropy, their actions ±1 noise). The sum is the actor loss of SAC plus that term; nothing else of
     SAC changes. Everything else (``zero_grad``, ``state_dict``, ``param_groups``: SB3 saves and
     schedules through them) is the wrapped optimiser's."""
 
@@ -272,9 +281,10 @@ class KeepCloning:
         obs, target = self._obs[idx], self._target[idx]
         with torch.no_grad():
             q_scale = torch.min(torch.cat(model.critic(obs, target), dim=1), dim=1)[0].abs().mean()
-        miss = torch.mean((model.actor(obs, deterministic=True) - target) ** 2)
-        (self._weight * q_scale * miss).backward()
+        miss, spread = cloning_loss(model.actor, obs, target)
+        (self._weight * q_scale * (miss + spread)).backward()
         model.logger.record_mean("train/clone_miss", miss.item())
+        model.logger.record_mean("train/clone_spread", spread.item())
         model.logger.record_mean("train/clone_q_scale", q_scale.item())
         return self.optimizer.step(closure)
 

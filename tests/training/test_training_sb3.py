@@ -660,9 +660,12 @@ def test_a_run_from_demonstrations_starts_from_the_cloned_policy_and_replays_eve
     assert np.mean(values) < -2.0 and np.std(values) > 0.1, (np.mean(values), np.std(values))
 
 
-def _demonstrated_miss(checkpoint: Path, demos_root: Path) -> float:
-    """Mean squared miss of the checkpoint's deterministic action on the dataset's steps ([-1, 1] scale)."""
+def _against_demonstrations(checkpoint: Path) -> tuple[float, float]:
+    """(mean squared miss of the checkpoint's deterministic action, its largest σ per action
+    dimension — the mean over steps of each dimension's σ, the widest dimension) on the
+    dataset's steps ([-1, 1] scale, σ before the squashing)."""
     import minari
+    import torch
     from stable_baselines3 import SAC
 
     model = SAC.load(str(checkpoint / "model.zip"), device="cpu")
@@ -671,7 +674,10 @@ def _demonstrated_miss(checkpoint: Path, demos_root: Path) -> float:
     actions = np.concatenate([np.asarray(e.actions) for e in dataset.iterate_episodes()])
     chosen, _ = model.predict(obs, deterministic=True)
     target = model.policy.scale_action(np.clip(actions, model.action_space.low, model.action_space.high))
-    return float(np.mean((model.policy.scale_action(chosen) - target) ** 2))
+    with torch.no_grad():
+        _, log_std, _ = model.actor.get_action_dist_params(torch.as_tensor(obs))
+    widest = float(log_std.exp().mean(dim=0).max())
+    return float(np.mean((model.policy.scale_action(chosen) - target) ** 2)), widest
 
 
 def test_a_cloning_term_kept_in_the_actors_loss_holds_it_to_the_demonstrations_new_or_resumed(demos_root, tmp_path):
@@ -693,15 +699,49 @@ def test_a_cloning_term_kept_in_the_actors_loss_holds_it_to_the_demonstrations_n
         args = ["train", str(REACH), "--robot", "jaco", "--config", str(path), "--out", str(out), "--quiet"]
         assert main([*args, "--demonstrations", DEMOS, "--demonstrations-root", str(demos_root)]) == 0
         run = RunDir(out)
-        misses[weight] = [_demonstrated_miss(run.checkpoint_dir(s), demos_root) for s in (0, 300)]
+        misses[weight] = [_against_demonstrations(run.checkpoint_dir(s)) for s in (0, 300)]
         assert json.loads(run.demonstrations_json.read_text())["clone_weight"] == weight
-    assert misses[0][0] == misses[10][0] < 0.02  # the same start: cloned alike
-    assert misses[0][1] > 0.2 and misses[10][1] < 0.02, misses  # SAC alone left the demonstrations
+    (miss0, sigma0), (miss, _) = misses[0]
+    (miss0_kept, sigma0_kept), (miss_kept, _) = misses[10]
+    assert miss0 == miss0_kept < 0.02 and sigma0 == sigma0_kept < 0.5  # the same start: cloned alike
+    assert miss > 0.2 and miss_kept < 0.02, misses  # SAC alone left the demonstrations; the term holds them
     # a resumed run reads the dataset again and keeps the term (it is not in the checkpoint)
     out = tmp_path / "run10"
     resume = ["train", str(REACH), "--robot", "jaco", "--config", str(tmp_path / "weight10.yaml"), "--out", str(out)]
     assert main([*resume, "--resume", "--steps", "450", "--quiet"]) == 0
-    assert _demonstrated_miss(RunDir(out).checkpoint_dir(450), demos_root) < 0.02
+    assert _against_demonstrations(RunDir(out).checkpoint_dir(450))[0] < 0.02
+
+
+def test_the_cloning_loss_fits_sigma_per_action_dimension_to_the_misses():
+    """The spread part of the cloning loss, the mean held: each action dimension's σ goes to the
+    root mean square of that dimension's misses, from too wide and from too narrow alike."""
+    import gymnasium as gym
+    import torch
+    from stable_baselines3 import SAC
+
+    from assistive_compiler.training.demonstrations import cloning_loss
+
+    env = gym.make("Pendulum-v1")  # one action dimension
+    model = SAC("MlpPolicy", env, policy_kwargs={"net_arch": [16]}, seed=0, device="cpu")
+    actor = model.actor
+    obs = torch.as_tensor(np.random.default_rng(0).normal(size=(512, 3)), dtype=torch.float32)
+    for start_log_std, misses in ((1.5, 0.05), (-4.0, 0.2)):
+        with torch.no_grad():
+            actor.log_std.bias.fill_(start_log_std)
+            actor.log_std.weight.zero_()
+            target = torch.tanh(actor.mu(actor.latent_pi(obs))) + misses * torch.randn(
+                512, 1, generator=torch.Generator().manual_seed(1)
+            )
+        optimiser = torch.optim.Adam(actor.log_std.parameters(), lr=0.05)
+        for _ in range(400):
+            _, spread = cloning_loss(actor, obs, target)
+            optimiser.zero_grad()
+            spread.backward()
+            optimiser.step()
+        with torch.no_grad():
+            sigma = float(torch.exp(actor.log_std(actor.latent_pi(obs))).mean())
+        assert sigma == pytest.approx(misses, rel=0.15), (start_log_std, sigma)
+    env.close()
 
 
 def test_a_cloned_target_entropy_is_the_clones_own_and_stays_with_the_run(demos_root, tmp_path):
