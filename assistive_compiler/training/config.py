@@ -170,6 +170,15 @@ class Demonstrations(Strict):
         "0: after the start, SAC's own actor loss alone.",
     )
 
+    hold_actor_steps: int = Field(
+        0,
+        ge=0,
+        le=1_000_000,
+        description="SAC's first gradient steps during which the actor is not updated (the critics and the "
+        "temperature are), so the critics learn the cloned policy's own returns online before the actor follows "
+        "them (0: the actor updates from the first step).",
+    )
+
     @model_validator(mode="after")
     def _warmup_needs_replay(self) -> Demonstrations:
         if self.critic_warmup_steps and not self.replay:

@@ -15,7 +15,8 @@ Before the first env step of a new run (never on ``--resume``):
    cloned behaviour before they know what it is worth.
 
 While SAC learns (``clone_weight`` > 0, on ``--resume`` too), the cloning stays in the actor's
-loss as a term (:class:`KeepCloning`), as offline-to-online methods (TD3+BC, AWAC) anchor the
+loss as a term, and the actor may be held still for SAC's first ``hold_actor_steps`` updates
+(:class:`ActorUpdate`), as offline-to-online methods (TD3+BC, AWAC) anchor the
 actor: without it, SAC's first actor updates follow critics that know the demonstrated actions
 only, and a Drinking actor cloned to 15 % success lost it within 13,000 env steps.
 
@@ -248,28 +249,35 @@ def _cloning_targets(model, data: DemonstrationData):
     return obs, target
 
 
-class KeepCloning:
-    """SAC's actor optimiser with a behaviour-cloning term added to the actor's loss.
+class ActorUpdate:
+    """SAC's actor optimiser as a run started from demonstrations updates its actor.
 
     SB3's SAC computes its actor loss (temperature × log π − min Q), back-propagates it and calls
-    ``actor.optimizer.step()``. In its place this object first adds the gradient of
+    ``actor.optimizer.step()``. In its place this object
 
-        clone_weight × mean |min Q(s, a)| × (miss + spread)
+    * **holds the actor** for the first ``hold_steps`` gradient steps of SAC (the step is skipped;
+      the critics and the temperature learn as usual), so the critics first learn the cloned
+      policy's own returns online before the actor follows them;
+    * then, with ``weight`` > 0, first adds the gradient of
 
-    on a batch of the successful demonstrations' steps (s, a) — the cloning loss itself
-    (:func:`cloning_loss`: the deterministic action's squared miss, and σ's likelihood of it),
-    |Q| of the demonstrated pairs taken without gradient, as TD3+BC scales its cloning term — and
-    then steps. σ is held too: SAC's entropy estimate rewards a squashed Gaussian whose σ runs to
-    its bound on a few action dimensions while the others narrow (Drinking: σ up to e² on
-    some joints after 5,000 steps at the clone's total entropy, their actions ±1 noise). The sum is the actor loss of SAC plus that term; nothing else of
-    SAC changes. Everything else (``zero_grad``, ``state_dict``, ``param_groups``: SB3 saves and
-    schedules through them) is the wrapped optimiser's."""
+          weight × mean |min Q(s, a)| × (miss + spread)
 
-    def __init__(self, model, data: DemonstrationData, weight: float, seed: int):
+      on a batch of the successful demonstrations' steps (s, a) — the cloning loss itself
+      (:func:`cloning_loss`: the deterministic action's squared miss, and σ's likelihood of it),
+      |Q| of the demonstrated pairs taken without gradient, as TD3+BC scales its cloning term —
+      and then steps. σ is held too: SAC's entropy estimate rewards a squashed Gaussian whose σ
+      runs to its bound on a few action dimensions while the others narrow (Drinking: σ up to e²
+      on some joints after 5,000 steps at the clone's total entropy, their actions ±1 noise).
+
+    The sum is the actor loss of SAC plus that term; nothing else of SAC changes. Everything else
+    (``zero_grad``, ``state_dict``, ``param_groups``: SB3 saves and schedules through them) is the
+    wrapped optimiser's."""
+
+    def __init__(self, model, data: DemonstrationData, weight: float, hold_steps: int, seed: int):
         import torch
 
         self.optimizer = model.actor.optimizer
-        self._model, self._weight = model, weight
+        self._model, self._weight, self._hold_steps = model, weight, hold_steps
         self._obs, self._target = _cloning_targets(model, data)
         self._generator = torch.Generator().manual_seed(seed)
 
@@ -277,25 +285,31 @@ class KeepCloning:
         import torch
 
         model = self._model
-        idx = torch.randint(len(self._obs), (model.batch_size,), generator=self._generator)
-        obs, target = self._obs[idx], self._target[idx]
-        with torch.no_grad():
-            q_scale = torch.min(torch.cat(model.critic(obs, target), dim=1), dim=1)[0].abs().mean()
-        miss, spread = cloning_loss(model.actor, obs, target)
-        (self._weight * q_scale * (miss + spread)).backward()
-        model.logger.record_mean("train/clone_miss", miss.item())
-        model.logger.record_mean("train/clone_spread", spread.item())
-        model.logger.record_mean("train/clone_q_scale", q_scale.item())
+        if model._n_updates < self._hold_steps:  # SB3 counts its gradient steps over every sitting
+            return None
+        if self._weight > 0:
+            idx = torch.randint(len(self._obs), (model.batch_size,), generator=self._generator)
+            obs, target = self._obs[idx], self._target[idx]
+            with torch.no_grad():
+                q_scale = torch.min(torch.cat(model.critic(obs, target), dim=1), dim=1)[0].abs().mean()
+            miss, spread = cloning_loss(model.actor, obs, target)
+            (self._weight * q_scale * (miss + spread)).backward()
+            model.logger.record_mean("train/clone_miss", miss.item())
+            model.logger.record_mean("train/clone_spread", spread.item())
+            model.logger.record_mean("train/clone_q_scale", q_scale.item())
         return self.optimizer.step(closure)
 
     def __getattr__(self, name: str):
         return getattr(self.__dict__["optimizer"], name)
 
 
-def keep_cloning(model, data: DemonstrationData, settings: Demonstrations, seed: int) -> None:
-    """Keep the cloning term in ``model``'s actor loss from now on (``settings.clone_weight`` > 0)."""
-    if settings.clone_weight > 0 and not isinstance(model.actor.optimizer, KeepCloning):
-        model.actor.optimizer = KeepCloning(model, data, settings.clone_weight, seed)
+def update_actor_as_configured(model, data: DemonstrationData, settings: Demonstrations, seed: int) -> None:
+    """From now on, ``model``'s actor updates as :class:`ActorUpdate` says (where the settings
+    hold the actor or keep cloning; otherwise SAC's own update stays)."""
+    if (settings.clone_weight > 0 or settings.hold_actor_steps > 0) and not isinstance(
+        model.actor.optimizer, ActorUpdate
+    ):
+        model.actor.optimizer = ActorUpdate(model, data, settings.clone_weight, settings.hold_actor_steps, seed)
 
 
 def cloned_entropy(model, data: DemonstrationData, seed: int) -> float:
@@ -330,4 +344,5 @@ def start_from(
     figures["replayed_steps"] = fill_replay(model, data) if settings.replay else 0
     figures.update(warm_critic(model, settings.critic_warmup_steps))
     figures["clone_weight"] = settings.clone_weight
+    figures["hold_actor_steps"] = settings.hold_actor_steps
     return figures

@@ -43,7 +43,8 @@ def _started_from(demonstrations: dict | bool) -> str:
         return ""
     d = demonstrations
     kept = f", cloning kept in the actor's loss (weight {d['clone_weight']:g})" if d.get("clone_weight") else ""
-    return f" from {d['episodes']} {d['policy']} demonstrations ({d['steps']:,} steps){kept}"
+    held = f", the actor held for SAC's first {d['hold_actor_steps']:,} updates" if d.get("hold_actor_steps") else ""
+    return f" from {d['episodes']} {d['policy']} demonstrations ({d['steps']:,} steps){kept}{held}"
 
 
 def _start_sentence(demonstrations: dict | bool) -> str:
@@ -63,7 +64,13 @@ def _start_sentence(demonstrations: dict | bool) -> str:
         f"{d['replayed_steps']:,} steps in the replay buffer, the critics warmed up for "
         f"{d['critic_warmup_steps']:,} gradient steps"
         + (
-            f"; then SAC learned with the cloning term kept in its actor loss (weight {d['clone_weight']:g} × the "
+            f"; the actor then held for SAC's first {d['hold_actor_steps']:,} updates (the critics learning the "
+            "cloned policy's returns online)"
+            if d.get("hold_actor_steps")
+            else ""
+        )
+        + (
+            f"; SAC learned with the cloning term kept in its actor loss (weight {d['clone_weight']:g} × the "
             "demonstrated pairs' mean |Q|)."
             if d.get("clone_weight")
             else "."

@@ -196,7 +196,8 @@ def train(
     A new run given ``demonstrations`` (:class:`.demonstrations.DemonstrationData`) starts from
     them: its actor cloned, its replay buffer filled, its critics warmed up and a checkpoint
     written at step 0 (the cloned policy, before any env step), before it learns; with the
-    config's ``clone_weight`` > 0 (new or resumed run) the cloning stays in the actor's loss.
+    config's ``clone_weight`` > 0 (new or resumed run) the cloning stays in the actor's loss, and
+    with ``hold_actor_steps`` the actor waits for the critics first.
 
     A stop request (``stop``, set by Ctrl-C or SIGTERM: :func:`.train.stop_on_signals`) ends
     training after the current env step; a checkpoint is written and the figures come back with
@@ -225,7 +226,7 @@ def train(
         import json
 
         from ..run_dir import write_atomic
-        from .demonstrations import keep_cloning, start_from
+        from .demonstrations import start_from, update_actor_as_configured
 
         assert config.demonstrations is not None
         if not latest:
@@ -235,7 +236,7 @@ def train(
             )
             save_checkpoint(run, model, 0)
             write_atomic(run.demonstrations_json, json.dumps(started_from, indent=1))
-        keep_cloning(model, demonstrations, config.demonstrations, config.seed + start_steps)
+        update_actor_as_configured(model, demonstrations, config.demonstrations, config.seed + start_steps)
     progress = Progress(run, weights, config.total_steps, start_steps, quiet=quiet)
     interrupted = False
     try:

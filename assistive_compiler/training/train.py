@@ -114,8 +114,9 @@ def train(
             f"{display(run.path)}: the run directory already holds a run; pass --resume to continue it, or choose another --out"
         )
     demo_data = None
-    # read and checked before the run directory is written; a resumed run reads them again to keep cloning
-    if config.demonstrations is not None and (not resume or config.demonstrations.clone_weight > 0):
+    # read and checked before the run directory is written; a resumed run reads them again for its actor's updates
+    d = config.demonstrations
+    if d is not None and (not resume or d.clone_weight > 0 or d.hold_actor_steps > 0):
         from .demonstrations import load_demonstrations
 
         if config.demonstrations.dataset is None:

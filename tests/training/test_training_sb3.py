@@ -712,6 +712,33 @@ def test_a_cloning_term_kept_in_the_actors_loss_holds_it_to_the_demonstrations_n
     assert _against_demonstrations(RunDir(out).checkpoint_dir(450))[0] < 0.02
 
 
+def test_a_held_actor_waits_for_the_critics_then_learns(demos_root, tmp_path):
+    """demonstrations.hold_actor_steps: SAC's first updates leave the actor as cloned (every
+    parameter) while the critics learn; after them, it learns — on --resume too."""
+    import torch
+    from stable_baselines3 import SAC
+
+    config = tmp_path / "held.yaml"
+    config.write_text(
+        SAC_FROM_DEMOS.replace("total_steps: 200", "total_steps: 100")
+        .replace("learning_starts: 100", "learning_starts: 0")
+        .replace("clone_batch_size: 32}", "clone_batch_size: 32, critic_warmup_steps: 0, hold_actor_steps: 150}")
+    )
+    out = tmp_path / "run"
+    args = ["train", str(REACH), "--robot", "jaco", "--config", str(config), "--out", str(out), "--quiet"]
+    assert main([*args, "--demonstrations", DEMOS, "--demonstrations-root", str(demos_root)]) == 0
+    assert main([*args, "--resume", "--steps", "300"]) == 0
+    run = RunDir(out)
+    models = {s: SAC.load(str(run.checkpoint_dir(s) / "model.zip"), device="cpu") for s in (0, 100, 300)}
+
+    def same(a, b) -> bool:
+        return all(torch.equal(x, y) for x, y in zip(a.parameters(), b.parameters(), strict=True))
+
+    assert same(models[0].actor, models[100].actor) and not same(models[0].critic, models[100].critic)
+    assert not same(models[100].actor, models[300].actor)  # held for 150 updates, then learning
+    assert json.loads(run.demonstrations_json.read_text())["hold_actor_steps"] == 150
+
+
 def test_the_cloning_loss_fits_sigma_per_action_dimension_to_the_misses():
     """The spread part of the cloning loss, the mean held: each action dimension's σ goes to the
     root mean square of that dimension's misses, from too wide and from too narrow alike."""
@@ -852,4 +879,8 @@ def test_results_from_demonstrations_say_so_in_every_table(demo_run, tmp_path):
     record["demonstrations"]["clone_weight"] = 0.4
     block = results_block([record])
     assert "(320 steps), cloning kept in the actor's loss (weight 0.4)" in block
-    assert "then SAC learned with the cloning term kept in its actor loss (weight 0.4 × the demonstrated" in block
+    assert "; SAC learned with the cloning term kept in its actor loss (weight 0.4 × the demonstrated" in block
+    record["demonstrations"]["hold_actor_steps"] = 10_000
+    block = results_block([record])
+    assert "(weight 0.4), the actor held for SAC's first 10,000 updates" in block
+    assert "; the actor then held for SAC's first 10,000 updates (the critics learning the cloned policy's" in block
