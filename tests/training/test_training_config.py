@@ -19,6 +19,14 @@ SHIPPED = sorted((REPO / "specs" / "training").glob("*.yaml"))
 REACH = REPO / "specs" / "examples" / "reach.yaml"
 
 
+def _problems(path, text: str) -> list[str]:
+    """The located problems that loading ``text``, written to ``path``, reports."""
+    path.write_text(text)
+    with pytest.raises(SpecError) as err:
+        load_training_config(path)
+    return [str(p) for p in err.value.problems]
+
+
 @pytest.mark.parametrize("path", SHIPPED, ids=lambda p: p.stem)
 def test_shipped_configs_validate_and_match_the_schema(path):
     import yaml
@@ -52,10 +60,7 @@ def test_mistakes_are_located(tmp_path):
         "checkpoint_every_steps: 50\n"
     )
     path = tmp_path / "bad.yaml"
-    path.write_text(text)
-    with pytest.raises(SpecError) as err:
-        load_training_config(path)
-    messages = [str(p) for p in err.value.problems]
+    messages = _problems(path, text)
     name = str(path)
     assert f"{name}:{at(text, '[64, 0]')}: network.hidden: every layer width must be ≥ 1, got [64, 0]" in messages
     assert (
@@ -78,10 +83,7 @@ def test_mistakes_are_located(tmp_path):
 def test_minibatch_larger_than_the_batch_is_located(tmp_path):
     text = "algorithm: ppo\nppo: {rollout_steps: 10, minibatch_size: 64, epochs: 1}\nenvs: 2\ntotal_steps: 100\ncheckpoint_every_steps: 50\n"
     path = tmp_path / "batch.yaml"
-    path.write_text(text)
-    with pytest.raises(SpecError) as err:
-        load_training_config(path)
-    assert [str(p) for p in err.value.problems] == [
+    assert _problems(path, text) == [
         f"{path}:{at(text, '64')}: ppo.minibatch_size: minibatch_size 64 is larger than the batch rollout_steps × envs = 10 × 2 = 20"
     ]
 
@@ -108,47 +110,30 @@ def test_algorithm_and_its_section_must_agree(tmp_path):
         "sac: {ent_coef: -0.1, gradient_stepz: 2}\ntotal_steps: 100\ncheckpoint_every_steps: 50\n"
     )
     path = tmp_path / "mixed.yaml"
-    path.write_text(text)
-    with pytest.raises(SpecError) as err:
-        load_training_config(path)
-    messages = [str(p) for p in err.value.problems]
+    messages = _problems(path, text)
     assert any(
         m.startswith(f"{path}:{at(text, 'gradient_stepz')}: unknown key 'gradient_stepz' in sac")
         and "(did you mean 'gradient_steps'?)" in m
         for m in messages
     ), messages
     text = "algorithm: sac\nppo: {rollout_steps: 10, minibatch_size: 8, epochs: 1}\nsac: {ent_coef: -0.1}\ntotal_steps: 100\ncheckpoint_every_steps: 50\n"
-    path.write_text(text)
-    with pytest.raises(SpecError) as err:
-        load_training_config(path)
-    assert [str(p) for p in err.value.problems] == [
+    assert _problems(path, text) == [
         f"{path}:{at(text, '-0.1')}: sac.ent_coef: the entropy temperature must be > 0 (or 'auto'), got -0.1"
     ]
     text = (
         "algorithm: sac\nsac: {ent_coef: 0.2, initial_ent_coef: 0.01}\ntotal_steps: 100\ncheckpoint_every_steps: 50\n"
     )
-    path.write_text(text)
-    with pytest.raises(SpecError) as err:
-        load_training_config(path)
-    assert [str(p) for p in err.value.problems] == [
+    assert _problems(path, text) == [
         f"{path}:{at(text, '0.01')}: sac.initial_ent_coef: the temperature α is fixed at ent_coef 0.2; "
         "a starting value is for ent_coef: auto only"
     ]
     text = "algorithm: sac\nppo: {rollout_steps: 10, minibatch_size: 8, epochs: 1}\nsac: {}\ntotal_steps: 100\ncheckpoint_every_steps: 50\n"
-    path.write_text(text)
-    with pytest.raises(SpecError) as err:
-        load_training_config(path)
-    assert [str(p) for p in err.value.problems] == [
+    assert _problems(path, text) == [
         f"{path}:{at(text, '{rollout_steps')}: ppo: a 'ppo:' section configures algorithm 'ppo', but algorithm is 'sac'; "
         "remove it or set algorithm: ppo"
     ]
     text = "algorithm: sac\ntotal_steps: 100\ncheckpoint_every_steps: 50\n"
-    path.write_text(text)
-    with pytest.raises(SpecError) as err:
-        load_training_config(path)
-    assert [str(p) for p in err.value.problems] == [
-        f"{path}:1:1: sac: algorithm 'sac' needs its settings in a 'sac:' section"
-    ]
+    assert _problems(path, text) == [f"{path}:1:1: sac: algorithm 'sac' needs its settings in a 'sac:' section"]
 
 
 def test_overrides_are_validated():
@@ -219,10 +204,7 @@ def test_a_cloned_target_entropy_needs_a_clone_and_a_learned_temperature(tmp_pat
         ),
     ):
         text = f"algorithm: sac\nsac: {sac}\ntotal_steps: 100\ncheckpoint_every_steps: 50\n{extra}"
-        path.write_text(text)
-        with pytest.raises(SpecError) as err:
-            load_training_config(path)
-        assert [str(p) for p in err.value.problems] == [f"{path}:{at(text, 'cloned')}: sac.target_entropy: {expected}"]
+        assert _problems(path, text) == [f"{path}:{at(text, 'cloned')}: sac.target_entropy: {expected}"]
 
 
 def test_sac_demos_is_the_recipe_started_from_demonstrations():
