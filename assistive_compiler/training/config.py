@@ -164,10 +164,10 @@ class Demonstrations(Strict):
         ge=0,
         le=100,
         description="Weight of a behaviour-cloning term kept in SAC's actor loss while it learns: at each actor "
-        "update, clone_weight × the mean |Q| of a batch of demonstrated (state, action) pairs × the mean squared "
-        "miss of the deterministic action on them (TD3+BC's scaling: the term's pull does not depend on how large "
-        "the task's returns are). It keeps the actor near the demonstrations where its critics know little. "
-        "0: after the start, SAC's own actor loss alone.",
+        "update, clone_weight × the mean |Q| of a batch of demonstrated (state, action) pairs × the cloning loss on "
+        "them (the deterministic action's mean squared miss, and σ's likelihood of it; TD3+BC's scaling: the term's "
+        "pull does not depend on how large the task's returns are). It keeps the actor near the demonstrations "
+        "where its critics know little. 0: after the start, SAC's own actor loss alone.",
     )
 
     hold_actor_steps: int = Field(
@@ -178,6 +178,12 @@ class Demonstrations(Strict):
         "temperature are), so the critics learn the cloned policy's own returns online before the actor follows "
         "them (0: the actor updates from the first step).",
     )
+
+    @property
+    def steers_actor_updates(self) -> bool:
+        """Whether SAC's actor updates use the demonstrations after the start (a kept cloning term or
+        a hold), so a resumed run reads the dataset again."""
+        return self.clone_weight > 0 or self.hold_actor_steps > 0
 
     @model_validator(mode="after")
     def _warmup_needs_replay(self) -> Demonstrations:

@@ -16,9 +16,10 @@ Before the first env step of a new run (never on ``--resume``):
 
 While SAC learns (``clone_weight`` > 0, on ``--resume`` too), the cloning stays in the actor's
 loss as a term, and the actor may be held still for SAC's first ``hold_actor_steps`` updates
-(:class:`ActorUpdate`), as offline-to-online methods (TD3+BC, AWAC) anchor the
-actor: without it, SAC's first actor updates follow critics that know the demonstrated actions
-only, and a Drinking actor cloned to 15 % success lost it within 13,000 env steps.
+(:class:`ActorUpdate`), as offline-to-online methods (TD3+BC, AWAC) anchor the actor: without
+it, SAC's first actor updates follow critics that know the demonstrated actions only, and a
+Drinking actor cloned to 15 % success lost it within 13,000 env steps. (With both, Drinking still
+loses it to critics that over-value: docs/results.md, ninth sitting.)
 
 The dataset must have been collected on the run's compiled task (the same content hash): a
 dataset of another task, robot or task version is refused with what it was collected on.
@@ -306,9 +307,7 @@ class ActorUpdate:
 def update_actor_as_configured(model, data: DemonstrationData, settings: Demonstrations, seed: int) -> None:
     """From now on, ``model``'s actor updates as :class:`ActorUpdate` says (where the settings
     hold the actor or keep cloning; otherwise SAC's own update stays)."""
-    if (settings.clone_weight > 0 or settings.hold_actor_steps > 0) and not isinstance(
-        model.actor.optimizer, ActorUpdate
-    ):
+    if settings.steers_actor_updates and not isinstance(model.actor.optimizer, ActorUpdate):
         model.actor.optimizer = ActorUpdate(model, data, settings.clone_weight, settings.hold_actor_steps, seed)
 
 

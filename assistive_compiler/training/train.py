@@ -116,15 +116,15 @@ def train(
     demo_data = None
     # read and checked before the run directory is written; a resumed run reads them again for its actor's updates
     d = config.demonstrations
-    if d is not None and (not resume or d.clone_weight > 0 or d.hold_actor_steps > 0):
+    if d is not None and (not resume or d.steers_actor_updates):
         from .demonstrations import load_demonstrations
 
-        if config.demonstrations.dataset is None:
+        if d.dataset is None:
             raise UsageError(
                 f"{display(Path(config_path))}: this config starts from demonstrations; "
                 "name the dataset with --demonstrations DATASET (a `collect` dataset of this task)"
             )
-        demo_data = load_demonstrations(config.demonstrations, manifest.content_hash)
+        demo_data = load_demonstrations(d, manifest.content_hash)
     if not resume:
         run.create(new_run_info(spec, manifest, robot, coop, engine, config), result.out_dir)
     weights = reward_weights(manifest)
