@@ -114,6 +114,11 @@ class SAC(Strict):
         "(a run started from demonstrations) is the cloned policy's own entropy on the demonstrations, so SAC "
         "explores as widely as the clone misses them instead of widening it to −(action dimensions).",
     )
+    critic_layer_norm: bool = Field(
+        False,
+        description="Layer-normalise every hidden layer of the twin critics (RLPD, Ball et al. 2023): their "
+        "values stay bounded where the data are thin, as in a run started from demonstrations (SB3 engine only).",
+    )
 
     @model_validator(mode="after")
     def _positive_temperature(self) -> SAC:

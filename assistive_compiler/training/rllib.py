@@ -192,6 +192,11 @@ def build_sac_config(run: RunDir, config: TrainingConfig, weights: dict[str, flo
         raise UsageError(
             f"sac.ent_coef {s.ent_coef}: the rllib engine learns the entropy temperature; use ent_coef: auto"
         )
+    if s.critic_layer_norm:
+        raise UsageError(
+            "sac.critic_layer_norm: layer-normalised critics are built for the sb3 engine only; "
+            "use --engine sb3, or set critic_layer_norm: false"
+        )
     updates_per_step = s.gradient_steps / s.train_freq
     buffer = "MultiAgentEpisodeReplayBuffer" if coop else "EpisodeReplayBuffer"
     cfg = (

@@ -77,8 +77,10 @@ def _new_model(venv, config: TrainingConfig, run: RunDir):
 
     if config.sac is not None:
         s = config.sac
+        from .critics import LayerNormSACPolicy
+
         return SAC(
-            "MlpPolicy",
+            LayerNormSACPolicy if s.critic_layer_norm else "MlpPolicy",
             venv,
             learning_rate=s.learning_rate,
             buffer_size=s.buffer_size,

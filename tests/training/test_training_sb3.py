@@ -363,6 +363,67 @@ def test_a_learned_temperature_starts_where_the_config_says(sac_run, tmp_path, e
         assert build_sac_config(RunDir(sac_run), config, {}, False).initial_alpha == alpha
 
 
+def test_layer_normed_critics_train_resume_and_stay_bounded_where_plain_ones_grow(sac_run, tmp_path):
+    """sac.critic_layer_norm: every hidden layer of both critics (and their targets) is
+    Linear → LayerNorm → ReLU; the run trains, checkpoints, loads back with that policy class and
+    resumes. Their point: a layer-normalised critic's value cannot grow with its input (far from
+    the data it stays within what its last layer allows), where the plain critic's grows with it."""
+    import torch
+    from stable_baselines3 import SAC
+    from torch import nn
+
+    from assistive_compiler.training.critics import LayerNormSACPolicy
+
+    config = tmp_path / "sac_ln.yaml"
+    config.write_text(SAC_TINY.replace("batch_size: 32}", "batch_size: 32, critic_layer_norm: true}"))
+    out = tmp_path / "reach-sac-ln"
+    args = ["train", str(REACH), "--robot", "jaco", "--config", str(config), "--out", str(out), "--quiet"]
+    assert main(args) == 0
+    assert main([*args, "--resume", "--steps", "800"]) == 0
+    run = RunDir(out)
+    normed = SAC.load(str(run.checkpoint_dir(800) / "model.zip"), device="cpu")
+    assert isinstance(normed.policy, LayerNormSACPolicy) and normed.num_timesteps == 800
+    for critic in (normed.critic, normed.critic_target):
+        for q in critic.q_networks:
+            kinds = [type(m) for m in q]
+            assert kinds == [nn.Linear, nn.LayerNorm, nn.ReLU, nn.Linear, nn.LayerNorm, nn.ReLU, nn.Linear]
+    assert SAC.load(str(run.checkpoint_dir(400) / "model.zip"), device="cpu").policy.critic.state_dict().keys() == (
+        normed.critic.state_dict().keys()
+    )
+    plain = SAC.load(str(RunDir(sac_run).latest_checkpoint()[1] / "model.zip"), device="cpu")
+    assert not any(isinstance(m, nn.LayerNorm) for m in plain.critic.modules())
+    obs = torch.as_tensor(
+        np.random.default_rng(0).normal(size=(64, normed.observation_space.shape[0])), dtype=torch.float32
+    )
+    act = torch.zeros(64, normed.action_space.shape[0])
+
+    def growth(model) -> float:
+        with torch.no_grad():
+            near, far = (torch.min(*model.critic(obs * k, act)).abs().mean() for k in (1e3, 1e6))
+        return float(far / near)
+
+    assert growth(normed) == pytest.approx(1.0, abs=0.01)  # bounded: the same value ever further out
+    assert growth(plain) > 100.0  # a ReLU critic is linear far out: ×1000 input, ~×1000 value
+    evaluated = evaluate(out, episodes=2, seed=EVAL_SEED)  # a run directory's policy evaluates as any other
+    assert evaluated["trained_steps"] == 800
+
+
+def test_layer_normed_critics_are_refused_on_rllib_with_what_to_do(sac_run, tmp_path):
+    pytest.importorskip("ray")
+    from assistive_compiler.errors import UsageError
+    from assistive_compiler.training.config import load_training_config
+    from assistive_compiler.training.rllib import build_sac_config
+
+    path = tmp_path / "sac_ln.yaml"
+    path.write_text(SAC_TINY.replace("batch_size: 32}", "batch_size: 32, critic_layer_norm: true}"))
+    with pytest.raises(UsageError) as raised:
+        build_sac_config(RunDir(sac_run), load_training_config(path), {}, False)
+    assert str(raised.value) == (
+        "sac.critic_layer_norm: layer-normalised critics are built for the sb3 engine only; "
+        "use --engine sb3, or set critic_layer_norm: false"
+    )
+
+
 def test_sac_resume_without_the_replay_buffer_is_refused(sac_run, tmp_path, capsys):
     copy = tmp_path / "no-buffer"
     shutil.copytree(sac_run, copy)
