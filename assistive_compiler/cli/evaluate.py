@@ -28,20 +28,15 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         )
         return EXIT_BAD_INPUT
     if source.startswith(PREFIX) or (Path(source) / POLICY_FILE).is_file():  # shipped or exported: NumPy only
-        if args.stochastic:
-            print(
-                f"evaluate: --stochastic samples a run's actions as training did; {source} is an exported policy, "
-                "which keeps only the deterministic action (the distribution's mean): evaluate its run directory",
-                file=sys.stderr,
-            )
-            return EXIT_BAD_INPUT
         if args.checkpoint is not None:
             print(
                 f"evaluate: --checkpoint picks a checkpoint of a run directory; {source} is an exported policy (one checkpoint)",
                 file=sys.stderr,
             )
             return EXIT_BAD_INPUT
-        result = evaluate_exported(source, episodes=args.episodes or 100, seed=args.seed, render=args.render)
+        result = evaluate_exported(
+            source, episodes=args.episodes or 100, seed=args.seed, render=args.render, stochastic=args.stochastic
+        )
         print(json.dumps(result, indent=1) if args.json else format_report(result))
         return EXIT_OK
     run = RunDir(source)

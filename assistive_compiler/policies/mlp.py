@@ -13,6 +13,12 @@ The network is evaluated in float64 whatever the training library did; actions a
 deterministic ones (the mean of its Gaussian), mapped to the action space's bounds as the
 training library maps them: ``tanh`` (SAC's squashed Gaussian, then scaled to [low, high]) or
 ``clip`` (PPO's unbounded Gaussian mean, clipped to [low, high]).
+
+Policies exported with their Gaussian's log-std (``network.log_std``
+in ``policy.json``) can also act as they did in training: :meth:`MLPPolicy.sampling` draws each
+action from the Gaussian (seeded) before the same squashing or clipping. The log-std is either a
+layer on the last hidden features (``state``: SAC's, clamped to its library's bounds) or one free
+vector (``free``: PPO's).
 """
 
 from __future__ import annotations
@@ -50,6 +56,8 @@ class MLPPolicy:
         obs_clip: float = 10.0,
         obs_eps: float = 1e-8,
         info: dict | None = None,
+        log_std: tuple[np.ndarray, np.ndarray] | np.ndarray | None = None,
+        log_std_bounds: tuple[float, float] = (-20.0, 2.0),
     ):
         if activation not in ACTIVATIONS:
             raise ValueError(f"unknown activation '{activation}'; expected one of {', '.join(ACTIVATIONS)}")
@@ -63,6 +71,13 @@ class MLPPolicy:
         self.obs_std = None if obs_var is None else np.sqrt(self.obs_var + obs_eps)
         self.obs_clip, self.obs_eps = float(obs_clip), float(obs_eps)
         self.info = dict(info or {})
+        if isinstance(log_std, tuple):  # a layer on the last hidden features: (W, b)
+            self.log_std: tuple[np.ndarray, np.ndarray] | np.ndarray | None = tuple(
+                np.asarray(a, dtype=np.float64) for a in log_std
+            )
+        else:
+            self.log_std = None if log_std is None else np.asarray(log_std, dtype=np.float64)
+        self.log_std_bounds = (float(log_std_bounds[0]), float(log_std_bounds[1]))
 
     @property
     def obs_dim(self) -> int:
@@ -72,20 +87,51 @@ class MLPPolicy:
     def action_dim(self) -> int:
         return self.layers[-1][0].shape[0]
 
-    def __call__(self, obs: np.ndarray) -> np.ndarray:
+    @property
+    def samples(self) -> bool:
+        """Whether the policy carries its Gaussian's log-std, so :meth:`sampling` can act as in training."""
+        return self.log_std is not None
+
+    def _features(self, obs: np.ndarray) -> np.ndarray:
+        """The last hidden layer's output for ``obs`` (normalised first where trained so)."""
         x = np.asarray(obs, dtype=np.float64)
         if self.obs_mean is not None:
             x = np.clip((x - self.obs_mean) / self.obs_std, -self.obs_clip, self.obs_clip)
         act = ACTIVATIONS[self.activation]
         for w, b in self.layers[:-1]:
             x = act(w @ x + b)
-        w, b = self.layers[-1]
-        x = w @ x + b
+        return x
+
+    def _to_bounds(self, x: np.ndarray) -> np.ndarray:
         if self.head == "tanh":
             x = self.low + 0.5 * (np.tanh(x) + 1.0) * (self.high - self.low)
         else:
             x = np.clip(x, self.low, self.high)
         return x.astype(np.float32)
+
+    def mean_and_std(self, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The Gaussian's mean and standard deviation for ``obs``, before the squashing or clipping
+        (the policy's [-1, 1]-scale pre-tanh units for SAC, the env's action units for PPO)."""
+        if self.log_std is None:
+            raise ValueError("this policy was exported without its log-std (by an earlier version): it has a mean only")
+        h = self._features(obs)
+        w, b = self.layers[-1]
+        if isinstance(self.log_std, tuple):
+            log_std = np.clip(self.log_std[0] @ h + self.log_std[1], *self.log_std_bounds)
+        else:
+            log_std = self.log_std
+        return w @ h + b, np.exp(log_std)
+
+    def __call__(self, obs: np.ndarray) -> np.ndarray:
+        w, b = self.layers[-1]
+        return self._to_bounds(w @ self._features(obs) + b)
+
+    def sampling(self, seed: int) -> SampledPolicy:
+        """This policy acting as in training: each action a sample of its Gaussian, squashed or
+        clipped as the mean is, from a generator seeded with ``seed``."""
+        if self.log_std is None:
+            raise ValueError("this policy was exported without its log-std (by an earlier version): it has a mean only")
+        return SampledPolicy(self, np.random.default_rng(seed))
 
     # -- files ---------------------------------------------------------------------------------
     def save(self, directory: str | Path, info: dict) -> Path:
@@ -102,6 +148,11 @@ class MLPPolicy:
         if self.obs_mean is not None:
             arrays["obs_mean"] = self.obs_mean
             arrays["obs_var"] = self.obs_var
+        if isinstance(self.log_std, tuple):
+            arrays["log_std_weight"] = self.log_std[0].astype(np.float32)
+            arrays["log_std_bias"] = self.log_std[1].astype(np.float32)
+        elif self.log_std is not None:
+            arrays["log_std"] = self.log_std.astype(np.float32)
         network = {
             "activation": self.activation,
             "head": self.head,
@@ -110,6 +161,8 @@ class MLPPolicy:
             "obs_normalised": self.obs_mean is not None,
             "obs_clip": self.obs_clip,
             "obs_eps": self.obs_eps,
+            "log_std": None if self.log_std is None else ("state" if isinstance(self.log_std, tuple) else "free"),
+            "log_std_bounds": list(self.log_std_bounds),
         }
         np.savez_compressed(directory / WEIGHTS_FILE, **arrays)
         (directory / POLICY_FILE).write_text(json.dumps({**info, "network": network}, indent=1) + "\n")
@@ -127,6 +180,33 @@ class MLPPolicy:
             mean = z["obs_mean"] if net["obs_normalised"] else None
             var = z["obs_var"] if net["obs_normalised"] else None
             low, high = z["action_low"], z["action_high"]
+            kind = net.get("log_std")  # absent from exports of earlier versions
+            log_std = (z["log_std_weight"], z["log_std_bias"]) if kind == "state" else z["log_std"] if kind else None
         return cls(
-            layers, net["activation"], net["head"], low, high, mean, var, net["obs_clip"], net["obs_eps"], info=info
+            layers,
+            net["activation"],
+            net["head"],
+            low,
+            high,
+            mean,
+            var,
+            net["obs_clip"],
+            net["obs_eps"],
+            info=info,
+            log_std=log_std,
+            log_std_bounds=tuple(net.get("log_std_bounds", (-20.0, 2.0))),
         )
+
+
+class SampledPolicy:
+    """An :class:`MLPPolicy` acting as in training: ``obs -> action`` drawn from its Gaussian
+    (mean and σ of :meth:`MLPPolicy.mean_and_std`), then squashed or clipped to the bounds. The
+    noise comes from ``rng``, which a co-optimised pair's two agents share as their run's
+    checkpoint does (:class:`~assistive_compiler.policies.checkpoint.RLlibPolicy`)."""
+
+    def __init__(self, policy: MLPPolicy, rng: np.random.Generator):
+        self.policy, self.info, self.rng = policy, policy.info, rng
+
+    def __call__(self, obs: np.ndarray) -> np.ndarray:
+        mean, std = self.policy.mean_and_std(obs)
+        return self.policy._to_bounds(mean + std * self.rng.standard_normal(mean.shape[0]))

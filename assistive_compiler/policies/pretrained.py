@@ -23,7 +23,7 @@ import numpy as np
 from ..errors import UsageError, did_you_mean, one_of
 from ..paths import data_root
 from ..run_dir import RUN_FILE
-from .mlp import POLICY_FILE, MLPPolicy
+from .mlp import POLICY_FILE, MLPPolicy, SampledPolicy
 
 PREFIX = "pretrained:"
 BASELINES = ("random", "zero", "scripted")
@@ -67,6 +67,18 @@ class CoopPolicy:
 
     def __call__(self, robot_obs: np.ndarray, human_obs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return self.robot(robot_obs), self.human(human_obs)
+
+    @property
+    def samples(self) -> bool:
+        return self.robot.samples and self.human.samples
+
+    def sampling(self, seed: int) -> CoopPolicy:
+        """Both agents acting as in training (:class:`.mlp.SampledPolicy`), drawing their noise in turn
+        (robot, then person) from one generator seeded with ``seed``, as the run's checkpoint does."""
+        if not self.samples:
+            raise ValueError("this pair was exported without its log-stds (by an earlier version): it has means only")
+        rng = np.random.default_rng(seed)
+        return CoopPolicy(SampledPolicy(self.robot, rng), SampledPolicy(self.human, rng), self.info)
 
 
 def load_folder(folder: Path):

@@ -90,13 +90,23 @@ def write_rollout(artifact_dir: str | Path, policy, coop: bool, seed: int, out: 
     return f"wrote {display(out)} ({len(frames)} frames; return {summary['return']:.1f}, success {'yes' if summary['success'] else 'no'})"
 
 
-def evaluate_exported(source: str, episodes: int = 100, seed: int = 0, render: str | None = None) -> dict:
+def evaluate_exported(
+    source: str, episodes: int = 100, seed: int = 0, render: str | None = None, stochastic: bool = False
+) -> dict:
     """Evaluate a shipped or exported policy (``pretrained:<name>`` or a policy folder) on its
     task, compiled on the current code (NumPy only; no training library needed). A co-optimised
-    pair plays both agents."""
+    pair plays both agents. ``stochastic`` samples its actions as training did (seeded with
+    ``seed``): for policies exported with their log-std; older ones are refused with what to do."""
+    from ..errors import UsageError
     from ..policies.pretrained import load_trained
 
-    policy, info = load_trained(source)
+    trained, info = load_trained(source)
+    if stochastic and not trained.samples:
+        raise UsageError(
+            f"evaluate --stochastic: {source} was exported without its policy's log-std (by an earlier version), "
+            "so it keeps only the deterministic action; evaluate its run directory, or export the run again"
+        )
+    policy = trained.sampling(seed) if stochastic else trained
     coop = bool(info.get("coop"))
     compiled = compile_for_policy(info)
     results = play_episodes(compiled.out_dir, policy, coop, episodes, seed)
@@ -111,13 +121,15 @@ def evaluate_exported(source: str, episodes: int = 100, seed: int = 0, render: s
         "trained_steps": info["trained_steps"],
         "episodes": episodes,
         "seed": seed,
+        "actions": "stochastic" if stochastic else "deterministic",
         "content_hash": compiled.manifest.content_hash,
         "trained_on_content_hash": info["content_hash"],
         **_figures(results),
         "per_episode": results,
     }
-    if render:
-        out["render"] = write_rollout(compiled.out_dir, policy, coop, seed, Path(render))
+    if render:  # the first episode again: a sampling policy starts over from its seed
+        picture = trained.sampling(seed) if stochastic else trained
+        out["render"] = write_rollout(compiled.out_dir, picture, coop, seed, Path(render))
     return out
 
 

@@ -49,13 +49,28 @@ def mlp_from_sb3(loaded, algorithm: str, activation: str) -> MLPPolicy:
     model = loaded.model
     low, high = model.action_space.low, model.action_space.high
     if algorithm == "sac":
+        from stable_baselines3.sac.policies import LOG_STD_MAX, LOG_STD_MIN
+
         layers = _layers(_linears(model.actor.latent_pi) + [model.actor.mu])
-        return MLPPolicy(layers, activation, "tanh", low, high)
+        log_std = _layers([model.actor.log_std])[0]  # a layer on the same features as the mean's
+        return MLPPolicy(
+            layers, activation, "tanh", low, high, log_std=log_std, log_std_bounds=(LOG_STD_MIN, LOG_STD_MAX)
+        )
     layers = _layers(_linears(model.policy.mlp_extractor.policy_net) + [model.policy.action_net])
+    free = model.policy.log_std.detach().cpu().numpy().astype(np.float64)  # one vector, whatever the state
     if loaded.obs_rms is None:
-        return MLPPolicy(layers, activation, "clip", low, high)
+        return MLPPolicy(layers, activation, "clip", low, high, log_std=free)
     return MLPPolicy(
-        layers, activation, "clip", low, high, loaded.obs_rms.mean, loaded.obs_rms.var, loaded.clip, loaded.eps
+        layers,
+        activation,
+        "clip",
+        low,
+        high,
+        loaded.obs_rms.mean,
+        loaded.obs_rms.var,
+        loaded.clip,
+        loaded.eps,
+        log_std=free,
     )
 
 
@@ -65,10 +80,13 @@ def mlp_from_rllib(module, algorithm: str, activation: str) -> MLPPolicy:
     encoder = module.pi_encoder if algorithm == "sac" else module.encoder.actor_encoder
     layers = _layers(_linears(encoder) + _linears(module.pi))
     w, b = layers[-1]
-    half = w.shape[0] // 2  # the head gives means, then log-stds
+    half = w.shape[0] // 2  # the head gives means, then log-stds, from the same features
     layers[-1] = (w[:half], b[:half])
     space = module.action_space
-    return MLPPolicy(layers, activation, "tanh" if algorithm == "sac" else "clip", space.low, space.high)
+    head = "tanh" if algorithm == "sac" else "clip"
+    return MLPPolicy(
+        layers, activation, head, space.low, space.high, log_std=(w[half:], b[half:]), log_std_bounds=(-20.0, 20.0)
+    )
 
 
 def check_same_actions(exported: MLPPolicy, original, observations: np.ndarray, atol: float = 1e-4) -> float:

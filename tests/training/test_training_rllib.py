@@ -111,6 +111,16 @@ def test_multi_agent_ppo_iteration_checkpoint_resume_evaluate(local_ray, tmp_pat
     first, again = (p(obs[0], human_obs) for p in sampled)
     assert all(np.array_equal(a, b) for a, b in zip(first, again, strict=True))
     assert not np.array_equal(first[0], mean(obs[0], human_obs)[0])
+    # The exported pair samples as the checkpoint does: the same means and σs (the head's second
+    # half), the noise drawn in turn from one generator of the same seed: the same actions.
+    from assistive_compiler.policies.pretrained import load_trained
+
+    exported, _ = load_trained(str(tmp_path / "ppo-pair"))
+    theirs = RLlibPolicy(ckpt, coop=True, algorithm="ppo", stochastic=True, seed=3)
+    ours = exported.sampling(3)
+    for o in obs:
+        for a, b in zip(ours(o, human_obs), theirs(o, human_obs), strict=True):
+            assert np.allclose(a, b, atol=1e-4)
 
 
 def test_unreachable_ray_address_fails_fast_with_a_message(tmp_path, capsys):

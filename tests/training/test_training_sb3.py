@@ -29,7 +29,7 @@ from assistive_compiler.errors import SpecError
 from assistive_compiler.policies import make_policy
 from assistive_compiler.run_dir import RunDir
 from assistive_compiler.runtime.env import AssistiveEnv
-from assistive_compiler.training.evaluate import evaluate
+from assistive_compiler.training.evaluate import evaluate, evaluate_exported
 from assistive_compiler.training.resume import check_resumable
 
 pytestmark = pytest.mark.slow
@@ -99,8 +99,8 @@ def test_evaluation_is_deterministic_for_a_seed(reach_run):
 
 def test_stochastic_evaluation_samples_as_training_did_and_is_seeded(reach_run, capsys):
     """--stochastic samples the policy's actions (the same seed, the same episodes; not the
-    deterministic ones) and leaves the run's evaluation.json alone; an exported policy, which
-    keeps only the mean, refuses it."""
+    deterministic ones) and leaves the run's evaluation.json alone; a policy exported by an
+    earlier version, which kept only the mean, refuses it with what to do."""
     saved = (reach_run / "evaluation.json").read_text() if (reach_run / "evaluation.json").is_file() else None
     deterministic = evaluate(reach_run, episodes=2, seed=5)
     sampled = evaluate(reach_run, episodes=2, seed=5, stochastic=True)
@@ -112,8 +112,8 @@ def test_stochastic_evaluation_samples_as_training_did_and_is_seeded(reach_run, 
     assert ((reach_run / "evaluation.json").read_text() if saved is not None else None) == saved
     assert main(["evaluate", "--policy", "pretrained:feeding-jaco", "--stochastic"]) == 2
     assert capsys.readouterr().err.strip() == (
-        "evaluate: --stochastic samples a run's actions as training did; pretrained:feeding-jaco is an exported "
-        "policy, which keeps only the deterministic action (the distribution's mean): evaluate its run directory"
+        "error: evaluate --stochastic: pretrained:feeding-jaco was exported without its policy's log-std (by an "
+        "earlier version), so it keeps only the deterministic action; evaluate its run directory, or export the run again"
     )
 
 
@@ -475,6 +475,27 @@ def test_export_gives_the_checkpoints_actions_in_numpy(which, reach_run, sac_run
         f"{which} tiny",
     )
     assert (exported.obs_mean is not None) == (which == "ppo")  # ppo_quick normalises observations
+    # The export keeps the Gaussian's σ (SAC's a layer of the state, PPO's one vector), so it can also
+    # act as in training: the same mean and σ as the checkpoint's distribution, before the squashing.
+    import torch
+
+    policy = original.model.policy
+    for obs in rng.normal(0, 2, (20, exported.obs_dim)).astype(np.float32):
+        mean, std = exported.mean_and_std(obs)
+        if original.obs_rms is not None:  # the checkpoint's network sees normalised observations
+            obs = np.clip((obs - original.obs_rms.mean) / np.sqrt(original.obs_rms.var + original.eps), -10, 10)
+        with torch.no_grad():
+            given = policy.obs_to_tensor(obs.astype(np.float32))[0]
+            if which == "sac":
+                want_mean, want_log_std, _ = policy.actor.get_action_dist_params(given)
+                want_std = want_log_std.exp()
+            else:
+                dist = policy.get_distribution(given).distribution
+                want_mean, want_std = dist.mean, dist.stddev
+        assert np.allclose(mean, want_mean.numpy()[0], atol=1e-5) and np.allclose(std, want_std.numpy()[0], rtol=1e-5)
+    sampled = [evaluate_exported(str(tmp_path / which), episodes=2, seed=100, stochastic=True) for _ in range(2)]
+    assert sampled[0]["actions"] == "stochastic" and sampled[0]["per_episode"] == sampled[1]["per_episode"]
+    assert [e["return"] for e in sampled[0]["per_episode"]] != record["evaluation"]["returns"][:2]
     ours = evaluate(run_dir, episodes=3, seed=100)
     assert [round(e["return"], 3) for e in ours["per_episode"]] == record["evaluation"]["returns"]
     assert record["evaluation"]["success_rate"] == ours["success_rate"]
