@@ -119,6 +119,15 @@ class SAC(Strict):
         description="Layer-normalise every hidden layer of the twin critics (RLPD, Ball et al. 2023): their "
         "values stay bounded where the data are thin, as in a run started from demonstrations (SB3 engine only).",
     )
+    conservative_weight: float = Field(
+        0.0,
+        ge=0,
+        le=100,
+        description="Weight of CQL's regulariser (Kumar et al. 2020) in every critic update, the critic warm-up "
+        "on demonstrations included: the critics value actions the replay buffer did not take (uniform and "
+        "policy samples) below the ones it did, so the actor is not led off into actions nobody tried. In Q's units "
+        "(CQL's MuJoCo runs: 5). 0: SAC's own critic loss (SB3 engine only).",
+    )
 
     @model_validator(mode="after")
     def _positive_temperature(self) -> SAC:

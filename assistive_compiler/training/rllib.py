@@ -197,6 +197,11 @@ def build_sac_config(run: RunDir, config: TrainingConfig, weights: dict[str, flo
             "sac.critic_layer_norm: layer-normalised critics are built for the sb3 engine only; "
             "use --engine sb3, or set critic_layer_norm: false"
         )
+    if s.conservative_weight:
+        raise UsageError(
+            "sac.conservative_weight: conservative critics are built for the sb3 engine only; "
+            "use --engine sb3, or set conservative_weight: 0"
+        )
     updates_per_step = s.gradient_steps / s.train_freq
     buffer = "MultiAgentEpisodeReplayBuffer" if coop else "EpisodeReplayBuffer"
     cfg = (

@@ -224,6 +224,10 @@ def train(
             model.load_replay_buffer(str(latest[1] / REPLAY_BUFFER))
     else:
         model = _new_model(venv, config, run)
+    if config.sac is not None and config.sac.conservative_weight > 0:  # new or resumed: not in the checkpoint
+        from .critics import make_conservative
+
+        make_conservative(model, config.sac.conservative_weight, config.seed + start_steps)
     if demonstrations is not None:  # train.train reads them only for a config that has a demonstrations block
         import json
 

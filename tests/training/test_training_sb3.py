@@ -408,20 +408,33 @@ def test_layer_normed_critics_train_resume_and_stay_bounded_where_plain_ones_gro
     assert evaluated["trained_steps"] == 800
 
 
-def test_layer_normed_critics_are_refused_on_rllib_with_what_to_do(sac_run, tmp_path):
+@pytest.mark.parametrize(
+    ("setting", "message"),
+    [
+        (
+            "critic_layer_norm: true",
+            "sac.critic_layer_norm: layer-normalised critics are built for the sb3 engine only; "
+            "use --engine sb3, or set critic_layer_norm: false",
+        ),
+        (
+            "conservative_weight: 5",
+            "sac.conservative_weight: conservative critics are built for the sb3 engine only; "
+            "use --engine sb3, or set conservative_weight: 0",
+        ),
+    ],
+    ids=["layer-norm", "conservative"],
+)
+def test_sb3_only_critics_are_refused_on_rllib_with_what_to_do(sac_run, tmp_path, setting, message):
     pytest.importorskip("ray")
     from assistive_compiler.errors import UsageError
     from assistive_compiler.training.config import load_training_config
     from assistive_compiler.training.rllib import build_sac_config
 
-    path = tmp_path / "sac_ln.yaml"
-    path.write_text(SAC_TINY.replace("batch_size: 32}", "batch_size: 32, critic_layer_norm: true}"))
+    path = tmp_path / "sac.yaml"
+    path.write_text(SAC_TINY.replace("batch_size: 32}", f"batch_size: 32, {setting}}}"))
     with pytest.raises(UsageError) as raised:
         build_sac_config(RunDir(sac_run), load_training_config(path), {}, False)
-    assert str(raised.value) == (
-        "sac.critic_layer_norm: layer-normalised critics are built for the sb3 engine only; "
-        "use --engine sb3, or set critic_layer_norm: false"
-    )
+    assert str(raised.value) == message
 
 
 def test_sac_resume_without_the_replay_buffer_is_refused(sac_run, tmp_path, capsys):
@@ -819,6 +832,44 @@ def test_a_held_actor_waits_for_the_critics_then_learns(demos_root, tmp_path):
     assert same(models[0].actor, models[100].actor) and not same(models[0].critic, models[100].critic)
     assert not same(models[100].actor, models[300].actor)  # held for 150 updates, then learning
     assert json.loads(run.demonstrations_json.read_text())["hold_actor_steps"] == 150
+
+
+def _margin_over_untried_actions(checkpoint: Path) -> float:
+    """Mean over the demonstrated states of Q(s, a_demonstrated) − Q(s, a uniform in the action
+    box) (min over the twin critics, 16 uniform actions a state)."""
+    import minari
+    import torch
+    from stable_baselines3 import SAC
+
+    model = SAC.load(str(checkpoint / "model.zip"), device="cpu")
+    dataset = minari.load_dataset(DEMOS)
+    obs = torch.as_tensor(
+        np.concatenate([np.asarray(e.observations[:-1], dtype=np.float32) for e in dataset.iterate_episodes()])
+    )
+    taken = np.concatenate([np.asarray(e.actions) for e in dataset.iterate_episodes()])
+    taken = torch.as_tensor(model.policy.scale_action(taken).clip(-1, 1), dtype=torch.float32)
+    generator = torch.Generator().manual_seed(0)
+    uniform = torch.rand(len(obs) * 16, taken.shape[1], generator=generator) * 2 - 1
+    with torch.no_grad():
+        q_taken = torch.min(*model.critic(obs, taken)).view(-1)
+        q_untried = torch.min(*model.critic(obs.repeat_interleave(16, 0), uniform)).view(-1, 16).mean(dim=1)
+    return float((q_taken - q_untried).mean())
+
+
+def test_a_conservative_critic_values_untried_actions_below_the_demonstrated_ones(demo_run, demos_root, tmp_path):
+    """sac.conservative_weight (CQL): after the same critic warm-up on the demonstrations, the
+    conservative critics value actions nobody took (uniform in the action box) well below the
+    demonstrated ones, where SAC's own critics barely tell them apart; it stays on --resume."""
+    config = tmp_path / "conservative.yaml"
+    config.write_text(SAC_FROM_DEMOS.replace("ent_coef: 0.001}", "ent_coef: 0.001, conservative_weight: 5}"))
+    out = tmp_path / "run"
+    args = ["train", str(REACH), "--robot", "jaco", "--config", str(config), "--out", str(out), "--quiet"]
+    assert main([*args, "--demonstrations", DEMOS, "--demonstrations-root", str(demos_root)]) == 0
+    plain = _margin_over_untried_actions(RunDir(demo_run).checkpoint_dir(0))
+    conservative = _margin_over_untried_actions(RunDir(out).checkpoint_dir(0))
+    assert conservative > plain + 1.0 and conservative > 1.0, (plain, conservative)
+    assert main([*args, "--resume", "--steps", "300"]) == 0
+    assert _margin_over_untried_actions(RunDir(out).checkpoint_dir(300)) > 1.0
 
 
 def test_the_cloning_loss_fits_sigma_per_action_dimension_to_the_misses():
