@@ -209,14 +209,21 @@ def test_a_cloned_target_entropy_needs_a_clone_and_a_learned_temperature(tmp_pat
 
 def test_sac_demos_is_the_recipe_started_from_demonstrations():
     """sac_demos: sac_laptop's SAC without the phase of random actions (the demonstrations fill the
-    buffer), with the start's settings spelled out and the dataset left to --demonstrations."""
+    buffer), a small starting temperature tuned to the clone's entropy, layer-normalised and
+    conservative critics, the actor held and then anchored to the demonstrations: the settings
+    of the Drinking run that improved on its clone (docs/results.md, tenth sitting), with the
+    dataset left to --demonstrations."""
     demos = load_training_config(REPO / "specs" / "training" / "sac_demos.yaml")
     recipe = load_training_config(REPO / "specs" / "training" / "sac_laptop.yaml")
     assert demos.sac.learning_starts == 0 and recipe.sac.learning_starts == 5000
     # the temperature starts small: the cloned policy is narrow, and α = 1 widens it into noise
     assert demos.sac.initial_ent_coef == 0.01 and recipe.sac.initial_ent_coef == 1.0
-    assert demos.sac.model_copy(update={"learning_starts": 5000, "initial_ent_coef": 1.0}) == recipe.sac
+    assert demos.sac.target_entropy == "cloned" and demos.sac.critic_layer_norm
+    assert demos.sac.conservative_weight == 2.0 and recipe.sac.conservative_weight == 0.0
+    changed = {"learning_starts", "initial_ent_coef", "target_entropy", "critic_layer_norm", "conservative_weight"}
+    assert demos.sac.model_copy(update={k: getattr(recipe.sac, k) for k in changed}) == recipe.sac
     assert (demos.network, demos.total_steps, demos.envs) == (recipe.network, recipe.total_steps, recipe.envs)
     d = demos.demonstrations
     assert d is not None and d.dataset is None and d.replay and d.critic_warmup_steps == 5000
+    assert (d.clone_weight, d.hold_actor_steps) == (2.5, 10_000)
     assert demos.with_overrides(demonstrations="a/b-v0").demonstrations == d.model_copy(update={"dataset": "a/b-v0"})
