@@ -80,8 +80,8 @@ def add_commands(sub) -> None:
     p.add_argument(
         "--stochastic",
         action="store_true",
-        help="a run directory's actions sampled as in training (seeded by --seed) instead of deterministic; "
-        "the run's evaluation.json is left as it is",
+        help="actions sampled as in training (seeded by --seed) instead of deterministic: a run directory's, or an "
+        "exported policy's that kept its log-std; a run's evaluation.json is left as it is",
     )
     p.add_argument("--json", action="store_true", help="print JSON (with every episode)")
     p.set_defaults(func=cmd_evaluate)

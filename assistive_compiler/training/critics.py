@@ -4,10 +4,11 @@
 Each hidden layer of each critic is ``Linear → LayerNorm → activation`` instead of ``Linear →
 activation``: the critic's features keep unit scale whatever the input, so its output is bounded
 by the norm of its last layer's weights and cannot run away where the data are thin. Ball et al.
-(2023, "Efficient Online Reinforcement Learning with Offline Data", RLPD) found this the one
-change that lets SAC use offline data without its critics over-valuing the actions the data
-never show; it is their default for every run from demonstrations. Measured here on Drinking's
-demonstrations: docs/results.md (tenth sitting).
+(2023, "Efficient Online Reinforcement Learning with Offline Data", RLPD) make it their default
+for SAC on offline data, against critics that over-value actions the data never show. Measured
+here on Drinking's demonstrations (docs/results.md, tenth sitting): it stops the plain critics'
+divergence, but alone their values still drift above the returns; with the conservative update
+below they stay ordered, and SAC improved on the cloned policy.
 
 The classes are Stable-Baselines3's own with only the critic's layers changed; a model saved with
 them records :class:`LayerNormSACPolicy` as its policy class, so it loads (``SAC.load``,
