@@ -109,11 +109,14 @@ class MLPPolicy:
             x = np.clip(x, self.low, self.high)
         return x.astype(np.float32)
 
+    def _require_log_std(self) -> None:
+        if self.log_std is None:
+            raise ValueError("this policy was exported without its log-std (by an earlier version): it has a mean only")
+
     def mean_and_std(self, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The Gaussian's mean and standard deviation for ``obs``, before the squashing or clipping
         (the policy's [-1, 1]-scale pre-tanh units for SAC, the env's action units for PPO)."""
-        if self.log_std is None:
-            raise ValueError("this policy was exported without its log-std (by an earlier version): it has a mean only")
+        self._require_log_std()
         h = self._features(obs)
         w, b = self.layers[-1]
         if isinstance(self.log_std, tuple):
@@ -129,8 +132,7 @@ class MLPPolicy:
     def sampling(self, seed: int) -> SampledPolicy:
         """This policy acting as in training: each action a sample of its Gaussian, squashed or
         clipped as the mean is, from a generator seeded with ``seed``."""
-        if self.log_std is None:
-            raise ValueError("this policy was exported without its log-std (by an earlier version): it has a mean only")
+        self._require_log_std()
         return SampledPolicy(self, np.random.default_rng(seed))
 
     # -- files ---------------------------------------------------------------------------------

@@ -89,14 +89,13 @@ class ConservativeCriticUpdate:
         with torch.no_grad():
             sampled, log_prob = model.actor.action_log_prob(repeated)
         log_uniform = -dims * math.log(2.0)
+        # one forward pass of each critic over the n·k uniform, n·k sampled and n taken pairs
+        values = model.critic(torch.cat([repeated, repeated, obs]), torch.cat([uniform, sampled, taken]))
         total = torch.zeros(n)
-        for q_uniform, q_sampled, q_taken in zip(
-            model.critic(repeated, uniform), model.critic(repeated, sampled), model.critic(obs, taken), strict=True
-        ):
-            soft = torch.cat(
-                [(q_uniform.view(n, k) - log_uniform), (q_sampled.view(n, k) - log_prob.view(n, k))], dim=1
-            )
-            total = total + torch.logsumexp(soft, dim=1) - math.log(2 * k) - q_taken.view(n)
+        for q in values:
+            q_uniform, q_sampled, q_taken = q.view(-1).split([n * k, n * k, n])
+            soft = torch.cat([q_uniform.view(n, k) - log_uniform, q_sampled.view(n, k) - log_prob.view(n, k)], dim=1)
+            total = total + torch.logsumexp(soft, dim=1) - math.log(2 * k) - q_taken
         return total
 
     def step(self, closure=None):

@@ -181,13 +181,12 @@ SAC_FRAGMENT_STEPS = 8
 SAC_ITERATION_STEPS = 1000
 
 
-def build_sac_config(run: RunDir, config: TrainingConfig, weights: dict[str, float], coop: bool):
-    """RLlib's SACConfig for this run: the same SAC as the SB3 engine's (twin Q critics, target
-    entropy, Polyak τ), with a multi-agent episode replay buffer for co-optimisation."""
-    from ray.rllib.algorithms.sac import SACConfig
-    from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
-
+def check_supported(config: TrainingConfig) -> None:
+    """Refuse, with what to do, the settings that only the SB3 engine builds. ``train`` calls this
+    before it writes the run directory, so a refused config leaves nothing behind."""
     s = config.sac
+    if s is None:
+        return
     if s.ent_coef != "auto":
         raise UsageError(
             f"sac.ent_coef {s.ent_coef}: the rllib engine learns the entropy temperature; use ent_coef: auto"
@@ -202,6 +201,16 @@ def build_sac_config(run: RunDir, config: TrainingConfig, weights: dict[str, flo
             "sac.conservative_weight: conservative critics are built for the sb3 engine only; "
             "use --engine sb3, or set conservative_weight: 0"
         )
+
+
+def build_sac_config(run: RunDir, config: TrainingConfig, weights: dict[str, float], coop: bool):
+    """RLlib's SACConfig for this run: the same SAC as the SB3 engine's (twin Q critics, target
+    entropy, Polyak τ), with a multi-agent episode replay buffer for co-optimisation."""
+    from ray.rllib.algorithms.sac import SACConfig
+    from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
+
+    check_supported(config)
+    s = config.sac
     updates_per_step = s.gradient_steps / s.train_freq
     buffer = "MultiAgentEpisodeReplayBuffer" if coop else "EpisodeReplayBuffer"
     cfg = (

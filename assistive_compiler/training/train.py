@@ -93,6 +93,10 @@ def train(
     config: TrainingConfig = load_training_config(config_path).with_overrides(
         steps=steps, seed=seed, envs=envs, demonstrations=demonstrations, demonstrations_root=demonstrations_root
     )
+    if engine == "rllib":
+        from .rllib import check_supported
+
+        check_supported(config)  # settings only SB3 builds are refused before anything is compiled or written
     result, robot = compile_for_run(spec, robot, coop)
     if engine == "rllib":
         from .rllib import init_ray

@@ -247,3 +247,20 @@ def test_a_shipped_policy_runs_without_torch(tmp_path):
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=REPO)
     assert proc.returncode == 0, proc.stderr
     assert "policy=pretrained:feeding-jaco" in proc.stdout
+
+
+def test_a_policy_exported_without_its_log_std_acts_on_its_mean_and_refuses_to_sample():
+    """Policies exported before exports kept their log-std have a mean only: they still act, and
+    asking them for their Gaussian or for sampled actions says why there is none."""
+    from assistive_compiler.policies.mlp import MLPPolicy
+
+    older = MLPPolicy.load(pretrained_dir() / "feeding-jaco")
+    assert not older.samples
+    obs = np.zeros(older.obs_dim, dtype=np.float32)
+    assert older(obs).shape == (older.action_dim,)
+    expected = "this policy was exported without its log-std (by an earlier version): it has a mean only"
+    with pytest.raises(ValueError) as asked_for_gaussian:
+        older.mean_and_std(obs)
+    with pytest.raises(ValueError) as asked_to_sample:
+        older.sampling(seed=0)
+    assert str(asked_for_gaussian.value) == str(asked_to_sample.value) == expected

@@ -412,6 +412,10 @@ def test_layer_normed_critics_train_resume_and_stay_bounded_where_plain_ones_gro
     ("setting", "message"),
     [
         (
+            "ent_coef: 0.1",
+            "sac.ent_coef 0.1: the rllib engine learns the entropy temperature; use ent_coef: auto",
+        ),
+        (
             "critic_layer_norm: true",
             "sac.critic_layer_norm: layer-normalised critics are built for the sb3 engine only; "
             "use --engine sb3, or set critic_layer_norm: false",
@@ -422,19 +426,35 @@ def test_layer_normed_critics_train_resume_and_stay_bounded_where_plain_ones_gro
             "use --engine sb3, or set conservative_weight: 0",
         ),
     ],
-    ids=["layer-norm", "conservative"],
+    ids=["fixed-temperature", "layer-norm", "conservative"],
 )
-def test_sb3_only_critics_are_refused_on_rllib_with_what_to_do(sac_run, tmp_path, setting, message):
+def test_sb3_only_sac_settings_are_refused_on_rllib_before_the_run_directory_is_written(
+    tmp_path, capsys, setting, message
+):
+    """The refusal comes before compiling, starting Ray or writing anything: no half-made run
+    directory is left for a later --resume to trip over."""
     pytest.importorskip("ray")
-    from assistive_compiler.errors import UsageError
-    from assistive_compiler.training.config import load_training_config
-    from assistive_compiler.training.rllib import build_sac_config
-
     path = tmp_path / "sac.yaml"
     path.write_text(SAC_TINY.replace("batch_size: 32}", f"batch_size: 32, {setting}}}"))
-    with pytest.raises(UsageError) as raised:
-        build_sac_config(RunDir(sac_run), load_training_config(path), {}, False)
-    assert str(raised.value) == message
+    out = tmp_path / "refused"
+    code = main(
+        [
+            "train",
+            str(REACH),
+            "--robot",
+            "jaco",
+            "--config",
+            str(path),
+            "--engine",
+            "rllib",
+            "--out",
+            str(out),
+            "--quiet",
+        ]
+    )
+    assert code == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
 
 
 def test_sac_resume_without_the_replay_buffer_is_refused(sac_run, tmp_path, capsys):
