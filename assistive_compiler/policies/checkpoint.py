@@ -15,6 +15,9 @@ from ..run_dir import RunDir, RunInfo, engine_modules
 
 #: RLlib's module id of a single-agent run (``ray.rllib.core.DEFAULT_MODULE_ID``).
 SINGLE_MODULE = "default_policy"
+#: The averaged actor's weights in an SB3 SAC checkpoint (``sac.actor_average_tau``): what acts
+#: from that checkpoint in the actor's place.
+ACTOR_AVERAGE = "actor_average.pt"
 
 
 def algorithm_class(config_or_name):
@@ -42,6 +45,11 @@ class SB3Policy:
         self.model = algorithm_class(algorithm).load(
             str(checkpoint / "model.zip"), device="cpu", custom_objects={"replay_buffer_class": None}
         )
+        average = checkpoint / ACTOR_AVERAGE
+        if average.is_file():  # trained with an averaged actor: the average acts
+            import torch
+
+            self.model.actor.load_state_dict(torch.load(average, weights_only=True))
         self.obs_rms = None
         stats = checkpoint / "vecnormalize.pkl"
         if stats.is_file():

@@ -128,6 +128,16 @@ class SAC(Strict):
         "policy samples) below the ones it did, so the actor is not led off into actions nobody tried. In Q's units "
         "(CQL's MuJoCo runs: 5). 0: SAC's own critic loss (SB3 engine only).",
     )
+    actor_average_tau: float = Field(
+        0.0,
+        ge=0,
+        le=1,
+        description="Act, evaluate and export with an exponential moving average of the actor's weights "
+        "instead of the actor itself (policy weight averaging, Nikishin et al. 2018): after each actor update "
+        "average ← (1 − τ)·average + τ·actor, so it follows the actor over about 1/τ updates and a checkpoint "
+        "is not one snapshot of a policy that swings between updates. Training still explores and learns with "
+        "the actor itself. 0: off (SB3 engine only).",
+    )
 
     @model_validator(mode="after")
     def _positive_temperature(self) -> SAC:

@@ -201,6 +201,11 @@ def check_supported(config: TrainingConfig) -> None:
             "sac.conservative_weight: conservative critics are built for the sb3 engine only; "
             "use --engine sb3, or set conservative_weight: 0"
         )
+    if s.actor_average_tau:
+        raise UsageError(
+            "sac.actor_average_tau: the averaged actor is built for the sb3 engine only; "
+            "use --engine sb3, or set actor_average_tau: 0"
+        )
 
 
 def build_sac_config(run: RunDir, config: TrainingConfig, weights: dict[str, float], coop: bool):

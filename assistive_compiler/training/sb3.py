@@ -135,6 +135,11 @@ def save_checkpoint(run: RunDir, model, steps: int) -> Path:
     off_policy = isinstance(model, OffPolicyAlgorithm)
     if off_policy:
         model.save_replay_buffer(str(out / REPLAY_BUFFER))
+        from .averaging import averaged
+
+        average = averaged(model)
+        if average is not None:
+            average.save(out)
     final = run.end_checkpoint(out, steps, {"engine": "sb3", "algorithm": type(model).__name__.lower()})
     if off_policy and older is not None and older[1] != final:
         (older[1] / REPLAY_BUFFER).unlink(missing_ok=True)
@@ -229,9 +234,6 @@ def train(
 
         make_conservative(model, config.sac.conservative_weight, config.seed + start_steps)
     if demonstrations is not None:  # train.train reads them only for a config that has a demonstrations block
-        import json
-
-        from ..run_dir import write_atomic
         from .demonstrations import start_from, update_actor_as_configured
 
         assert config.demonstrations is not None
@@ -240,9 +242,18 @@ def train(
             started_from = start_from(
                 model, demonstrations, config.demonstrations, config.seed, config.sac.target_entropy
             )
-            save_checkpoint(run, model, 0)
-            write_atomic(run.demonstrations_json, json.dumps(started_from, indent=1))
         update_actor_as_configured(model, demonstrations, config.demonstrations, config.seed + start_steps)
+    if config.sac is not None and config.sac.actor_average_tau > 0:  # new (after any cloning) or resumed
+        from .averaging import make_averaged
+
+        make_averaged(model, config.sac.actor_average_tau, latest[1] if latest else None)
+    if demonstrations is not None and not latest:
+        import json
+
+        from ..run_dir import write_atomic
+
+        save_checkpoint(run, model, 0)  # the cloned policy, before any env step
+        write_atomic(run.demonstrations_json, json.dumps(started_from, indent=1))
     progress = Progress(run, weights, config.total_steps, start_steps, quiet=quiet)
     interrupted = False
     try:

@@ -425,8 +425,13 @@ def test_layer_normed_critics_train_resume_and_stay_bounded_where_plain_ones_gro
             "sac.conservative_weight: conservative critics are built for the sb3 engine only; "
             "use --engine sb3, or set conservative_weight: 0",
         ),
+        (
+            "actor_average_tau: 0.001",
+            "sac.actor_average_tau: the averaged actor is built for the sb3 engine only; "
+            "use --engine sb3, or set actor_average_tau: 0",
+        ),
     ],
-    ids=["fixed-temperature", "layer-norm", "conservative"],
+    ids=["fixed-temperature", "layer-norm", "conservative", "averaged-actor"],
 )
 def test_sb3_only_sac_settings_are_refused_on_rllib_before_the_run_directory_is_written(
     tmp_path, capsys, setting, message
@@ -455,6 +460,86 @@ def test_sb3_only_sac_settings_are_refused_on_rllib_before_the_run_directory_is_
     assert code == 2
     assert message in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_the_averaged_actor_follows_the_actor_by_polyak_steps(sac_run):
+    """sac.actor_average_tau: after each actor step, average ← (1 − τ)·average + τ·actor, exactly."""
+    import torch
+    from stable_baselines3 import SAC
+
+    from assistive_compiler.training.averaging import averaged, make_averaged
+
+    checkpoint = RunDir(sac_run).latest_checkpoint()[1]
+    model = SAC.load(str(checkpoint / "model.zip"), device="cpu", custom_objects={"replay_buffer_class": None})
+    make_averaged(model, 0.25, None)
+    average = averaged(model)
+    assert average is not None
+    before = [p.detach().clone() for p in model.actor.parameters()]
+    obs = torch.as_tensor(
+        np.random.default_rng(0).normal(size=(8, model.observation_space.shape[0])), dtype=torch.float32
+    )
+    model.actor.optimizer.zero_grad()
+    mean, log_std, _ = model.actor.get_action_dist_params(obs)
+    (mean.square().sum() + log_std.sum()).backward()
+    model.actor.optimizer.step()
+    after = [p.detach() for p in model.actor.parameters()]
+    assert all(not torch.equal(b, a) for b, a in zip(before, after))  # the actor moved
+    for b, a, mixed in zip(before, after, average.average.parameters(), strict=True):
+        assert torch.allclose(mixed, 0.75 * b + 0.25 * a, atol=1e-7)
+
+
+def test_a_run_with_an_averaged_actor_acts_evaluates_exports_and_resumes_with_the_average(tmp_path, capsys):
+    """The checkpoints carry the average; evaluation, export and --policy RUN_DIR act with it, not
+    with the actor; a resumed run continues the same average, and refuses to start a new one."""
+    import torch
+    from stable_baselines3 import SAC
+
+    from assistive_compiler.policies.checkpoint import SB3Policy
+    from assistive_compiler.policies.mlp import MLPPolicy
+    from assistive_compiler.training.export import export_run
+
+    config = tmp_path / "sac_averaged.yaml"
+    config.write_text(SAC_TINY.replace("batch_size: 32}", "batch_size: 32, actor_average_tau: 0.002}"))
+    out = tmp_path / "averaged"
+    train = ["train", str(REACH), "--robot", "jaco", "--config", str(config), "--out", str(out), "--quiet"]
+    assert main(train) == 0
+    run = RunDir(out)
+    assert (run.checkpoint_dir(400) / "actor_average.pt").is_file()
+    checkpoint = run.checkpoint_dir(600)
+    average = torch.load(checkpoint / "actor_average.pt", weights_only=True)
+    live = SAC.load(str(checkpoint / "model.zip"), device="cpu", custom_objects={"replay_buffer_class": None})
+    # 500 updates at τ 0.002: the average lags the actor
+    distance = sum(float((average[k] - v).norm()) for k, v in live.actor.state_dict().items())
+    assert distance > 1e-3
+    acting = SB3Policy(checkpoint, "sac")
+    obs = np.random.default_rng(3).normal(0, 2, (20, live.observation_space.shape[0])).astype(np.float32)
+    with torch.no_grad():
+        live_actions = np.stack([live.predict(o, deterministic=True)[0] for o in obs])
+    assert all(torch.equal(acting.model.actor.state_dict()[k], v) for k, v in average.items())
+    assert not np.allclose([acting(o) for o in obs], live_actions, atol=1e-4)
+    exported = export_run(out, tmp_path / "exported", episodes=2, seed=100)
+    assert exported["trained_steps"] == 600
+    numpy_policy = MLPPolicy.load(tmp_path / "exported")
+    assert np.allclose([numpy_policy(o) for o in obs], [acting(o) for o in obs], atol=1e-5)
+    # resumed: the same average goes on (its first update starts from the saved one)
+    resumed = tmp_path / "resumed"
+    shutil.copytree(out, resumed)
+    again = [*train[:-2], str(resumed), "--resume", "--steps", "800", "--quiet"]
+    assert main(again) == 0
+    after = torch.load(RunDir(resumed).checkpoint_dir(800) / "actor_average.pt", weights_only=True)
+    moved = sum(float((after[k] - v).norm()) for k, v in average.items())
+    # 200 more updates keep 0.998^200 ≈ 2/3 of the saved average: it moved a fraction of its lag
+    # behind the actor; an average restarted from the actor would have jumped the whole lag
+    assert 0 < moved < 0.5 * distance
+    # a checkpoint that lost its average is not silently restarted from the actor
+    missing = RunDir(resumed).checkpoint_dir(800) / "actor_average.pt"
+    missing.unlink()
+    capsys.readouterr()
+    assert main([*again[:-3], "--steps", "900", "--quiet"]) == 2
+    assert (
+        f"{missing}: --resume of a run with sac.actor_average_tau needs the checkpoint's averaged actor, which is missing"
+        in capsys.readouterr().err
+    )
 
 
 def test_sac_resume_without_the_replay_buffer_is_refused(sac_run, tmp_path, capsys):
