@@ -21,104 +21,18 @@ sets up rows for: one normal and two friction rows per point).
 from __future__ import annotations
 
 import argparse
-import collections
 import json
-import os
-import re
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-import pybullet as pb
-
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.paths import specs_dir
+from assistive_compiler.profiling import STAGES, profile_episode
 from assistive_compiler.runtime.env import AssistiveEnv
 
 TASKS = ["feeding", "scratch_itch", "drinking", "bed_bathing", "arm_manipulation", "dressing"]
-
-STAGES = {
-    "solver iterations": ["solveGroupCacheFriendlyIterations"],
-    "solver setup (contact and joint rows)": ["solveGroupCacheFriendlySetup"],
-    "collision: pair processing (narrowphase)": ["processAllOverlappingPairs"],
-    "collision: bounding boxes (broadphase)": ["updateAabbs", "calculateOverlappingPairs"],
-    "soft bodies": [
-        "solveSoftConstraints",
-        "predictUnconstraintMotionSoftBody",
-        "softBodySelfCollision",
-        "btSoftBody",
-        "integrateTransformsSoftBody",
-        "solveDeformableConstraints",
-        "btDeformable",
-    ],
-    "multibody dynamics (forward, integrate)": [
-        "btMultiBody stepVelocities",
-        "btMultiBody stepPositions",
-        "computeAccelerationsArticulatedBodyAlgorithmMultiDof",
-    ],
-}
-"""Bullet profiler zones summed into each stage (a zone counts once: its nearest named ancestor wins)."""
-
-
-def _intervals(trace: dict) -> list[tuple[float, float, str]]:
-    """(start µs, end µs, zone) of every profiler zone, numbered suffixes dropped, sorted to nest."""
-    opened: dict[str, float] = {}
-    out = []
-    for e in trace["traceEvents"]:
-        if e["ph"] == "B":
-            opened[e["name"]] = e["ts"]
-        elif e["ph"] == "E" and e["name"] in opened:
-            out.append((opened.pop(e["name"]), e["ts"], re.sub(r"\d+$", "", e["name"])))
-    out.sort(key=lambda iv: (iv[0], -iv[1]))
-    return out
-
-
-def stage_shares(trace: dict) -> dict[str, float]:
-    """Each stage's share of stepSimulation's time (the remainder: ``other``)."""
-    step = 0.0
-    spent: collections.Counter = collections.Counter()
-    stack: list[tuple[float, float, str, str | None]] = []  # (start, end, zone, stage it counts toward)
-    for start, end, zone in _intervals(trace):
-        while stack and stack[-1][1] <= start:
-            stack.pop()
-        inherited = stack[-1][3] if stack else None
-        if zone == "CMD_STEP_FORWARD_SIMULATION":
-            step += end - start
-        own = next((stage for stage, zones in STAGES.items() if any(zone.startswith(z) for z in zones)), None)
-        if own is not None and inherited is None:
-            spent[own] += end - start
-        stack.append((start, end, zone, inherited or own))
-    shares = {stage: spent[stage] / step for stage in STAGES} if step else {}
-    shares["other"] = max(0.0, 1.0 - sum(shares.values()))
-    return shares
-
-
-class _quiet_stdout:
-    """File descriptor 1 pointed at /dev/null for a while (C code's printf included)."""
-
-    def __enter__(self):
-        sys.stdout.flush()
-        self.saved = os.dup(1)
-        null = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(null, 1)
-        os.close(null)
-
-    def __exit__(self, *exc):
-        os.dup2(self.saved, 1)
-        os.close(self.saved)
-
-
-def _names(env) -> dict[int, str]:
-    """Body id -> the name a spec uses (particles as their set, the ground as ground)."""
-    world = env.world
-    names = {h.id: name for name, h in world.bodies.items()}
-    for v in env.manifest.person.variants:
-        names[world.variant_bodies[v.name].id] = "person"
-    for set_name, ids in world.particles.items():
-        names.update({bid: set_name for bid in ids})
-    names[world.ground] = "ground"
-    return names
 
 
 def profile(spec: Path, robot: str, steps: int, seed: int, out_dir: Path) -> dict:
@@ -126,8 +40,6 @@ def profile(spec: Path, robot: str, steps: int, seed: int, out_dir: Path) -> dic
     result = compile_task(spec, robot, out_dir / f"{spec.stem}-{robot}")
     env = AssistiveEnv.from_compiled(result)
     try:
-        c = env.world.client
-        names = _names(env)
         physics = [0.0]
         original = env.world.step_physics
 
@@ -147,19 +59,7 @@ def profile(spec: Path, robot: str, steps: int, seed: int, out_dir: Path) -> dic
         total = time.perf_counter() - t0
         env.world.step_physics = original  # type: ignore[method-assign]
         # Pass 2, the same episode under Bullet's profiler, counting contacts.
-        env.reset(seed=seed)
-        trace_file = out_dir / f"{spec.stem}-{robot}-trace.json"
-        log = pb.startStateLogging(pb.STATE_LOGGING_PROFILE_TIMINGS, str(trace_file), physicsClientId=c)
-        contacts: collections.Counter = collections.Counter()
-        for a in actions:
-            env.step(a)
-            for point in pb.getContactPoints(physicsClientId=c):
-                pair = tuple(sorted((names.get(point[1], str(point[1])), names.get(point[2], str(point[2])))))
-                contacts[" – ".join(pair)] += 1
-        with _quiet_stdout():  # Bullet prints "Writing N timings" from C
-            pb.stopStateLogging(log, physicsClientId=c)
-        written = sorted(out_dir.glob(f"{trace_file.name}_*.json"))  # Bullet appends _<thread>.json
-        shares = stage_shares(json.loads(written[0].read_text())) if written else {}
+        shares, contacts = profile_episode(env, actions, seed)
         return {
             "task": env.manifest.task,
             "robot": robot,
@@ -169,7 +69,7 @@ def profile(spec: Path, robot: str, steps: int, seed: int, out_dir: Path) -> dic
             "physics_share_of_step": physics[0] / total,
             "python_us_per_step": (total - physics[0]) / steps * 1e6,
             "bullet_stage_shares": shares,
-            "contact_points_per_env_step": {pair: n / steps for pair, n in contacts.most_common()},
+            "contact_points_per_env_step": contacts,
         }
     finally:
         env.close()

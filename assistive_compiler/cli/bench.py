@@ -164,6 +164,22 @@ def measure_resets(env, resets: int) -> tuple[list[float], list[float]]:
     return reset_ms, seeded_ms
 
 
+def measure_stages(env, steps: int, seed: int) -> dict[str, float]:
+    """Each stage's share of the physics (:mod:`assistive_compiler.profiling`) over one episode of
+    ``steps`` seeded random actions, rounded to 0.1%."""
+    from ..profiling import profile_episode
+
+    env.action_space.seed(seed)
+    shares, _ = profile_episode(env, [env.action_space.sample() for _ in range(steps)], seed)
+    return {stage: round(share, 3) for stage, share in shares.items()}
+
+
+def _percent(shares: dict[str, float]) -> str:
+    from .output import MISSING
+
+    return ", ".join(f"{stage} {100 * share:.0f}%" for stage, share in shares.items()) or MISSING
+
+
 def measure_process(artifact_dir: Path) -> dict:
     """In a fresh interpreter: ``import assistive_compiler`` time (s), heavy modules it imported, and
     peak RSS (MB) of one env stepped 200 times."""
@@ -230,6 +246,7 @@ def bench(
         env_rates, raw_rates, overhead = rates["shipped"]
         raw_loop = measure_raw_loop(env, steps)
         reset_ms, seeded_ms = measure_resets(env, resets)
+        stages = measure_stages(env, steps, seed)
         m = env.manifest
         env.close()
         proc = measure_process(cold.out_dir)
@@ -274,6 +291,7 @@ def bench(
         "env_over_raw": round(env_med / raw_med, 3),
         "env_overhead_us_per_step": round(statistics.median(overhead), 1),
         "raw_loop_steps_per_s_at_rest": round(raw_loop, 1),
+        "physics_stages": stages,
         "reset_ms_median": round(reset_med, 3),
         "reset_ms_p95": round(reset_p95, 3),
         "resets": resets,
@@ -288,7 +306,9 @@ def bench(
         "notes": "env/raw: the same episodes, physics timed inside env.step (stepSimulation + gravity compensation) vs the whole step; "
         "reference_solver: the same episodes and actions on an artifact compiled with the reference's sim.solver, repeats "
         "interleaved with the shipped ones (when reference_solver_is_shipped, the same figure as env_steps_per_s); random actions; "
-        "medians over repeats; both agents acting: bench --coop",
+        "medians over repeats; physics_stages: each stage's share of stepSimulation by Bullet's profiler over one more "
+        "episode of the first repeat's seed (the profiler's cost inflates every stage alike: read the shares); "
+        "both agents acting: bench --coop",
     }
 
 
@@ -358,7 +378,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         figures = {k: v for k, v in results[0].items() if k != "notes"}
         print_table(
             ["figure", "value"],
-            [[key, cell(value)] for key, value in figures.items()],
+            [[key, _percent(value) if key == "physics_stages" else cell(value)] for key, value in figures.items()],
             left=["figure", "value"],
             caption=f"notes: {results[0]['notes']}",
         )
@@ -367,6 +387,16 @@ def cmd_bench(args: argparse.Namespace) -> int:
     columns = BENCH_COOP_TABLE if args.coop else BENCH_TABLE
     print_table(columns, [[cell(r[k]) for k in columns] for r in results], left=("task", "robot"))
     if not args.coop:
+        stages = list(dict.fromkeys(stage for r in results for stage in r["physics_stages"]))
+        print("\nwhere the physics goes (share of stepSimulation, Bullet's profiler):")
+        print_table(
+            ["task", "robot", *stages],
+            [
+                [r["task"], r["robot"], *(f"{100 * r['physics_stages'].get(k, 0.0):.0f}%" for k in stages)]
+                for r in results
+            ],
+            left=("task", "robot"),
+        )
         for figure in sorted({r["reference_figure"] for r in results if r["reference_figure"]}):
             rows = ", ".join(f"{r['task']}/{r['robot']}" for r in results if r["reference_figure"] == figure)
             print(f"reference_env_steps_per_s of {rows}: {figure}")

@@ -570,6 +570,10 @@ def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, 
     assert fewer_r["vs_reference_at_reference_solver"] == pytest.approx(
         fewer_r["env_steps_per_s_reference_solver"] / 348, abs=0.0051
     )
+    # Where Feeding's physics goes: solving the rows of the food resting in the spoon, no cloth.
+    stages = feeding["physics_stages"]
+    assert sum(stages.values()) == pytest.approx(1.0, abs=0.005) and stages["soft bodies"] == 0.0
+    assert stages["solver iterations"] + stages["solver setup (contact and joint rows)"] > 0.5
     rc = main(["bench", str(SPEC), str(fewer), "--robot", "jaco", "--steps", "10", "--repeats", "1", "--resets", "2"])
     out = capsys.readouterr().out
     assert out.splitlines()[0].split() == [
@@ -584,8 +588,12 @@ def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, 
         "vs_reference",
         "vs_reference_at_reference_solver",
     ]
-    rows = [line.split() for line in out.splitlines() if line.split()[:1] == ["feeding"]]
+    speeds, stage_table = out.split("where the physics goes (share of stepSimulation, Bullet's profiler):")
+    rows = [line.split() for line in speeds.splitlines() if line.split()[:1] == ["feeding"]]
     assert len(rows) == 2 and all(r[1] == "jaco" and r[7] == "348" for r in rows)
+    assert [line.split()[:2] for line in stage_table.splitlines() if line.startswith("feeding")] == [
+        ["feeding", "jaco"]
+    ] * 2
     assert float(rows[0][2]) == float(rows[0][3])  # shipped = reference settings: the same figure in both columns
     assert "reference_env_steps_per_s of feeding/jaco, feeding/jaco: measured side by side on 2026-11-27" in out
     # Figures measured beside ours: the harness's lines, the reference on its fork (gravity emulation's share removed).

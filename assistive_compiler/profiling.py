@@ -1,0 +1,139 @@
+"""Where the physics of an env step goes: Bullet's own profiler over one episode, its zones summed
+into stages (constraint solving, contact and joint row setup, collision detection, soft bodies,
+multibody dynamics), and a census of the contact points each pair of bodies brings to the solver.
+
+Bullet's profiler (``STATE_LOGGING_PROFILE_TIMINGS``) records the engine's timed zones around its
+stages. Their intervals are nested by time, and each stage's share of ``stepSimulation`` is the
+time of its outermost zones. The profiler's own cost inflates every zone a little and evenly, so
+the shares, not the absolute times, are what to read. ``bench`` reports the shares
+(``physics_stages``); ``benchmarks/physics_profile.py`` adds the contact census and the split of a
+step between the physics and our Python.
+"""
+
+from __future__ import annotations
+
+import collections
+import json
+import os
+import re
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pybullet as pb
+
+STAGES = {
+    "solver iterations": ["solveGroupCacheFriendlyIterations"],
+    "solver setup (contact and joint rows)": ["solveGroupCacheFriendlySetup"],
+    "collision: pair processing (narrowphase)": ["processAllOverlappingPairs"],
+    "collision: bounding boxes (broadphase)": ["updateAabbs", "calculateOverlappingPairs"],
+    "soft bodies": [
+        "solveSoftConstraints",
+        "predictUnconstraintMotionSoftBody",
+        "softBodySelfCollision",
+        "btSoftBody",
+        "integrateTransformsSoftBody",
+        "solveDeformableConstraints",
+        "btDeformable",
+    ],
+    "multibody dynamics (forward, integrate)": [
+        "btMultiBody stepVelocities",
+        "btMultiBody stepPositions",
+        "computeAccelerationsArticulatedBodyAlgorithmMultiDof",
+    ],
+}
+"""Bullet profiler zones summed into each stage (a zone counts once: its nearest named ancestor wins)."""
+
+STEP_ZONE = "CMD_STEP_FORWARD_SIMULATION"
+"""The zone around one ``stepSimulation`` call: the whole the shares are of."""
+
+
+def _intervals(trace: dict) -> list[tuple[float, float, str]]:
+    """(start µs, end µs, zone) of every profiler zone, numbered suffixes dropped, sorted to nest."""
+    opened: dict[str, float] = {}
+    out = []
+    for e in trace["traceEvents"]:
+        if e["ph"] == "B":
+            opened[e["name"]] = e["ts"]
+        elif e["ph"] == "E" and e["name"] in opened:
+            out.append((opened.pop(e["name"]), e["ts"], re.sub(r"\d+$", "", e["name"])))
+    out.sort(key=lambda iv: (iv[0], -iv[1]))
+    return out
+
+
+def stage_shares(trace: dict) -> dict[str, float]:
+    """Each stage's share of stepSimulation's time in a Chrome-format trace of Bullet's profiler
+    (the remainder: ``other``); empty when the trace holds no step."""
+    step = 0.0
+    spent: collections.Counter = collections.Counter()
+    stack: list[tuple[float, float, str, str | None]] = []  # (start, end, zone, stage it counts toward)
+    for start, end, zone in _intervals(trace):
+        while stack and stack[-1][1] <= start:
+            stack.pop()
+        inherited = stack[-1][3] if stack else None
+        if zone == STEP_ZONE:
+            step += end - start
+        own = next((stage for stage, zones in STAGES.items() if any(zone.startswith(z) for z in zones)), None)
+        if own is not None and inherited is None:
+            spent[own] += end - start
+        stack.append((start, end, zone, inherited or own))
+    if not step:
+        return {}
+    shares = {stage: spent[stage] / step for stage in STAGES}
+    shares["other"] = max(0.0, 1.0 - sum(shares.values()))
+    return shares
+
+
+class _quiet_stdout:
+    """File descriptor 1 pointed at /dev/null for a while (C code's printf included)."""
+
+    def __enter__(self):
+        sys.stdout.flush()
+        self.saved = os.dup(1)
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, 1)
+        os.close(null)
+
+    def __exit__(self, *exc):
+        os.dup2(self.saved, 1)
+        os.close(self.saved)
+
+
+def body_names(env) -> dict[int, str]:
+    """Body id -> the name a spec uses (every person variant as ``person``, particles as their set,
+    the ground as ``ground``)."""
+    world = env.world
+    names = {h.id: name for name, h in world.bodies.items()}
+    for v in env.manifest.person.variants:
+        names[world.variant_bodies[v.name].id] = "person"
+    for set_name, ids in world.particles.items():
+        names.update({bid: set_name for bid in ids})
+    names[world.ground] = "ground"
+    return names
+
+
+def profile_episode(env, actions: list[np.ndarray], seed: int) -> tuple[dict[str, float], dict[str, float]]:
+    """One seeded episode of ``actions`` under Bullet's profiler: each stage's share of the physics
+    (:func:`stage_shares`) and the contact points per env step by body pair (``"a – b"``, the last
+    physics step's, most first)."""
+    c = env.world.client
+    names = body_names(env)
+    contacts: collections.Counter = collections.Counter()
+    env.reset(seed=seed)
+    with tempfile.TemporaryDirectory() as tmp:
+        trace_file = Path(tmp) / "trace.json"
+        log = pb.startStateLogging(pb.STATE_LOGGING_PROFILE_TIMINGS, str(trace_file), physicsClientId=c)
+        try:
+            for a in actions:
+                env.step(a)
+                for point in pb.getContactPoints(physicsClientId=c):
+                    pair = sorted((names.get(point[1], str(point[1])), names.get(point[2], str(point[2]))))
+                    contacts[" – ".join(pair)] += 1
+        finally:
+            with _quiet_stdout():  # Bullet prints "Writing N timings" from C
+                pb.stopStateLogging(log, physicsClientId=c)
+        written = sorted(Path(tmp).glob(f"{trace_file.name}_*.json"))  # Bullet appends _<thread>.json
+        shares = stage_shares(json.loads(written[0].read_text())) if written else {}
+    steps = max(1, len(actions))
+    return shares, {pair: n / steps for pair, n in contacts.most_common()}
