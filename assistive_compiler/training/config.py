@@ -77,7 +77,18 @@ class SAC(Strict):
     critics and an entropy temperature tuned to a target entropy."""
 
     learning_rate: float = Field(
-        3e-4, gt=0, le=1, description="Adam learning rate of the actor, the critics and the temperature."
+        3e-4,
+        gt=0,
+        le=1,
+        description="Adam learning rate of the critics and the temperature, and of the actor unless "
+        "actor_learning_rate gives it its own.",
+    )
+    actor_learning_rate: float | None = Field(
+        None,
+        gt=0,
+        le=1,
+        description="Adam learning rate of the actor alone (none: learning_rate). A smaller one keeps the actor "
+        "from running ahead of critics that are still learning its returns.",
     )
     buffer_size: int = Field(
         1_000_000, ge=1, description="Transitions the replay buffer holds (the oldest are overwritten)."

@@ -230,7 +230,7 @@ def build_sac_config(run: RunDir, config: TrainingConfig, weights: dict[str, flo
         )
         .learners(num_learners=0)
         .training(
-            actor_lr=s.learning_rate,
+            actor_lr=s.actor_learning_rate or s.learning_rate,
             critic_lr=s.learning_rate,
             alpha_lr=s.learning_rate,
             gamma=s.gamma,

@@ -229,6 +229,10 @@ def train(
             model.load_replay_buffer(str(latest[1] / REPLAY_BUFFER))
     else:
         model = _new_model(venv, config, run)
+    if config.sac is not None and config.sac.actor_learning_rate is not None:  # new or resumed
+        from .actor_rate import set_actor_learning_rate
+
+        set_actor_learning_rate(model, config.sac.actor_learning_rate)
     if config.sac is not None and config.sac.conservative_weight > 0:  # new or resumed: not in the checkpoint
         from .critics import make_conservative
 

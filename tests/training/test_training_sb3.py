@@ -462,6 +462,44 @@ def test_sb3_only_sac_settings_are_refused_on_rllib_before_the_run_directory_is_
     assert not out.exists()
 
 
+def test_an_actor_learning_rate_of_its_own_slows_the_actor_and_not_the_critics(sac_run, tmp_path):
+    """sac.actor_learning_rate: with the same seed and steps as sac_run, an actor at a thousandth of
+    the rate barely moves between the checkpoints at 400 and 600 steps, while its critics learn
+    as sac_run's do; a resumed run keeps the actor's rate."""
+    import torch
+    from stable_baselines3 import SAC
+
+    config = tmp_path / "sac_slow_actor.yaml"
+    config.write_text(SAC_TINY.replace("batch_size: 32}", "batch_size: 32, actor_learning_rate: 3.0e-7}"))
+    out = tmp_path / "slow-actor"
+    train = ["train", str(REACH), "--robot", "jaco", "--config", str(config), "--out", str(out), "--quiet"]
+    assert main(train) == 0
+
+    def movement(run: Path, part: str) -> float:
+        weights = []
+        for step in (400, 600):
+            model = SAC.load(
+                str(RunDir(run).checkpoint_dir(step) / "model.zip"),
+                device="cpu",
+                custom_objects={"replay_buffer_class": None},
+            )
+            weights.append(torch.cat([p.detach().view(-1) for p in getattr(model, part).parameters()]))
+        return float((weights[1] - weights[0]).norm() / weights[0].norm())
+
+    assert movement(out, "actor") < movement(sac_run, "actor") / 100
+    assert movement(out, "critic") == pytest.approx(movement(sac_run, "critic"), rel=0.5)
+    assert main([*train[:-1], "--resume", "--steps", "700", "--quiet"]) == 0
+    resumed = SAC.load(str(RunDir(out).checkpoint_dir(700) / "model.zip"), device="cpu")
+    assert resumed.actor.optimizer.param_groups[0]["lr"] == 3.0e-7  # the last actor step's rate
+    assert resumed.critic.optimizer.param_groups[0]["lr"] == 3.0e-4
+    pytest.importorskip("ray")
+    from assistive_compiler.training.config import load_training_config
+    from assistive_compiler.training.rllib import build_sac_config
+
+    rllib = build_sac_config(RunDir(out), load_training_config(config), {}, False)  # RLlib has the setting itself
+    assert (rllib.actor_lr, rllib.critic_lr, rllib.alpha_lr) == (3.0e-7, 3.0e-4, 3.0e-4)
+
+
 def test_the_averaged_actor_follows_the_actor_by_polyak_steps(sac_run):
     """sac.actor_average_tau: after each actor step, average ← (1 − τ)·average + τ·actor, exactly."""
     import torch
