@@ -14,7 +14,7 @@ from pathlib import Path
 from ..run_dir import engine_modules
 from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, add_library_argument, require_extra
 
-SHIPPED_CONFIGS = "sac_laptop, sac_demos, ppo_paper, ppo_laptop, ppo_quick, ppo_rllib_reference"
+SHIPPED_CONFIGS = "sac_laptop, sac_low_entropy, sac_demos, ppo_paper, ppo_laptop, ppo_quick, ppo_rllib_reference"
 
 
 def training_config_path(name: str) -> str:

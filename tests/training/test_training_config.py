@@ -227,3 +227,13 @@ def test_sac_demos_is_the_recipe_started_from_demonstrations():
     assert d is not None and d.dataset is None and d.replay and d.critic_warmup_steps == 5000
     assert (d.clone_weight, d.hold_actor_steps) == (2.5, 10_000)
     assert demos.with_overrides(demonstrations="a/b-v0").demonstrations == d.model_copy(update={"dataset": "a/b-v0"})
+
+
+def test_sac_low_entropy_is_the_recipe_with_less_noise_to_hide_behind():
+    """sac_low_entropy: sac_laptop with the target entropy three nats per Jaco joint lower (−21),
+    nothing else changed, so its comparison with sac_laptop on Itch Scratching is one change."""
+    low = load_training_config(REPO / "specs" / "training" / "sac_low_entropy.yaml")
+    recipe = load_training_config(REPO / "specs" / "training" / "sac_laptop.yaml")
+    assert low.sac.target_entropy == -21.0 and recipe.sac.target_entropy == "auto"
+    assert low.sac.model_copy(update={"target_entropy": "auto"}) == recipe.sac
+    assert low.model_copy(update={"sac": recipe.sac, "description": recipe.description}) == recipe
