@@ -14,14 +14,14 @@ from __future__ import annotations
 
 import collections
 import json
-import os
 import re
-import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 import pybullet as pb
+
+from .compile.external_checks import captured_c_output
 
 STAGES = {
     "solver iterations": ["solveGroupCacheFriendlyIterations"],
@@ -85,21 +85,6 @@ def stage_shares(trace: dict) -> dict[str, float]:
     return shares
 
 
-class _quiet_stdout:
-    """File descriptor 1 pointed at /dev/null for a while (C code's printf included)."""
-
-    def __enter__(self):
-        sys.stdout.flush()
-        self.saved = os.dup(1)
-        null = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(null, 1)
-        os.close(null)
-
-    def __exit__(self, *exc):
-        os.dup2(self.saved, 1)
-        os.close(self.saved)
-
-
 def body_names(env) -> dict[int, str]:
     """Body id -> the name a spec uses (every person variant as ``person``, particles as their set,
     the ground as ``ground``)."""
@@ -131,7 +116,7 @@ def profile_episode(env, actions: list[np.ndarray], seed: int) -> tuple[dict[str
                     pair = sorted((names.get(point[1], str(point[1])), names.get(point[2], str(point[2]))))
                     contacts[" – ".join(pair)] += 1
         finally:
-            with _quiet_stdout():  # Bullet prints "Writing N timings" from C
+            with captured_c_output():  # Bullet prints "Writing N timings" from C; dropped
                 pb.stopStateLogging(log, physicsClientId=c)
         written = sorted(Path(tmp).glob(f"{trace_file.name}_*.json"))  # Bullet appends _<thread>.json
         shares = stage_shares(json.loads(written[0].read_text())) if written else {}
