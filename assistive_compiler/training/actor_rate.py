@@ -7,21 +7,20 @@ rate right before each of its steps; nothing else of SAC changes.
 
 from __future__ import annotations
 
+from .wrapped_optimizer import WrappedOptimizer
 
-class ActorLearningRate:
-    """The actor's optimiser, stepping at ``learning_rate``. Everything else (``zero_grad``,
-    ``state_dict``, ...) is the wrapped optimiser's, so checkpoints stay SB3's."""
+
+class ActorLearningRate(WrappedOptimizer):
+    """The actor's optimiser, stepping at ``learning_rate``."""
 
     def __init__(self, optimizer, learning_rate: float):
-        self.optimizer, self._learning_rate = optimizer, learning_rate
+        super().__init__(optimizer)
+        self._learning_rate = learning_rate
 
     def step(self, closure=None):
         for group in self.optimizer.param_groups:
             group["lr"] = self._learning_rate
         return self.optimizer.step(closure)
-
-    def __getattr__(self, name: str):
-        return getattr(self.__dict__["optimizer"], name)
 
 
 def set_actor_learning_rate(model, learning_rate: float) -> None:

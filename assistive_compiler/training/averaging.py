@@ -24,16 +24,16 @@ from stable_baselines3.common.utils import polyak_update
 
 from ..errors import UsageError
 from ..policies.checkpoint import ACTOR_AVERAGE
+from .wrapped_optimizer import WrappedOptimizer
 
 
-class AveragedActorUpdate:
+class AveragedActorUpdate(WrappedOptimizer):
     """SAC's actor optimiser, followed after each step by the average's Polyak update. The
     average's distance from the actor, relative to the actor's weights' norm, is logged as
-    ``train/actor_average_distance``. Everything else (``zero_grad``, ``state_dict``, ...) is the
-    wrapped optimiser's, so checkpoints stay SB3's."""
+    ``train/actor_average_distance``."""
 
     def __init__(self, model, tau: float):
-        self.optimizer = model.actor.optimizer
+        super().__init__(model.actor.optimizer)
         self._model, self._tau = model, tau
         self.average = model.policy.make_actor()  # the same architecture, its own weights
         self.average.load_state_dict(model.actor.state_dict())
@@ -54,9 +54,6 @@ class AveragedActorUpdate:
 
     def save(self, checkpoint: Path) -> None:
         torch.save(self.average.state_dict(), checkpoint / ACTOR_AVERAGE)
-
-    def __getattr__(self, name: str):
-        return getattr(self.__dict__["optimizer"], name)
 
 
 def averaged(model) -> AveragedActorUpdate | None:

@@ -29,6 +29,8 @@ from stable_baselines3.common.policies import ContinuousCritic
 from stable_baselines3.sac.policies import SACPolicy
 from torch import nn
 
+from .wrapped_optimizer import WrappedOptimizer
+
 
 def layer_normed(q_network: nn.Sequential) -> nn.Sequential:
     """``q_network`` (SB3's ``Linear, act, ..., Linear``) rebuilt with a LayerNorm after every
@@ -60,7 +62,7 @@ class LayerNormSACPolicy(SACPolicy):
         return LayerNormCritic(**critic_kwargs).to(self.device)
 
 
-class ConservativeCriticUpdate:
+class ConservativeCriticUpdate(WrappedOptimizer):
     """SAC's critic optimiser with CQL's regulariser (the CQL(H) form for SAC).
 
     SB3's SAC back-propagates its critic loss and calls ``critic.optimizer.step()``. Before that step
@@ -72,11 +74,10 @@ class ConservativeCriticUpdate:
     from the [-1, 1] action box (p = 2^-|A|) and k from the current policy at s (p = π(a'|s)): the
     importance-weighted soft maximum of Q over actions, minus Q of the action taken. It is zero
     when unseen actions are valued no higher than the taken one and pushes them down otherwise.
-    The gap is logged as ``train/conservative_gap``. Everything else (``zero_grad``,
-    ``state_dict``, ...) is the wrapped optimiser's, so checkpoints stay SB3's."""
+    The gap is logged as ``train/conservative_gap``."""
 
     def __init__(self, model, weight: float, actions_per_state: int = 4, states: int = 64, seed: int = 0):
-        self.optimizer = model.critic.optimizer
+        super().__init__(model.critic.optimizer)
         self._model, self._weight, self._k, self._states = model, weight, actions_per_state, states
         self._generator = torch.Generator().manual_seed(seed)
 
@@ -105,9 +106,6 @@ class ConservativeCriticUpdate:
         if getattr(self._model, "_logger", None) is not None:  # SB3 sets its logger up when learn() starts
             self._model.logger.record_mean("train/conservative_gap", gap.item())
         return self.optimizer.step(closure)
-
-    def __getattr__(self, name: str):
-        return getattr(self.__dict__["optimizer"], name)
 
 
 def make_conservative(model, weight: float, seed: int) -> None:

@@ -36,6 +36,7 @@ import numpy as np
 
 from ..errors import UsageError
 from .config import Demonstrations
+from .wrapped_optimizer import WrappedOptimizer
 
 
 @dataclass(frozen=True)
@@ -250,7 +251,7 @@ def _cloning_targets(model, data: DemonstrationData):
     return obs, target
 
 
-class ActorUpdate:
+class ActorUpdate(WrappedOptimizer):
     """SAC's actor optimiser as a run started from demonstrations updates its actor.
 
     SB3's SAC computes its actor loss (temperature × log π − min Q), back-propagates it and calls
@@ -270,14 +271,12 @@ class ActorUpdate:
       runs to its bound on a few action dimensions while the others narrow (Drinking: σ up to e²
       on some joints after 5,000 steps at the clone's total entropy, their actions ±1 noise).
 
-    The sum is the actor loss of SAC plus that term; nothing else of SAC changes. Everything else
-    (``zero_grad``, ``state_dict``, ``param_groups``: SB3 saves and schedules through them) is the
-    wrapped optimiser's."""
+    The sum is the actor loss of SAC plus that term; nothing else of SAC changes."""
 
     def __init__(self, model, data: DemonstrationData, weight: float, hold_steps: int, seed: int):
         import torch
 
-        self.optimizer = model.actor.optimizer
+        super().__init__(model.actor.optimizer)
         self._model, self._weight, self._hold_steps = model, weight, hold_steps
         self._obs, self._target = _cloning_targets(model, data)
         self._generator = torch.Generator().manual_seed(seed)
@@ -299,9 +298,6 @@ class ActorUpdate:
             model.logger.record_mean("train/clone_spread", spread.item())
             model.logger.record_mean("train/clone_q_scale", q_scale.item())
         return self.optimizer.step(closure)
-
-    def __getattr__(self, name: str):
-        return getattr(self.__dict__["optimizer"], name)
 
 
 def update_actor_as_configured(model, data: DemonstrationData, settings: Demonstrations, seed: int) -> None:
