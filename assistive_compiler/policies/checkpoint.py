@@ -67,6 +67,27 @@ class SB3Policy:
         return action
 
 
+class SB3PairPolicy(SB3Policy):
+    """A co-optimised pair trained with SB3 SAC, one actor per agent
+    (:mod:`assistive_compiler.training.factored_actor`): ``(robot_obs, human_obs) -> (a_robot,
+    a_human)``, and each agent alone with :meth:`agent` (its actor reads its own observation only)."""
+
+    def __init__(self, checkpoint: Path, algorithm: str = "sac", stochastic: bool = False, seed: int = 0):
+        super().__init__(checkpoint, algorithm, stochastic, seed)
+        self.robot_obs_size, self.robot_action_size = self.model.actor.agent_split
+        self.human_obs_size = self.model.observation_space.shape[0] - self.robot_obs_size
+
+    def __call__(self, obs: np.ndarray, human_obs: np.ndarray | None = None):
+        joint = super().__call__(np.concatenate([obs, human_obs]))
+        return joint[: self.robot_action_size], joint[self.robot_action_size :]
+
+    def agent(self, name: str):
+        """One agent's policy, ``obs -> action`` (the other agent's observation is not read: zeros)."""
+        if name == AGENTS[0]:
+            return lambda obs: self(obs, np.zeros(self.human_obs_size, np.float32))[0]
+        return lambda obs: self(np.zeros(self.robot_obs_size, np.float32), obs)[1]
+
+
 class RLlibPolicy:
     """A trained RLlib run's policies as plain functions (by default deterministic: the Gaussian's mean).
 
@@ -122,7 +143,7 @@ def load_policy(info: RunInfo, checkpoint: Path, stochastic: bool = False, seed:
     deterministic, or with ``stochastic`` sampling its actions as training did (from a generator
     seeded with ``seed``)."""
     if info.engine == "sb3":
-        return SB3Policy(checkpoint, info.algorithm, stochastic=stochastic, seed=seed)
+        return (SB3PairPolicy if info.coop else SB3Policy)(checkpoint, info.algorithm, stochastic=stochastic, seed=seed)
     return RLlibPolicy(checkpoint, coop=info.coop, algorithm=info.algorithm, stochastic=stochastic, seed=seed)
 
 

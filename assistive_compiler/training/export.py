@@ -43,19 +43,35 @@ def _layers(linears) -> list[tuple[np.ndarray, np.ndarray]]:
     ]
 
 
+def _sac_actor(actor, activation: str, low: np.ndarray, high: np.ndarray) -> MLPPolicy:
+    """SAC's actor (SB3's, or one agent's head of a factored actor: ``latent_pi``, ``mu``,
+    ``log_std``) as its mean through tanh, with the log-std layer for sampling."""
+    from stable_baselines3.sac.policies import LOG_STD_MAX, LOG_STD_MIN
+
+    layers = _layers(_linears(actor.latent_pi) + [actor.mu])
+    log_std = _layers([actor.log_std])[0]  # a layer on the same features as the mean's
+    return MLPPolicy(layers, activation, "tanh", low, high, log_std=log_std, log_std_bounds=(LOG_STD_MIN, LOG_STD_MAX))
+
+
+def pair_from_sb3(loaded, activation: str) -> dict[str, MLPPolicy]:
+    """Each agent's deterministic policy of a co-optimised SB3 SAC checkpoint
+    (:class:`~assistive_compiler.policies.checkpoint.SB3PairPolicy`), by agent name."""
+    actor, space = loaded.model.actor, loaded.model.action_space
+    return {
+        agent: _sac_actor(
+            head, activation, space.low[actor.action_slices[agent]], space.high[actor.action_slices[agent]]
+        )
+        for agent, head in actor.heads.items()
+    }
+
+
 def mlp_from_sb3(loaded, algorithm: str, activation: str) -> MLPPolicy:
     """The deterministic policy of a loaded SB3 checkpoint (:class:`~assistive_compiler.policies.checkpoint.SB3Policy`: SAC's actor
     mean through tanh; PPO's Gaussian mean, clipped), with PPO's observation normalisation if it used one."""
     model = loaded.model
     low, high = model.action_space.low, model.action_space.high
     if algorithm == "sac":
-        from stable_baselines3.sac.policies import LOG_STD_MAX, LOG_STD_MIN
-
-        layers = _layers(_linears(model.actor.latent_pi) + [model.actor.mu])
-        log_std = _layers([model.actor.log_std])[0]  # a layer on the same features as the mean's
-        return MLPPolicy(
-            layers, activation, "tanh", low, high, log_std=log_std, log_std_bounds=(LOG_STD_MIN, LOG_STD_MAX)
-        )
+        return _sac_actor(model.actor, activation, low, high)
     layers = _layers(_linears(model.policy.mlp_extractor.policy_net) + [model.policy.action_net])
     free = model.policy.log_std.detach().cpu().numpy().astype(np.float64)  # one vector, whatever the state
     if loaded.obs_rms is None:
@@ -159,23 +175,31 @@ def export_run(
     steps, checkpoint = checkpoint_at(run, checkpoint_steps)
     config = run_config(info)
     rng = np.random.default_rng(0)
-    if info.engine == "sb3":
+    from ..policies.pretrained import CoopPolicy
+
+    if info.engine == "sb3" and not info.coop:
         from ..policies.checkpoint import SB3Policy
 
         original = SB3Policy(checkpoint, config.algorithm)
         policy = mlp_from_sb3(original, config.algorithm, config.network.activation)
         worst = check_same_actions(policy, original, rng.normal(0.0, 1.0, (32, policy.obs_dim)))
     else:
-        from ..policies.checkpoint import SINGLE_MODULE, RLlibPolicy
-        from ..policies.pretrained import CoopPolicy
+        if info.engine == "sb3":
+            from ..policies.checkpoint import SB3PairPolicy
 
-        original = RLlibPolicy(checkpoint, info.coop, config.algorithm)
-        parts = {
-            name: mlp_from_rllib(module, config.algorithm, config.network.activation)
-            for name, module in original.modules.items()
-        }
+            pair = SB3PairPolicy(checkpoint, config.algorithm)
+            parts, act = pair_from_sb3(pair, config.network.activation), pair.agent
+        else:
+            from ..policies.checkpoint import SINGLE_MODULE, RLlibPolicy
+
+            rllib = RLlibPolicy(checkpoint, info.coop, config.algorithm)
+            parts = {
+                name: mlp_from_rllib(module, config.algorithm, config.network.activation)
+                for name, module in rllib.modules.items()
+            }
+            act = lambda name: lambda o: rllib._act(name, o)  # noqa: E731
         worst = max(
-            check_same_actions(part, lambda o, n=name: original._act(n, o), rng.normal(0.0, 1.0, (32, part.obs_dim)))
+            check_same_actions(part, act(name), rng.normal(0.0, 1.0, (32, part.obs_dim)))
             for name, part in parts.items()
         )
         policy = CoopPolicy(parts["robot"], parts["human"], {}) if info.coop else parts[SINGLE_MODULE]

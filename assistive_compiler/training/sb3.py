@@ -1,9 +1,11 @@
-"""Single-agent training on one machine: Stable-Baselines3 PPO or SAC over ``envs`` env processes.
+"""Training on one machine: Stable-Baselines3 PPO or SAC over ``envs`` env processes.
 
 The envs are SB3's process-based vector env (:class:`SubprocVecEnv`; one env runs in-process),
 each a :class:`~assistive_compiler.runtime.env.AssistiveEnv` built from the run's compiled
 artifact, optionally (PPO) behind :class:`VecNormalize` (running observation and return
-statistics, saved with every checkpoint). A checkpoint is a directory holding ``model.zip``, PPO's
+statistics, saved with every checkpoint). A co-optimisation run (``coop``, SAC only) trains the
+robot and the person together: each env is :class:`~assistive_compiler.coop.joint.JointAgentsEnv`
+and the actor one network per agent with one shared critic (:mod:`.factored_actor`). A checkpoint is a directory holding ``model.zip``, PPO's
 ``vecnormalize.pkl`` and SAC's ``replay_buffer.pkl`` (kept in the newest checkpoint only: it is
 the bulk of a checkpoint); resuming loads them and continues the step count.
 """
@@ -25,25 +27,30 @@ SAC_LOG_EVERY_STEPS = 2_000
 REPLAY_BUFFER = "replay_buffer.pkl"
 
 
-def make_monitored_env(artifact_dir: str, in_worker: bool = False):
-    """One env of the vector env: the compiled task behind SB3's episode Monitor. In a worker
-    process Ctrl-C is ignored: the trainer stops the workers after writing its checkpoint."""
+def make_monitored_env(artifact_dir: str, in_worker: bool = False, coop: bool = False):
+    """One env of the vector env: the compiled task (``coop``: both agents as one,
+    :class:`~assistive_compiler.coop.joint.JointAgentsEnv`) behind SB3's episode Monitor. In a
+    worker process Ctrl-C is ignored: the trainer stops the workers after writing its checkpoint."""
     from stable_baselines3.common.monitor import Monitor
 
     if in_worker:
         import signal
 
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if coop:
+        from ..coop.joint import JointAgentsEnv
+
+        return Monitor(JointAgentsEnv(artifact_dir))
     from ..runtime.env import AssistiveEnv
 
     return Monitor(AssistiveEnv(artifact_dir))
 
 
-def make_vec_env(artifact_dir: Path, n_envs: int, seed: int):
+def make_vec_env(artifact_dir: Path, n_envs: int, seed: int, coop: bool = False):
     """``n_envs`` envs (processes when more than one), seeded ``seed``, ``seed + 1``, ..."""
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
-    fns = [functools.partial(make_monitored_env, str(artifact_dir), n_envs > 1) for _ in range(n_envs)]
+    fns = [functools.partial(make_monitored_env, str(artifact_dir), n_envs > 1, coop) for _ in range(n_envs)]
     venv = SubprocVecEnv(fns, start_method="forkserver") if n_envs > 1 else DummyVecEnv(fns)
     venv.seed(seed)
     return venv
@@ -72,15 +79,30 @@ def _normalized(venv, config: TrainingConfig, checkpoint: Path | None):
     )
 
 
-def _new_model(venv, config: TrainingConfig, run: RunDir):
+def sac_policy(config: TrainingConfig, agent_split: tuple[int, int] | None) -> tuple[object, dict]:
+    """SAC's policy class and ``policy_kwargs``: SB3's own, with layer-normalised critics
+    (``sac.critic_layer_norm``) and, for a co-optimised pair (``agent_split``: the robot's
+    observation and action sizes), one actor per agent."""
+    from .critics import LayerNormSACPolicy
+
+    assert config.sac is not None
+    kwargs = policy_kwargs(config)
+    if agent_split is None:
+        return (LayerNormSACPolicy if config.sac.critic_layer_norm else "MlpPolicy"), kwargs
+    from .factored_actor import FactoredLayerNormSACPolicy, FactoredSACPolicy
+
+    policy = FactoredLayerNormSACPolicy if config.sac.critic_layer_norm else FactoredSACPolicy
+    return policy, kwargs | {"agent_split": agent_split}
+
+
+def _new_model(venv, config: TrainingConfig, run: RunDir, agent_split: tuple[int, int] | None = None):
     from stable_baselines3 import PPO, SAC
 
     if config.sac is not None:
         s = config.sac
-        from .critics import LayerNormSACPolicy
-
+        policy, kwargs = sac_policy(config, agent_split)
         return SAC(
-            LayerNormSACPolicy if s.critic_layer_norm else "MlpPolicy",
+            policy,
             venv,
             learning_rate=s.learning_rate,
             buffer_size=s.buffer_size,
@@ -92,7 +114,7 @@ def _new_model(venv, config: TrainingConfig, run: RunDir):
             gradient_steps=s.gradient_steps,
             ent_coef=f"auto_{s.initial_ent_coef:g}" if s.ent_coef == "auto" else s.ent_coef,
             target_entropy="auto" if s.target_entropy == "cloned" else s.target_entropy,  # cloned: set on cloning
-            policy_kwargs=policy_kwargs(config),
+            policy_kwargs=kwargs,
             tensorboard_log=str(run.tb),
             seed=config.seed,
             device="cpu",
@@ -197,8 +219,10 @@ def train(
     quiet: bool = False,
     stop=None,
     demonstrations=None,
+    coop: bool = False,
 ) -> dict:
     """Train (or continue) the run to ``config.total_steps``; returns the session's figures.
+    ``coop`` (SAC): the robot and the person together, one actor each and one critic.
 
     A new run given ``demonstrations`` (:class:`.demonstrations.DemonstrationData`) starts from
     them: its actor cloned, its replay buffer filled, its critics warmed up and a checkpoint
@@ -220,7 +244,7 @@ def train(
         raise UsageError(
             f"{latest[1] / REPLAY_BUFFER}: --resume of a SAC run needs the newest checkpoint's replay buffer, which is missing"
         )
-    venv = make_vec_env(run.artifact, config.envs, config.seed + start_steps)
+    venv = make_vec_env(run.artifact, config.envs, config.seed + start_steps, coop)
     venv = _normalized(venv, config, latest[1] if latest else None)
     if latest:
         model = algorithm_class(config).load(str(latest[1] / "model.zip"), env=venv, device="cpu")
@@ -228,7 +252,7 @@ def train(
         if config.sac is not None:
             model.load_replay_buffer(str(latest[1] / REPLAY_BUFFER))
     else:
-        model = _new_model(venv, config, run)
+        model = _new_model(venv, config, run, venv.get_attr("agent_split")[0] if coop else None)
     if config.sac is not None and config.sac.actor_learning_rate is not None:  # new or resumed
         from .actor_rate import set_actor_learning_rate
 

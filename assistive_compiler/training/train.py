@@ -1,8 +1,9 @@
 """``train``: compile the task, open (or resume) a run directory, and hand it to an engine.
 
-Engines: ``sb3`` (Stable-Baselines3 PPO or SAC, single agent, one machine) and ``rllib`` (Ray RLlib PPO:
-co-optimisation with policies ``robot`` and ``human``, or any run on a Ray cluster via
-``--address``). ``auto`` picks RLlib for ``--coop`` or an ``--address``, SB3 otherwise.
+Engines: ``sb3`` (Stable-Baselines3 PPO or SAC on one machine; with ``--coop``, SAC with one actor
+per agent and one shared critic) and ``rllib`` (Ray RLlib PPO or SAC: co-optimisation with policies
+``robot`` and ``human``, or any run on a Ray cluster via ``--address``). ``auto`` picks RLlib for
+``--coop`` or an ``--address``, SB3 otherwise.
 """
 
 from __future__ import annotations
@@ -31,8 +32,6 @@ def choose_engine(engine: str, coop: bool, address: str | None) -> str:
         )
     if engine == "auto":
         return "rllib" if coop or address else "sb3"
-    if engine == "sb3" and coop:
-        raise UsageError("--coop trains two policies (robot and human): use --engine rllib (or auto)")
     if engine == "sb3" and address:
         raise UsageError("--address attaches to a Ray cluster: use --engine rllib (or auto)")
     return engine
@@ -88,11 +87,16 @@ def train(
         raise UsageError(
             "--demonstrations starts a new run; --resume continues one with the demonstrations it started from"
         )
-    if demonstrations is not None and engine != "sb3":
+    if demonstrations is not None and (engine != "sb3" or coop):
         raise UsageError("--demonstrations: starting from demonstrations is for single-agent SB3 SAC (--engine sb3)")
     config: TrainingConfig = load_training_config(config_path).with_overrides(
         steps=steps, seed=seed, envs=envs, demonstrations=demonstrations, demonstrations_root=demonstrations_root
     )
+    if engine == "sb3" and coop and config.algorithm != "sac":
+        raise UsageError(
+            f"--coop --engine sb3 trains SAC (one actor per agent, one shared critic); {display(Path(config_path))} is "
+            f"{config.algorithm.upper()}: use --engine rllib (or auto) for {config.algorithm.upper()} co-optimisation"
+        )
     if engine == "rllib":
         from .rllib import check_supported
 
@@ -145,7 +149,9 @@ def train(
         if engine == "sb3":
             from . import sb3
 
-            figures = sb3.train(run, config, weights, resume=resume, quiet=quiet, stop=stop, demonstrations=demo_data)
+            figures = sb3.train(
+                run, config, weights, resume=resume, quiet=quiet, stop=stop, demonstrations=demo_data, coop=coop
+            )
         else:
             from . import rllib
 

@@ -570,9 +570,10 @@ def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, 
     assert fewer_r["vs_reference_at_reference_solver"] == pytest.approx(
         fewer_r["env_steps_per_s_reference_solver"] / 348, abs=0.0051
     )
-    # Where Feeding's physics goes: solving the rows of the food resting in the spoon, no cloth.
+    # Where Feeding's physics goes: solving the rows of the food resting in the spoon, no cloth. The
+    # soft-body world's empty pass still opens its zones: a tenth of a percent, never the work of a cloth.
     stages = feeding["physics_stages"]
-    assert sum(stages.values()) == pytest.approx(1.0, abs=0.005) and stages["soft bodies"] == 0.0
+    assert sum(stages.values()) == pytest.approx(1.0, abs=0.005) and stages["soft bodies"] < 0.01
     assert stages["solver iterations"] + stages["solver setup (contact and joint rows)"] > 0.5
     rc = main(["bench", str(SPEC), str(fewer), "--robot", "jaco", "--steps", "10", "--repeats", "1", "--resets", "2"])
     out = capsys.readouterr().out

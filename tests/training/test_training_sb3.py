@@ -717,6 +717,99 @@ def test_run_render_and_evaluate_take_a_run_directory_or_an_exported_policy(reac
     ]
 
 
+FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
+
+
+def test_a_coop_pair_trains_on_sb3_with_one_critic_and_each_agent_acts_on_its_own_observation(tmp_path, capsys):
+    """``--coop --engine sb3``: SAC with one actor per agent and one critic for the pair. The critic
+    sees both observations and both actions; each actor reads only its agent's observation, so the
+    pair exports to two NumPy policies that act as the checkpoint does, play under ``run --coop``,
+    and the run resumes."""
+    import torch
+
+    from assistive_compiler.policies.checkpoint import load_policy
+    from assistive_compiler.policies.pretrained import load_trained
+    from assistive_compiler.training.evaluate import play_episodes
+    from assistive_compiler.training.export import export_run
+    from assistive_compiler.training.factored_actor import FactoredActor
+
+    config = tmp_path / "sac_tiny.yaml"
+    config.write_text(SAC_TINY)
+    out = tmp_path / "feeding-coop-sac"
+    train = ["train", str(FEEDING), "--robot", "jaco", "--coop", "--engine", "sb3", "--config", str(config)]
+    assert main([*train, "--out", str(out), "--quiet"]) == 0
+    run = RunDir(out)
+    assert (run.info().engine, run.info().coop, run.info().algorithm) == ("sb3", True, "sac")
+    pair = load_policy(run.info(), run.latest_checkpoint()[1])
+    model = pair.model
+    robot_obs, human_obs = 25, 23  # Feeding, Jaco: the robot's and the person's observation sizes
+    robot_act, human_act = 7, 4
+    assert isinstance(model.actor, FactoredActor) and model.actor.agent_split == (robot_obs, robot_act)
+    # One critic for the pair: both observations and both actions in.
+    assert model.critic.q_networks[0][0].in_features == robot_obs + human_obs + robot_act + human_act
+    # Each actor learnt (its weights moved from their start) and reads only its own observation.
+    rng = np.random.default_rng(0)
+    o_robot, o_human = rng.normal(size=robot_obs).astype(np.float32), rng.normal(size=human_obs).astype(np.float32)
+    a_robot, a_human = pair(o_robot, o_human)
+    assert a_robot.shape == (robot_act,) and a_human.shape == (human_act,)
+    other_robot, other_human = pair(o_robot, o_human + 3.0)
+    assert np.array_equal(other_robot, a_robot) and not np.allclose(other_human, a_human)
+    other_robot, other_human = pair(o_robot + 3.0, o_human)
+    assert np.array_equal(other_human, a_human) and not np.allclose(other_robot, a_robot)
+    assert np.array_equal(pair.agent("robot")(o_robot), a_robot) and np.array_equal(
+        pair.agent("human")(o_human), a_human
+    )
+    first = {k: v.clone() for k, v in model.actor.state_dict().items()}
+
+    # Export: two NumPy policies, each acting as the checkpoint's on a real co-optimised episode.
+    record = export_run(out, tmp_path / "pair", episodes=1, seed=7)
+    assert record["coop"] and record["engine"] == "sb3" and record["export_max_action_difference"] < 1e-4
+    exported, _ = load_trained(str(tmp_path / "pair"))
+    seen: dict[str, list] = {"robot": [], "human": []}
+
+    class Recorded:
+        def agent(self, name):
+            act = pair.agent(name)
+            return lambda obs: (seen[name].append(obs), act(obs))[1]
+
+    play_episodes(run.artifact, Recorded(), True, 1, 7)
+    for name, observations in seen.items():
+        assert len(observations) > 50
+        worst = max(np.abs(exported.agent(name)(o) - pair.agent(name)(o)).max() for o in observations)
+        assert worst < 1e-4, (name, worst)
+    capsys.readouterr()
+    played = ["run", str(FEEDING), "--robot", "jaco", "--coop", "--policy", str(tmp_path / "pair")]
+    assert main([*played, "--episodes", "1", "--seed", "7", "--json", "--quiet"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["human_policy"] == str(tmp_path / "pair")  # the pair plays the person too
+    assert report["episodes"][0]["return"] == pytest.approx(record["evaluation"]["returns"][0], abs=1e-3)
+
+    # Resume: the same factored actor goes on learning from the checkpoint, with its replay buffer.
+    assert main([*train, "--out", str(out), "--resume", "--steps", "800", "--quiet"]) == 0
+    steps, newest = run.latest_checkpoint()
+    resumed = load_policy(run.info(), newest).model
+    assert steps == 800 and isinstance(resumed.actor, FactoredActor)
+    assert any(not torch.equal(first[k], v) for k, v in resumed.actor.state_dict().items())
+
+
+def test_coop_on_sb3_is_sac_and_without_demonstrations(tmp_path, capsys):
+    """PPO co-optimisation is RLlib's; SB3 co-optimises with SAC only, and not from demonstrations
+    (a dataset holds the robot's actions alone). Refused before the run directory is written."""
+    out = tmp_path / "run"
+    train = ["train", str(FEEDING), "--robot", "jaco", "--coop", "--engine", "sb3", "--out", str(out)]
+    assert main([*train, "--config", "ppo_laptop"]) == 2
+    assert capsys.readouterr().err.strip().splitlines()[-1] == (
+        "error: --coop --engine sb3 trains SAC (one actor per agent, one shared critic); "
+        "specs/training/ppo_laptop.yaml is PPO: "
+        "use --engine rllib (or auto) for PPO co-optimisation"
+    )
+    assert main([*train, "--config", "sac_demos", "--demonstrations", "assistive_compiler/feeding-jaco/any-v0"]) == 2
+    assert capsys.readouterr().err.strip().splitlines()[-1] == (
+        "error: --demonstrations: starting from demonstrations is for single-agent SB3 SAC (--engine sb3)"
+    )
+    assert not out.exists()
+
+
 def test_a_trained_policy_of_another_task_is_refused(reach_run, capsys):
     code = main(
         [
