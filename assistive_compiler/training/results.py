@@ -119,9 +119,15 @@ def _order(r: dict) -> tuple:
     return (TASKS.index(r["task"]) if r["task"] in TASKS else len(TASKS), r["task"], r["robot"], r["name"])
 
 
+def _settings(r: dict) -> tuple:
+    """A cell's learning settings: its network and its algorithm's section of the config."""
+    return (r["config"].get("network"), r["config"].get(r["algorithm"]))
+
+
 def _claim_row(coop: dict, records: list[dict]) -> list[str] | None:
-    """A co-optimised cell against the static-person cell of the same task, robot and algorithm with
-    the nearest budget: success (env steps) each; None when there is no such static cell."""
+    """A co-optimised cell against the static-person cell of the same task, robot and algorithm —
+    of the same settings where there is one — with the nearest budget: success (env steps, policy)
+    each; None when there is no such static cell."""
     static = [
         r
         for r in records
@@ -129,10 +135,10 @@ def _claim_row(coop: dict, records: list[dict]) -> list[str] | None:
     ]
     if not static:
         return None
-    s = min(static, key=lambda r: abs(r["trained_steps"] - coop["trained_steps"]))
+    s = min(static, key=lambda r: (_settings(r) != _settings(coop), abs(r["trained_steps"] - coop["trained_steps"])))
 
     def cell(r: dict) -> str:
-        return f"{100 * r['evaluation']['success_rate']:.0f}% ({r['trained_steps']:,} steps)"
+        return f"{100 * r['evaluation']['success_rate']:.0f}% ({r['trained_steps']:,} steps, `{r['name']}`)"
 
     return [
         TASK_TITLES[coop["task"]],
@@ -167,7 +173,7 @@ def results_block(records: list[dict]) -> str:
     if claim:
         parts.append(
             "Each co-optimised cell beside the static-person cell of the same task, robot and algorithm "
-            "(the nearest budget when several); the same evaluation seeds.\n"
+            "(of the same settings where one has them, then the nearest budget); the same evaluation seeds.\n"
         )
         parts.append(
             markdown_table(["Task", "Robot", "Algorithm", "Static person", "Active person (co-optimised)"], claim)

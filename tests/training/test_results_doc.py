@@ -63,6 +63,24 @@ def test_the_claim_pairs_a_coop_cell_with_the_static_cell_of_its_algorithm():
     coop["evaluation"] = {**coop["evaluation"], "success_rate": 0.81}
     block = results_block(records + [coop])
     claim = block[block.index("### The paper's claim") : block.index("### Each cell")]
-    static_cell = f"{100 * static_ppo['evaluation']['success_rate']:.0f}% ({static_ppo['trained_steps']:,} steps)"
-    assert f"| Feeding | Jaco | PPO | {static_cell} | 81% (360,000 steps) |" in claim
+    static_cell = f"{100 * static_ppo['evaluation']['success_rate']:.0f}% ({static_ppo['trained_steps']:,} steps, `feeding-jaco-ppo`)"
+    assert f"| Feeding | Jaco | PPO | {static_cell} | 81% (360,000 steps, `feeding-jaco-coop`) |" in claim
     assert "Not measured yet" in results_block([r for r in records if not r["coop"]])
+
+
+def test_the_claim_pairs_a_coop_cell_with_the_static_cell_of_its_settings_before_the_nearest_budget():
+    """Itch Scratching has two static SAC cells (sac_laptop at 174k, sac_low_entropy at 167k): a
+    co-optimised low-entropy cell at 174k is set beside the low-entropy one, not the nearer budget."""
+    import copy
+
+    records = [r for r in shipped_records() if r["name"] != "scratch_itch-jaco-coop"]
+    laptop, low = (
+        next(r for r in records if r["name"] == n) for n in ("scratch_itch-jaco", "scratch_itch-jaco-low-entropy")
+    )
+    assert abs(laptop["trained_steps"] - 174_000) < abs(low["trained_steps"] - 174_000)
+    coop = copy.deepcopy(low)
+    coop.update(name="scratch_itch-jaco-coop-sac", coop=True, trained_steps=174_000)
+    block = results_block(records + [coop])
+    claim = block[block.index("### The paper's claim") : block.index("### Each cell")]
+    row = next(line for line in claim.splitlines() if line.startswith("| Itch Scratching | Jaco | SAC |"))
+    assert "`scratch_itch-jaco-low-entropy`" in row and "`scratch_itch-jaco`" not in row
