@@ -1,5 +1,6 @@
 """Small helpers shared by test modules: where a needle sits in a spec's text (``LINE:COL``, as
-the CLI reports locations) and an env of a spec compiled into a fresh directory."""
+the CLI reports locations), an env of a spec compiled into a fresh directory, and the check that
+an exported co-optimised pair acts as its checkpoint."""
 
 from __future__ import annotations
 
@@ -44,3 +45,26 @@ def cli(*args: str, cwd: Path | None = None, env: dict | None = None, timeout: f
         env=os.environ | (env or {}),
     )
     return proc.returncode, proc.stdout, proc.stderr
+
+
+def assert_exported_pair_acts_as(checkpoint_pair, exported, artifact: Path, seed: int = 7) -> None:
+    """On the observations of a real co-optimised episode of ``artifact`` (seed ``seed``, played by
+    ``checkpoint_pair``), each agent of the ``exported`` pair acts as the checkpoint's, to float32
+    precision. (Their episode returns may still differ by a point: the food's contacts amplify a
+    1e-6 action difference.)"""
+    import numpy as np
+
+    from assistive_compiler.training.evaluate import play_episodes
+
+    seen: dict[str, list] = {"robot": [], "human": []}
+
+    class Recorded:
+        def agent(self, name):
+            act = checkpoint_pair.agent(name)
+            return lambda obs: (seen[name].append(obs), act(obs))[1]
+
+    play_episodes(artifact, Recorded(), True, 1, seed)
+    for name, observations in seen.items():
+        assert len(observations) > 50
+        worst = max(np.abs(exported.agent(name)(o) - checkpoint_pair.agent(name)(o)).max() for o in observations)
+        assert worst < 1e-4, (name, worst)

@@ -18,6 +18,8 @@ pytest.importorskip("ray", reason='needs the "train" extra (README: Training); C
 # pytest 9.2 with xdist 3.8 (the group never reaches the scheduler), so the clusters do overlap.
 pytestmark = pytest.mark.xdist_group("ray")
 
+from helpers import assert_exported_pair_acts_as  # noqa: E402 (after the importorskip)
+
 from assistive_compiler.cli import main  # noqa: E402 (after the importorskip)
 from assistive_compiler.run_dir import RunDir  # noqa: E402 (after the importorskip)
 from assistive_compiler.training.evaluate import evaluate  # noqa: E402 (after the importorskip)
@@ -161,28 +163,13 @@ def test_multi_agent_sac_trains_and_exports_a_pair_that_plays_under_coop(local_r
     record = export_run(out, tmp_path / "pair", episodes=1, seed=7)
     assert record["coop"] and record["export_max_action_difference"] < 1e-4
     assert {p.name for p in (tmp_path / "pair").iterdir()} >= {"policy.json", "robot", "human"}
-    # On the observations of a real co-optimised episode (not only the export's random ones), each
-    # exported agent acts as the checkpoint's, to float32 precision. (Their episode returns may
-    # still differ by a point: the food's contacts amplify a 1e-6 action difference.)
     from assistive_compiler.policies.checkpoint import load_policy
     from assistive_compiler.policies.pretrained import load_trained
-    from assistive_compiler.training.evaluate import play_episodes
 
     run = RunDir(out)
     checkpoint_pair = load_policy(run.info(), run.latest_checkpoint()[1])
     exported, _ = load_trained(str(tmp_path / "pair"))
-    seen: dict[str, list] = {"robot": [], "human": []}
-
-    class Recorded:
-        def agent(self, name):
-            act = checkpoint_pair.agent(name)
-            return lambda obs: (seen[name].append(obs), act(obs))[1]
-
-    play_episodes(run.artifact, Recorded(), True, 1, 7)
-    for name, observations in seen.items():
-        assert len(observations) > 50
-        worst = max(np.abs(exported.agent(name)(o) - checkpoint_pair.agent(name)(o)).max() for o in observations)
-        assert worst < 1e-4, (name, worst)
+    assert_exported_pair_acts_as(checkpoint_pair, exported, run.artifact)
     capsys.readouterr()
     assert (
         main(

@@ -21,6 +21,7 @@ from PIL import Image
 pytest.importorskip("stable_baselines3", reason='needs the "train" extra (README: Training); CI installs it')
 
 from conftest import built_once
+from helpers import assert_exported_pair_acts_as
 
 from assistive_compiler.artifact import Manifest
 from assistive_compiler.cli import main
@@ -729,7 +730,6 @@ def test_a_coop_pair_trains_on_sb3_with_one_critic_and_each_agent_acts_on_its_ow
 
     from assistive_compiler.policies.checkpoint import load_policy
     from assistive_compiler.policies.pretrained import load_trained
-    from assistive_compiler.training.evaluate import play_episodes
     from assistive_compiler.training.export import export_run
     from assistive_compiler.training.factored_actor import FactoredActor
 
@@ -765,18 +765,7 @@ def test_a_coop_pair_trains_on_sb3_with_one_critic_and_each_agent_acts_on_its_ow
     record = export_run(out, tmp_path / "pair", episodes=1, seed=7)
     assert record["coop"] and record["engine"] == "sb3" and record["export_max_action_difference"] < 1e-4
     exported, _ = load_trained(str(tmp_path / "pair"))
-    seen: dict[str, list] = {"robot": [], "human": []}
-
-    class Recorded:
-        def agent(self, name):
-            act = pair.agent(name)
-            return lambda obs: (seen[name].append(obs), act(obs))[1]
-
-    play_episodes(run.artifact, Recorded(), True, 1, 7)
-    for name, observations in seen.items():
-        assert len(observations) > 50
-        worst = max(np.abs(exported.agent(name)(o) - pair.agent(name)(o)).max() for o in observations)
-        assert worst < 1e-4, (name, worst)
+    assert_exported_pair_acts_as(pair, exported, run.artifact)
     capsys.readouterr()
     played = ["run", str(FEEDING), "--robot", "jaco", "--coop", "--policy", str(tmp_path / "pair")]
     assert main([*played, "--episodes", "1", "--seed", "7", "--json", "--quiet"]) == 0
