@@ -102,7 +102,7 @@ def profile_episode(env, actions: list[np.ndarray], seed: int) -> tuple[dict[str
     """One seeded episode of ``actions`` under Bullet's profiler: each stage's share of the physics
     (:func:`stage_shares`) and the contact points per env step by body pair (``"a – b"``, the last
     physics step's, most first)."""
-    c = env.world.client
+    c = env.client
     names = body_names(env)
     contacts: collections.Counter = collections.Counter()
     env.reset(seed=seed)

@@ -143,7 +143,7 @@ def measure_raw_loop(env, steps: int) -> float:
     env.reset(seed=0)
     t0 = time.perf_counter()
     for _ in range(steps * env.manifest.sim.frame_skip):
-        pb.stepSimulation(physicsClientId=env.world.client)
+        pb.stepSimulation(physicsClientId=env.client)
     return steps / (time.perf_counter() - t0)
 
 

@@ -90,7 +90,7 @@ class ScriptedPolicy:
         else:
             self.tracks = [_Track(env, m.scripted, links["tool_mount"], list(m.robot.arm_joints))]
         robot = env.world.robot
-        c = env.world.client
+        c = env.client
         movable = [
             j
             for j in range(pb.getNumJoints(robot.id, physicsClientId=c))
@@ -176,8 +176,8 @@ class ScriptedPolicy:
         env = self.env
         if env.steps == 0:  # first action of an episode
             self._start_episode()
-        c = env.world.client
-        robot = env.world.robot.id
+        c = env.client
+        robot = env.body_id("robot")
         rest = [pb.getJointState(robot, j, physicsClientId=c)[0] for j in self.movable]
         action = np.zeros(env.action_space.shape, dtype=np.float32)
         for track in self.tracks:

@@ -63,7 +63,7 @@ class SceneReader:
 
     def link_poses(self) -> tuple[np.ndarray, np.ndarray]:
         """(L, 3) positions and (L, 4) quaternions of every link's URDF frame, world."""
-        w, c = self.env.world, self.env.world.client
+        w, c = self.env.world, self.env.client
         pos = np.empty((len(self.links), 3))
         quat = np.empty((len(self.links), 4))
         for handle, children, columns, base in self._reads:

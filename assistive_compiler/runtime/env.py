@@ -76,8 +76,9 @@ class AssistiveEnv(gym.Env):
       ``human_action_space`` and ``human_observation_space``;
     * ``manifest`` (the compiled task), ``steps`` (env steps this episode), ``impairment`` (this
       episode's, drawn), ``success_threshold``;
-    * the scene as it is now: :attr:`person_body`, :meth:`marker_state`, :meth:`particle_state`,
-      :meth:`garment_nodes`, :attr:`arm_limit_reverts`;
+    * the scene as it is now: :attr:`person_body`, :attr:`person_variant`, :meth:`marker_state`,
+      :meth:`particle_state`, :meth:`garment_nodes`, :attr:`arm_limit_reverts`;
+    * reading pybullet directly, by name: :attr:`client`, :meth:`body_id`, :meth:`link_index`;
     * for controllers, renders and benchmarks that work on the physics itself: ``world``
       (:class:`~.world.World`: the pybullet client, body handles, link frames), ``snap`` (the
       :class:`~.snapshot.Snapshot` every term reads, refreshed each step; read it, never write it),
@@ -306,6 +307,43 @@ class AssistiveEnv(gym.Env):
     def person_body(self) -> str:
         """Body name of this episode's person variant (``person_<variant>``)."""
         return self.world.active_variant.body
+
+    @property
+    def person_variant(self) -> str:
+        """This episode's person variant (e.g. ``male_50th``)."""
+        return self.world.active_variant.name
+
+    @property
+    def client(self) -> int:
+        """The pybullet physics client of this env's world: pass it as ``physicsClientId`` to read
+        the simulation directly (tools, tests). Writing through it bypasses the env's bookkeeping."""
+        return self.world.client
+
+    def body_id(self, name: str) -> int:
+        """The pybullet body id of the scene's body ``name``: ``robot``, ``person`` (this episode's
+        variant), a variant's own name (``person_<variant>``), a tool or a piece of furniture."""
+        if name == "person":
+            name = self.person_body
+        if name not in self.world.bodies:
+            from ..errors import did_you_mean, one_of
+
+            known = ["person", *self.world.bodies]
+            raise KeyError(
+                f"no body '{name}' in this scene; expected one of {one_of(known)}{did_you_mean(name, known)}"
+            )
+        return self.world.bodies[name].id
+
+    def link_index(self, body: str, link: str) -> int:
+        """The pybullet link index of ``link`` of the body ``name`` (as :meth:`body_id`); −1 is the
+        base link. Links merged at compile time have none (their frames ride on the link they joined)."""
+        handle = self.world.bodies[self.person_body if body == "person" else body]
+        if link not in handle.links:
+            from ..errors import did_you_mean, one_of
+
+            raise KeyError(
+                f"{body} has no link '{link}'; expected one of {one_of(handle.links)}{did_you_mean(link, handle.links)}"
+            )
+        return handle.links[link]
 
     def marker_state(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """Marker set ``name``: every marker's position, (N, 3) world m (cleared ones too), and

@@ -63,7 +63,7 @@ def merged_links(env, variant: int = 0) -> list[str]:
 
 def self_contacts(env) -> list[tuple]:
     p = person(env)
-    return pb.getContactPoints(p.id, p.id, physicsClientId=env.world.client)
+    return pb.getContactPoints(p.id, p.id, physicsClientId=env.client)
 
 
 def touching(env) -> list[tuple]:
@@ -162,7 +162,7 @@ def forearm_into_torso(env, seed: int, self_collision: bool) -> tuple[float, int
     the number of self-contact points and their largest normal force (N)."""
     env.reset(seed=seed)
     p = person(env)
-    c = env.world.client
+    c = env.client
     if not self_collision:  # as before: no pair collides
         for a, b in itertools.combinations(sorted(p.links.values()), 2):
             pb.setCollisionFilterPair(p.id, p.id, a, b, 0, physicsClientId=c)

@@ -57,13 +57,13 @@ def person(env):
 def angles(env, joints) -> np.ndarray:
     p = person(env)
     return np.array(
-        [s[0] for s in pb.getJointStates(p.id, [p.joints[j] for j in joints], physicsClientId=env.env.world.client)]
+        [s[0] for s in pb.getJointStates(p.id, [p.joints[j] for j in joints], physicsClientId=env.env.client)]
     )
 
 
 def wrist(env, side: str) -> np.ndarray:
     p = person(env)
-    return np.array(pb.getLinkState(p.id, p.links[f"{side}_wrist"], physicsClientId=env.env.world.client)[4])
+    return np.array(pb.getLinkState(p.id, p.links[f"{side}_wrist"], physicsClientId=env.env.client)[4])
 
 
 def saturated_actions(n: int, seed: int) -> list[np.ndarray]:
@@ -80,7 +80,7 @@ def test_saturated_actions_never_leave_the_limits(task, impairment, coop_envs):
     _, infos = env.reset(seed=3)
     variant = env.env.world.active_variant
     movable = variant.movable_joints
-    p, c = person(env), env.env.world.client
+    p, c = person(env), env.env.client
     urdf = np.array([pb.getJointInfo(p.id, p.joints[j], physicsClientId=c)[8:10] for j in movable])
     lo, hi = urdf[:, 0].copy(), urdf[:, 1].copy()
     drawn = infos["human"]["impairment"]
@@ -150,7 +150,7 @@ def into_chest(env, side: str, seed: int, self_collision: bool = True) -> tuple[
     first, until the next seeded reset rebuilds the world). Returns the deepest penetration of forearm or hand into the chest's rigid link
     (m, negative), the number of self-contact points and their largest normal force (N)."""
     env.reset(seed=seed)
-    p, c = person(env), env.env.world.client
+    p, c = person(env), env.env.client
     if not self_collision:
         for i, j in itertools.combinations(sorted(p.links.values()), 2):
             pb.setCollisionFilterPair(p.id, p.id, i, j, 0, physicsClientId=c)

@@ -96,7 +96,7 @@ def test_events_left_out_of_the_manifest_are_not_applied(artifact):
 
 def test_reset_info_names_what_the_events_drew(env):
     _, info = env.reset(seed=5, options={"person_variant": "female_50th"})
-    assert info["person_variant"] == "female_50th" and env.world.active_variant.name == "female_50th"
+    assert info["person_variant"] == "female_50th" and env.person_variant == "female_50th"
     variant = next(v for v in env.manifest.person.variants if v.name == "female_50th")
     start = variant.starts[info["start"]]
     assert np.allclose(env.world.base_frame(env.world.robot)[0], start.base_position, atol=1e-6)

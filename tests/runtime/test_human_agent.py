@@ -64,9 +64,7 @@ def person(env):
 
 def angles(env, joints) -> np.ndarray:
     p = person(env)
-    return np.array(
-        [s[0] for s in pb.getJointStates(p.id, [p.joints[j] for j in joints], physicsClientId=env.world.client)]
-    )
+    return np.array([s[0] for s in pb.getJointStates(p.id, [p.joints[j] for j in joints], physicsClientId=env.client)])
 
 
 def watch_physics_steps(env, check):
@@ -165,7 +163,7 @@ def test_limits_hold_at_every_physics_step_under_saturated_actions(which, arm_en
     policy = env.manifest.person.policy_joints
     info = env.reset(seed=1)[1]
     p = person(env)
-    c = env.world.client
+    c = env.client
     urdf = np.array([pb.getJointInfo(p.id, p.joints[j], physicsClientId=c)[8:10] for j in policy])
     lo, hi = urdf[:, 0], urdf[:, 1]
     if which == "limited_range":
@@ -232,7 +230,7 @@ def test_weaker_arm_reaches_less(tmp_path_factory):
                     assert info["impairment"]["strength"] == 0.25
                     assert env.human.policy_forces == [3.0] * len(policy)
                 p = person(env)
-                c = env.world.client
+                c = env.client
                 z0 = pb.getLinkState(p.id, p.links["right_elbow"], physicsClientId=c)[4][2]
                 goal = angles(env, policy)
                 goal[policy.index("right_shoulder_y")] = math.radians(-60)
@@ -260,7 +258,7 @@ def test_arm_limit_guard_reverts_invalid_poses_in_the_running_sim(arm_env):
     model = AnalyticArmLimits()
     arm = list(ARM_LIMIT_JOINTS["right"])
     p = person(env)
-    c = env.world.client
+    c = env.client
     assert env.human.arm_side == "right" and isinstance(env.human.guard.model, AnalyticArmLimits)
     guard = env.human.guard
     events = {"reverted": 0, "steps": 0}

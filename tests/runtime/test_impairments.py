@@ -37,8 +37,8 @@ def env(tmp_path_factory):
 
 
 def head_angles(env) -> dict[str, float]:
-    person = env.world.variant_bodies[env.world.active_variant.name]
-    return {j: pb.getJointState(person.id, person.joints[j], physicsClientId=env.world.client)[0] for j in HEAD}
+    person = env.world.variant_bodies[env.person_variant]
+    return {j: pb.getJointState(person.id, person.joints[j], physicsClientId=env.client)[0] for j in HEAD}
 
 
 def test_draws_over_500_resets_follow_the_paper(env):
@@ -124,8 +124,8 @@ def test_a_compliant_arm_yields_where_a_held_one_does_not(tmp_path):
         spec.write_text(text)
         env = AssistiveEnv(compile_task(spec, "jaco", tmp_path / name).out_dir)
         env.reset(seed=0)
-        person = env.world.variant_bodies[env.world.active_variant.name]
-        c, elbow = env.world.client, person.joints["right_elbow"]
+        person = env.world.variant_bodies[env.person_variant]
+        c, elbow = env.client, person.joints["right_elbow"]
         before = pb.getJointState(person.id, elbow, physicsClientId=c)[0]
         for _ in range(10):
             for _ in range(env.manifest.sim.frame_skip):

@@ -42,7 +42,7 @@ def env(artifact):
 
 def water_in_cup_frame(env) -> np.ndarray:
     """Where the water is (carried particles where they are carried), in the cup frame (m)."""
-    w, c = env.world, env.world.client
+    w, c = env.world, env.client
     cup = w.bodies["cup"]
     pos, orn = w.base_frame(cup)
     inv = pb.invertTransform(pos, orn)
@@ -73,7 +73,7 @@ def tip_cup(env, start_deg: float, end_deg: float, steps: int) -> None:
     """Turn the cup in the hand about its x axis from ``start_deg`` to ``end_deg`` away from its grip
     over ``steps`` env steps (the fixed constraint's child frame), the arm holding still. The grip
     frame is identity in the cup (its inertial sits at its frame origin)."""
-    w, c = env.world, env.world.client
+    w, c = env.world, env.client
     cid = w.tool_constraints["cup"]
     for k in range(1, steps + 1):
         angle = math.radians(start_deg + (end_deg - start_deg) * k / steps)
@@ -93,7 +93,7 @@ def test_held_upright_cup_carries_its_water_for_a_whole_episode(env):
     assert env.particles.remaining("water") == 64 and env.particles.carried["water"].all()
     assert inside_cup(env).all()
     # Carried water is out of the physics: parked far away, touching nothing near the scene.
-    c = env.world.client
+    c = env.client
     for pid in env.world.particles["water"]:
         assert pb.getBasePositionAndOrientation(pid, physicsClientId=c)[0][1] > 100
 
@@ -103,7 +103,7 @@ def test_parked_particles_are_put_back_up_before_they_reach_the_ground(env):
     ``repark_steps`` env steps it goes back to its parking spot, so it never lands on the ground
     plane (where 64 resting contacts would cost solver work every physics step)."""
     env.reset(seed=0)
-    w, c = env.world, env.world.client
+    w, c = env.world, env.client
     ids = w.particles["water"]
     assert env.particles.repark_steps == 31  # free fall from 50 m to 1 m: 3.16 s of 0.1 s env steps
     lowest = math.inf
@@ -265,7 +265,7 @@ def feeding_artifact(tmp_path_factory):
 
 def spoon_gap_to_person(env) -> float:
     """The gap between the spoon and the person, m (inf: farther than 1 m)."""
-    w, c = env.world, env.world.client
+    w, c = env.world, env.client
     person = env.particles.snap.handle(env.particles.snap.body_key("person")).id
     points = pb.getClosestPoints(w.bodies["spoon"].id, person, 1.0, -1, physicsClientId=c)
     return min((p[8] for p in points), default=math.inf)

@@ -55,18 +55,18 @@ def where(env, handle) -> np.ndarray:
 
 
 def arm_angles(env) -> np.ndarray:
-    c = env.world.client
-    return np.array([s[0] for s in pb.getJointStates(env.world.robot.id, env.arm_idx, physicsClientId=c)])
+    c = env.client
+    return np.array([s[0] for s in pb.getJointStates(env.body_id("robot"), env.arm_idx, physicsClientId=c)])
 
 
 def particle_positions(env) -> np.ndarray:
-    c = env.world.client
+    c = env.client
     return np.array([pb.getBasePositionAndOrientation(p, physicsClientId=c)[0] for p in env.world.particles["food"]])
 
 
 def remove_food(env) -> None:
     """Teleport every food particle far from the spoon: the next step counts them lost and parks them."""
-    c = env.world.client
+    c = env.client
     for k, pid in enumerate(env.world.particles["food"]):
         pb.resetBasePositionAndOrientation(pid, (3.0 + 0.1 * k, 3.0, 1.0), (0, 0, 0, 1), physicsClientId=c)
 
@@ -160,7 +160,7 @@ def test_seeded_episodes_of_either_variant_replay_after_any_draws(make_env):
     drawn: dict[str, int] = {}
     for seed in range(40):
         env.reset(seed=seed)
-        drawn.setdefault(env.world.active_variant.name, seed)
+        drawn.setdefault(env.person_variant, seed)
     assert len(drawn) == 2
     actions = np.random.default_rng(5).uniform(-1.0, 1.0, (40, 7)).astype(np.float32)
     first, second = drawn.values()
@@ -186,12 +186,12 @@ def test_reset_with_the_same_seed_repeats_the_reset(env):
 
 def test_reset_reuses_the_world(env):
     env.reset(seed=0)
-    client = env.world.client
+    client = env.client
     bodies = pb.getNumBodies(physicsClientId=client)
     for seed in range(20):
         env.reset(seed=seed)
         env.step(np.zeros(7))
-    assert env.world.client == client
+    assert env.client == client
     assert pb.getNumBodies(physicsClientId=client) == bodies
 
 
@@ -218,7 +218,7 @@ def test_without_compensation_the_arm_falls(make_env):
     ee0 = where(env, env.tool_point)
     remove_food(env)
     env.world.gravity_groups = []
-    pb.setGravity(0, 0, -9.81, physicsClientId=env.world.client)
+    pb.setGravity(0, 0, -9.81, physicsClientId=env.client)
     for _ in range(50):
         env.step(np.zeros(7))
     assert ee0[2] - where(env, env.tool_point)[2] > 0.02
@@ -249,8 +249,8 @@ def test_contact_force_of_a_resting_body_equals_its_weight(make_env):
     env.reset(seed=0)
     for _ in range(30):
         env.step(np.zeros(7))
-    bowl = env.world.bodies["bowl"].id
-    mass = pb.getDynamicsInfo(bowl, -1, physicsClientId=env.world.client)[0]
+    bowl = env.body_id("bowl")
+    mass = pb.getDynamicsInfo(bowl, -1, physicsClientId=env.client)[0]
     assert env.snap.contact_force(["bowl"], ["table"]) == pytest.approx(mass * 9.81, rel=0.03)
 
 
@@ -302,7 +302,7 @@ def test_pooled_contacts_follow_the_world(make_env):
     env = make_env()
     env.reset(seed=0)
     snap = env.snap
-    c, bowl = env.world.client, env.world.bodies["bowl"].id
+    c, bowl = env.client, env.body_id("bowl")
     env.step(np.zeros(7, dtype=np.float32))
     resting = snap.contacts(["bowl"], ["table"])
     assert resting and snap.contacts(["bowl"], ["table"]) is resting  # pooled within the step
@@ -336,7 +336,7 @@ def test_food_starts_in_the_spoon_and_stays_while_still(env):
 
 def test_tipping_the_spoon_spills_the_food(env):
     env.reset(seed=0)
-    w, c = env.world, env.world.client
+    w, c = env.world, env.client
     joint = w.robot.joints[env.manifest.robot.arm_joints[-1]]
     q = pb.getJointState(w.robot.id, joint, physicsClientId=c)[0] + math.pi / 2
     assert env.manifest.robot.joint_lower[-1] <= q <= env.manifest.robot.joint_upper[-1]
@@ -362,7 +362,7 @@ def test_food_at_the_mouth_is_eaten_and_rewarded(env):
     sub-steps of dt.
     """
     env.reset(seed=0)
-    w, c, m = env.world, env.world.client, env.manifest
+    w, c, m = env.world, env.client, env.manifest
     mouth = where(env, env.snap.point(TargetPoint(target="mouth")))
     pid = w.particles["food"][0]
     n, dt = m.sim.frame_skip, m.sim.time_step
@@ -680,3 +680,26 @@ def test_package_import_is_light(tmp_path):
         [sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=tmp_path, check=True
     )
     assert json.loads(out.stdout.strip().splitlines()[-1]) == []
+
+
+def test_the_env_names_its_bodies_and_links_for_direct_reads(env):
+    """Tools and tests read the simulation through the env's client, by body and link name: the
+    person is this episode's variant, the base link is −1, and a wrong name lists the right ones."""
+    env.reset(seed=3)
+    assert env.body_id("person") == env.body_id(env.person_body) != env.body_id("robot")
+    assert env.person_body == f"person_{env.person_variant}"
+    assert pb.getNumJoints(env.body_id("person"), physicsClientId=env.client) == len(
+        env.manifest.person.variants[0].movable_joints
+    )
+    assert env.link_index("robot", "j2s7s300_link_base") == -1
+    ee = env.link_index("robot", "j2s7s300_end_effector")
+    assert pb.getJointInfo(env.body_id("robot"), ee, physicsClientId=env.client)[12] == b"j2s7s300_end_effector"
+    with pytest.raises(KeyError) as bad:
+        env.body_id("spon")
+    assert bad.value.args[0] == (
+        "no body 'spon' in this scene; expected one of 'bowl', 'person', 'person_female_50th', "
+        "'person_male_50th', 'robot', 'spoon', 'table', 'wheelchair' (did you mean 'spoon'?)"
+    )
+    with pytest.raises(KeyError) as bad:
+        env.link_index("spoon", "tray")
+    assert bad.value.args[0].startswith("spoon has no link 'tray'; expected one of ")

@@ -420,14 +420,14 @@ def test_person_settles_supine_on_the_mattress(bathing):
     env = bathing
     for seed in (0, 1):
         env.reset(seed=seed)
-        handle = env.world.variant_bodies[env.world.active_variant.name]
-        c = env.world.client
-        bed = env.world.bodies["bed"].id
+        handle = env.world.variant_bodies[env.person_variant]
+        c = env.client
+        bed = env.body_id("bed")
         gap = min(cp[8] for cp in pb.getClosestPoints(handle.id, bed, 0.1, physicsClientId=c))
         assert -0.02 < gap < 0.005  # resting on the bed: touching, not floating, not sunk in
         for link in ("right_shoulder", "right_elbow", "right_wrist"):  # the arm to wipe lies on the 0.73 m mattress
             assert 0.69 < pb.getAABB(handle.id, handle.links[link], physicsClientId=c)[0][2] < 0.78
-        chest_pos, chest_orn = env.world.base_frame(env.world.variant_bodies[env.world.active_variant.name])
+        chest_pos, chest_orn = env.world.base_frame(env.world.variant_bodies[env.person_variant])
         up = np.asarray(pb.getMatrixFromQuaternion(chest_orn)).reshape(3, 3)[:, 2]
         assert abs(up[1]) > 0.9  # the body's long axis (chest z) lies along the bed (±Y): supine
 
@@ -501,13 +501,13 @@ def test_nightstand_is_carried_under_the_searched_base(bathing):
 def test_closest_distance_equals_a_full_query_every_step(bathing):
     """closest_distance starts from its last answer; the result is the full query's minimum, exactly."""
     env = bathing
-    wiper = env.world.bodies["wiper"].id
+    wiper = env.body_id("wiper")
     rng = np.random.default_rng(3)
     env.reset(seed=3)
     for _ in range(60):
         env.step(rng.uniform(-1, 1, env.action_space.shape))
-        person = env.world.variant_bodies[env.world.active_variant.name].id
-        full = min([cp[8] for cp in pb.getClosestPoints(wiper, person, 5.0, physicsClientId=env.world.client)] + [5.0])
+        person = env.body_id("person")
+        full = min([cp[8] for cp in pb.getClosestPoints(wiper, person, 5.0, physicsClientId=env.client)] + [5.0])
         assert env.snap.closest_distance("wiper", ["person"], 5.0) == full
 
 
@@ -620,9 +620,9 @@ def test_closest_distance_term(bathing):
     env.reset(seed=0)
     env.snap.refresh()
     d = next(fn for name, _, fn in env.reward_fns if name == "distance_to_person")(env.snap)
-    wiper = env.world.bodies["wiper"].id
-    person = env.world.variant_bodies[env.world.active_variant.name].id
-    expected = min(cp[8] for cp in pb.getClosestPoints(wiper, person, 5.0, physicsClientId=env.world.client))
+    wiper = env.body_id("wiper")
+    person = env.body_id("person")
+    expected = min(cp[8] for cp in pb.getClosestPoints(wiper, person, 5.0, physicsClientId=env.client))
     assert d == pytest.approx(expected) and d > 0.05  # the start pose is well clear of the person
 
 

@@ -78,7 +78,7 @@ def test_two_arm_robot_acts_with_both_arms_and_holds_two_scoopers(pr2):
     }
     assert len(m.robot.gripper_joints) == 8 and set(m.robot.gripper_position) == {0.15}
     env.reset(seed=0)
-    w, c = env.world, env.world.client
+    w, c = env.world, env.client
     start = m.person.variants[0].starts[0]  # each arm's scooper starts near its own start pose
 
     def tool_in_hand(tool: str, link: str):

@@ -244,7 +244,7 @@ def _pixel(env, point, width=480, height=360) -> np.ndarray:
     """Where world ``point`` (m) lands in a render of the task's camera, pixels (x right, y down)."""
     from assistive_compiler.runtime.camera import camera_matrices, clip_transform
 
-    view_m, proj = camera_matrices(env.manifest.camera, width, height, env.world.client)
+    view_m, proj = camera_matrices(env.manifest.camera, width, height, env.client)
     clip = clip_transform(view_m, proj) @ np.array([*point, 1.0])
     return np.array([(clip[0] / clip[3] + 1.0) / 2.0 * width, (1.0 - clip[1] / clip[3]) / 2.0 * height])
 
@@ -256,7 +256,7 @@ def test_first_frame_after_reset_shows_the_sleeve_at_the_hand_not_where_it_was_l
     g = env.world.garments[0]
     at_hand = _pixel(env, _nodes(env).mean(axis=0))
     # pybullet's render copy of the soft body is still where the mesh was loaded until a step
-    stale_mesh = np.asarray(pb.getMeshData(g.soft_id, -1, physicsClientId=env.world.client)[1])
+    stale_mesh = np.asarray(pb.getMeshData(g.soft_id, -1, physicsClientId=env.client)[1])
     stale = _pixel(env, stale_mesh.mean(axis=0))
     assert np.linalg.norm(at_hand - stale) > 50.0  # the two places are far apart in the picture
     image = render_rgb(env)

@@ -65,9 +65,9 @@ def point(snap: Snapshot, body: str, link: str):
 
 def contacts(env, a: str, b: str) -> tuple:
     snap_ids = {"person": env.snap.handle("person").id}
-    ida = snap_ids.get(a) or env.world.bodies[a].id
-    idb = snap_ids.get(b) or env.world.bodies[b].id
-    return pb.getContactPoints(bodyA=ida, bodyB=idb, physicsClientId=env.world.client)
+    ida = snap_ids.get(a) or env.body_id(a)
+    idb = snap_ids.get(b) or env.body_id(b)
+    return pb.getContactPoints(bodyA=ida, bodyB=idb, physicsClientId=env.client)
 
 
 def press_spoon_into_face(env, snap: Snapshot, depth: float = 0.01, steps: int = 2) -> None:
@@ -301,8 +301,8 @@ def test_dressing_force(env, snap):
 
 
 def test_pressure(env, snap):
-    c = env.world.client
-    spoon_id, person_id = env.world.bodies["spoon"].id, env.snap.handle("person").id
+    c = env.client
+    spoon_id, person_id = env.body_id("spoon"), env.snap.handle("person").id
     # apart (just reset): no closest points within 1 cm → exactly 0
     snap.refresh()
     assert not pb.getClosestPoints(spoon_id, person_id, 0.01, physicsClientId=c)
@@ -349,7 +349,7 @@ def test_target_offset_follows_the_person_variant(env):
         seen.add(variant)
         person = env.snap.handle("person")
         state = pb.getLinkState(
-            person.id, person.links["head"], computeForwardKinematics=True, physicsClientId=env.world.client
+            person.id, person.links["head"], computeForwardKinematics=True, physicsClientId=env.client
         )
         rot = np.array(pb.getMatrixFromQuaternion(state[5])).reshape(3, 3)
         np.testing.assert_allclose(
