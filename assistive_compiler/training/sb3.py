@@ -5,9 +5,11 @@ each a :class:`~assistive_compiler.runtime.env.AssistiveEnv` built from the run'
 artifact, optionally (PPO) behind :class:`VecNormalize` (running observation and return
 statistics, saved with every checkpoint). A co-optimisation run (``coop``, SAC only) trains the
 robot and the person together: each env is :class:`~assistive_compiler.coop.joint.JointAgentsEnv`
-and the actor one network per agent with one shared critic (:mod:`.factored_actor`). A checkpoint is a directory holding ``model.zip``, PPO's
-``vecnormalize.pkl`` and SAC's ``replay_buffer.pkl`` (kept in the newest checkpoint only: it is
-the bulk of a checkpoint); resuming loads them and continues the step count.
+and the actor one network per agent with one shared critic (:mod:`.factored_actor`).
+
+A checkpoint is a directory holding ``model.zip``, PPO's ``vecnormalize.pkl`` and SAC's
+``replay_buffer.pkl`` (kept in the newest checkpoint only: it is the bulk of a checkpoint);
+resuming loads them and continues the step count.
 """
 
 from __future__ import annotations
