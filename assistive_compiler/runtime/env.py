@@ -322,28 +322,28 @@ class AssistiveEnv(gym.Env):
     def body_id(self, name: str) -> int:
         """The pybullet body id of the scene's body ``name``: ``robot``, ``person`` (this episode's
         variant), a variant's own name (``person_<variant>``), a tool or a piece of furniture."""
-        if name == "person":
-            name = self.person_body
-        if name not in self.world.bodies:
-            from ..errors import did_you_mean, one_of
-
-            known = ["person", *self.world.bodies]
-            raise KeyError(
-                f"no body '{name}' in this scene; expected one of {one_of(known)}{did_you_mean(name, known)}"
-            )
-        return self.world.bodies[name].id
+        return self._body(name).id
 
     def link_index(self, body: str, link: str) -> int:
         """The pybullet link index of ``link`` of the body ``name`` (as :meth:`body_id`); −1 is the
         base link. Links merged at compile time have none (their frames ride on the link they joined)."""
-        handle = self.world.bodies[self.person_body if body == "person" else body]
-        if link not in handle.links:
+        links = self._body(body).links
+        if link not in links:
             from ..errors import did_you_mean, one_of
 
-            raise KeyError(
-                f"{body} has no link '{link}'; expected one of {one_of(handle.links)}{did_you_mean(link, handle.links)}"
-            )
-        return handle.links[link]
+            raise KeyError(f"{body} has no link '{link}'; expected one of {one_of(links)}{did_you_mean(link, links)}")
+        return links[link]
+
+    def _body(self, name: str):
+        """The world's handle of body ``name`` (``person``: this episode's variant); a wrong name
+        lists the scene's bodies."""
+        key = self.person_body if name == "person" else name
+        if key not in self.world.bodies:
+            from ..errors import did_you_mean, one_of
+
+            known = ["person", *self.world.bodies]
+            raise KeyError(f"no body '{key}' in this scene; expected one of {one_of(known)}{did_you_mean(key, known)}")
+        return self.world.bodies[key]
 
     def marker_state(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """Marker set ``name``: every marker's position, (N, 3) world m (cleared ones too), and

@@ -184,22 +184,20 @@ def export_run(
         policy = mlp_from_sb3(original, config.algorithm, config.network.activation)
         worst = check_same_actions(policy, original, rng.normal(0.0, 1.0, (32, policy.obs_dim)))
     else:
+        from ..policies.checkpoint import SINGLE_MODULE, RLlibPolicy, SB3PairPolicy
+
+        agents: SB3PairPolicy | RLlibPolicy  # each agent's checkpoint policy, by name: .agent(name)
         if info.engine == "sb3":
-            from ..policies.checkpoint import SB3PairPolicy
-
-            pair = SB3PairPolicy(checkpoint, config.algorithm)
-            parts, act = pair_from_sb3(pair, config.network.activation), pair.agent
+            agents = SB3PairPolicy(checkpoint, config.algorithm)
+            parts = pair_from_sb3(agents, config.network.activation)
         else:
-            from ..policies.checkpoint import SINGLE_MODULE, RLlibPolicy
-
-            rllib = RLlibPolicy(checkpoint, info.coop, config.algorithm)
+            agents = RLlibPolicy(checkpoint, info.coop, config.algorithm)
             parts = {
                 name: mlp_from_rllib(module, config.algorithm, config.network.activation)
-                for name, module in rllib.modules.items()
+                for name, module in agents.modules.items()
             }
-            act = lambda name: lambda o: rllib._act(name, o)  # noqa: E731
         worst = max(
-            check_same_actions(part, act(name), rng.normal(0.0, 1.0, (32, part.obs_dim)))
+            check_same_actions(part, agents.agent(name), rng.normal(0.0, 1.0, (32, part.obs_dim)))
             for name, part in parts.items()
         )
         policy = CoopPolicy(parts["robot"], parts["human"], {}) if info.coop else parts[SINGLE_MODULE]
