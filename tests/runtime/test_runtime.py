@@ -703,3 +703,6 @@ def test_the_env_names_its_bodies_and_links_for_direct_reads(env):
     with pytest.raises(KeyError) as bad:
         env.link_index("spoon", "tray")
     assert bad.value.args[0].startswith("spoon has no link 'tray'; expected one of ")
+    with pytest.raises(KeyError) as bad:
+        env.link_index("spon", "tray")
+    assert bad.value.args[0].startswith("no body 'spon' in this scene;")
