@@ -85,25 +85,12 @@ def stage_shares(trace: dict) -> dict[str, float]:
     return shares
 
 
-def body_names(env) -> dict[int, str]:
-    """Body id -> the name a spec uses (every person variant as ``person``, particles as their set,
-    the ground as ``ground``)."""
-    world = env.world
-    names = {h.id: name for name, h in world.bodies.items()}
-    for v in env.manifest.person.variants:
-        names[world.variant_bodies[v.name].id] = "person"
-    for set_name, ids in world.particles.items():
-        names.update({bid: set_name for bid in ids})
-    names[world.ground] = "ground"
-    return names
-
-
 def profile_episode(env, actions: list[np.ndarray], seed: int) -> tuple[dict[str, float], dict[str, float]]:
     """One seeded episode of ``actions`` under Bullet's profiler: each stage's share of the physics
     (:func:`stage_shares`) and the contact points per env step by body pair (``"a – b"``, the last
     physics step's, most first)."""
     c = env.client
-    names = body_names(env)
+    names = env.body_names()
     contacts: collections.Counter = collections.Counter()
     env.reset(seed=seed)
     with tempfile.TemporaryDirectory() as tmp:

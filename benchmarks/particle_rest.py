@@ -39,13 +39,13 @@ from assistive_compiler.spec.load import load_spec  # noqa: E402
 
 def container_frame(env, ps, box) -> np.ndarray:
     """Every particle of set ``ps`` in the frame of container ``box``, (n, 3) m."""
-    w, c = env.world, env.world.client
-    pos, orn = w.base_frame(w.bodies[box.body])
+    c = env.client
+    pos, orn = env.base_pose(box.body)
     inv = pb.invertTransform(pos, orn)
     return np.array(
         [
             pb.multiplyTransforms(*inv, pb.getBasePositionAndOrientation(pid, physicsClientId=c)[0], (0, 0, 0, 1))[0]
-            for pid in w.particles[ps.name]
+            for pid in env.particle_ids(ps.name)
         ]
     )
 
@@ -67,7 +67,7 @@ def creep(artifact: Path, box, angles: list[int]) -> None:
         n = max(2, theta // 5)
         for k in range(1, n + 1):
             turn = pb.getQuaternionFromEuler([-math.radians(theta * k / n), 0, 0])
-            pb.changeConstraint(grip, jointChildFrameOrientation=turn, maxForce=500, physicsClientId=env.world.client)
+            pb.changeConstraint(grip, jointChildFrameOrientation=turn, maxForce=500, physicsClientId=env.client)
             env.step(hold)
         for _ in range(20):
             env.step(hold)

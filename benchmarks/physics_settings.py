@@ -72,24 +72,24 @@ class EpisodeProbe:
 
     def __init__(self, env: AssistiveEnv):
         self.env = env
-        w, m = env.world, env.manifest
-        c = w.client
-        self.intruders = [w.robot.id] + [w.bodies[b.name].id for b in m.bodies if b.kind == "tool"]
-        self.intruders += [pid for ids in w.particles.values() for pid in ids]
-        self.furniture = {w.bodies[b.name].id for b in m.bodies if b.kind == "furniture"}
+        m, c = env.manifest, env.client
+        self.robot = env.body_id("robot")
+        self.intruders = [self.robot] + [env.body_id(b.name) for b in m.bodies if b.kind == "tool"]
+        self.intruders += [pid for ps in m.particles for pid in env.particle_ids(ps.name)]
+        self.furniture = {env.body_id(b.name) for b in m.bodies if b.kind == "furniture"}
         movable = [
             j
-            for j in range(pb.getNumJoints(w.robot.id, physicsClientId=c))
-            if pb.getJointInfo(w.robot.id, j, physicsClientId=c)[2] != pb.JOINT_FIXED
+            for j in range(pb.getNumJoints(self.robot, physicsClientId=c))
+            if pb.getJointInfo(self.robot, j, physicsClientId=c)[2] != pb.JOINT_FIXED
         ]
         self.robot_idle = [j for j in movable if j not in set(env.arm_idx)]
 
     def begin(self) -> None:
-        env, c = self.env, self.env.world.client
+        env, c = self.env, self.env.client
         h = env.human
         compliant = set(env.manifest.person.compliant_joints)
         tremor = {k for k, _ in h._tremor}
-        variant = env.world.active_variant
+        variant = next(v for v in env.manifest.person.variants if v.name == env.person_variant)
         self.person_id = h.body_id
         self.held = {}  # kind → (joint indices, hold angles)
         for kind, soft in (("stiff", False), ("compliant", True)):
@@ -97,7 +97,7 @@ class EpisodeProbe:
             if keep:
                 self.held[kind] = ([h.idx[k] for k in keep], np.array([h.hold[k] for k in keep]))
         self.idle_q = (
-            np.array([s[0] for s in pb.getJointStates(env.world.robot.id, self.robot_idle, physicsClientId=c)])
+            np.array([s[0] for s in pb.getJointStates(self.robot, self.robot_idle, physicsClientId=c)])
             if self.robot_idle
             else None
         )
@@ -107,7 +107,7 @@ class EpisodeProbe:
         self.lost = self.consumed = 0
 
     def after_step(self, info: dict) -> None:
-        env, c = self.env, self.env.world.client
+        env, c = self.env, self.env.client
         self.forces.append(info["total_force_on_human"])
         targets = self.targets
         for a in self.intruders:
@@ -122,7 +122,7 @@ class EpisodeProbe:
             q = np.array([s[0] for s in pb.getJointStates(self.person_id, idx, physicsClientId=c)])
             self.hold_drift[kind] = max(self.hold_drift[kind], float(np.max(np.abs(q - hold))))
         if self.idle_q is not None:
-            q = np.array([s[0] for s in pb.getJointStates(env.world.robot.id, self.robot_idle, physicsClientId=c)])
+            q = np.array([s[0] for s in pb.getJointStates(self.robot, self.robot_idle, physicsClientId=c)])
             self.idle_drift = max(self.idle_drift, float(np.max(np.abs(q - self.idle_q))))
 
 

@@ -55,8 +55,7 @@ class _Track:
         self.steps_m = [w.step_m for w in waypoints]
         self.turn_steps = [w.turn_step_rad for w in waypoints]
         self.repeat_from = script.repeat_from
-        robot = env.world.robot
-        self.ee_link = robot.links[mount_link]
+        self.ee_link = env.link_index("robot", mount_link)
         self.ee_point = snap.point(LinkPoint(body="robot", link=mount_link))
         order = list(m.robot.arm_joints)
         self.action_cols = [
@@ -89,12 +88,11 @@ class ScriptedPolicy:
             ]
         else:
             self.tracks = [_Track(env, m.scripted, links["tool_mount"], list(m.robot.arm_joints))]
-        robot = env.world.robot
-        c = env.client
+        robot, c = env.body_id("robot"), env.client
         movable = [
             j
-            for j in range(pb.getNumJoints(robot.id, physicsClientId=c))
-            if pb.getJointInfo(robot.id, j, physicsClientId=c)[2] != pb.JOINT_FIXED
+            for j in range(pb.getNumJoints(robot, physicsClientId=c))
+            if pb.getJointInfo(robot, j, physicsClientId=c)[2] != pb.JOINT_FIXED
         ]
         self.movable = movable
         # Each arm joint with its followers: IK spreads a move over the group, the action is their mean.
@@ -102,16 +100,20 @@ class ScriptedPolicy:
         for track in self.tracks:
             track.cols = [
                 [movable.index(env.arm_idx[k])]
-                + [movable.index(robot.joints[f]) for f, lead in followers.items() if lead == m.robot.arm_joints[k]]
+                + [
+                    movable.index(env.joint_index("robot", f))
+                    for f, lead in followers.items()
+                    if lead == m.robot.arm_joints[k]
+                ]
                 for k in track.action_cols
             ]
-        self.lo_all = [pb.getJointInfo(robot.id, j, physicsClientId=c)[8] for j in movable]
-        self.hi_all = [pb.getJointInfo(robot.id, j, physicsClientId=c)[9] for j in movable]
+        self.lo_all = [pb.getJointInfo(robot, j, physicsClientId=c)[8] for j in movable]
+        self.hi_all = [pb.getJointInfo(robot, j, physicsClientId=c)[9] for j in movable]
         self.ranges = [max(h - link, 1e-3) for link, h in zip(self.lo_all, self.hi_all)]
         # A mobile base drives: IK moves its planar joints with the arm, and the wheel actions head
         # for the planar change it asks of the base (see :meth:`_wheels`).
         # The robot's own script may damp some arm joints (e.g. a slow shoulder).
-        own = {robot.joints[name]: value for name, value in (m.scripted.ik_damping or {}).items()}
+        own = {env.joint_index("robot", name): value for name, value in (m.scripted.ik_damping or {}).items()}
         self.damping = ik_damping(movable, [], env.drive.idx if env.drive else [], own)
         self.drive_cols = [movable.index(j) for j in env.drive.idx] if env.drive else []
         self.arm_offset = 2 if env.drive else 0

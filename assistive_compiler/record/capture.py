@@ -19,20 +19,26 @@ class SceneReader:
 
     def __init__(self, env):
         self.env = env
-        w, m = env.world, env.manifest
+        m = env.manifest
         self.bodies: list[dict] = []
         self.links: list[list[str]] = []
-        #: Per body: (handle, [link indices ≥ 0], their columns, column of the base)
+        #: Per body: (name, pybullet id, [link indices ≥ 0], their columns, column of the base)
         self._reads: list[tuple] = []
         for body in m.bodies:
-            handle = w.bodies[body.name]
-            names = sorted(handle.links, key=handle.links.get)  # base (-1) first, then joint order
+            links = env.links(body.name)
+            names = sorted(links, key=links.get)  # base (-1) first, then joint order
             first = len(self.links)
             self.links += [[body.name, name] for name in names]
             self.bodies.append({"name": body.name, "kind": body.kind, "urdf": body.urdf, "links": names})
-            children = [handle.links[n] for n in names if handle.links[n] >= 0]
+            children = [links[n] for n in names if links[n] >= 0]
             self._reads.append(
-                (handle, children, [first + k for k, n in enumerate(names) if handle.links[n] >= 0], first)
+                (
+                    body.name,
+                    env.body_id(body.name),
+                    children,
+                    [first + k for k, n in enumerate(names) if links[n] >= 0],
+                    first,
+                )
             )
         for g in m.garments:
             self.bodies.append({"name": g.name, "kind": "garment", "urdf": g.obj, "links": []})
@@ -63,14 +69,14 @@ class SceneReader:
 
     def link_poses(self) -> tuple[np.ndarray, np.ndarray]:
         """(L, 3) positions and (L, 4) quaternions of every link's URDF frame, world."""
-        w, c = self.env.world, self.env.client
+        env, c = self.env, self.env.client
         pos = np.empty((len(self.links), 3))
         quat = np.empty((len(self.links), 4))
-        for handle, children, columns, base in self._reads:
-            pos[base], quat[base] = w.base_frame(handle)
+        for name, body_id, children, columns, base in self._reads:
+            pos[base], quat[base] = env.base_pose(name)
             if children:
                 for col, s in zip(
-                    columns, pb.getLinkStates(handle.id, children, computeForwardKinematics=1, physicsClientId=c)
+                    columns, pb.getLinkStates(body_id, children, computeForwardKinematics=1, physicsClientId=c)
                 ):
                     pos[col], quat[col] = s[4], s[5]
         return pos, quat

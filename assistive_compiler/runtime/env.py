@@ -32,6 +32,7 @@ but can differ in the last digits from a replay.
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 import gymnasium as gym
@@ -76,9 +77,12 @@ class AssistiveEnv(gym.Env):
       ``human_action_space`` and ``human_observation_space``;
     * ``manifest`` (the compiled task), ``steps`` (env steps this episode), ``impairment`` (this
       episode's, drawn), ``success_threshold``;
-    * the scene as it is now: :attr:`person_body`, :attr:`person_variant`, :meth:`marker_state`,
-      :meth:`particle_state`, :meth:`garment_nodes`, :attr:`arm_limit_reverts`;
-    * reading pybullet directly, by name: :attr:`client`, :meth:`body_id`, :meth:`link_index`;
+    * the scene as it is now: :attr:`person_body`, :attr:`person_variant`, :attr:`active_variant`, :meth:`marker_state`,
+      :meth:`particle_state`, :meth:`garment_nodes`, :attr:`arm_limit_reverts`, and the poses of
+      bodies and links by name (:meth:`base_pose`, :meth:`link_pose`; URDF frames, world);
+    * reading pybullet directly, by name: :attr:`client`, :meth:`body_id`, :meth:`link_index`,
+      :meth:`joint_index`, :meth:`links`, :meth:`joints`, :meth:`particle_ids`, and back from ids to names, :meth:`body_names`;
+    * ``physics_s``, the time its steps spent in physics (benchmarks);
     * for controllers, renders and benchmarks that work on the physics itself: ``world``
       (:class:`~.world.World`: the pybullet client, body handles, link frames), ``snap`` (the
       :class:`~.snapshot.Snapshot` every term reads, refreshed each step; read it, never write it),
@@ -149,6 +153,9 @@ class AssistiveEnv(gym.Env):
         self.observation_space = self.robot_features.space
         self.action_space = gym.spaces.Box(-1.0, 1.0, (m.robot.action_size,), np.float32)
         self.steps = 0
+        #: Wall seconds spent in physics (``stepSimulation`` and its per-step forces) by this env's
+        #: steps since it was built: a benchmark's step minus this is the env's own cost.
+        self.physics_s = 0.0
         self.success_metric: float | None = None
         #: Whether the world has seen anything since it was built (a reset runs collision
         #: detection, a step physics): a seeded reset then rebuilds it, to replay bit for bit.
@@ -271,7 +278,9 @@ class AssistiveEnv(gym.Env):
         step = EnvStep(self.steps, human)
         for component in self._stepped:
             component.before_physics(step)
+        t0 = time.perf_counter()
         w.step_physics()
+        self.physics_s += time.perf_counter() - t0
         self.steps += 1
         self.snap.actions["robot"] = raw
         if self.drive:  # robot_base observations are in the moving base's frame
@@ -309,6 +318,12 @@ class AssistiveEnv(gym.Env):
         return self.world.active_variant.body
 
     @property
+    def active_variant(self):
+        """This episode's person variant as the manifest describes it
+        (:class:`~assistive_compiler.artifact.PersonVariant`: its body, movable joints, markers, surfaces)."""
+        return self.world.active_variant
+
+    @property
     def person_variant(self) -> str:
         """This episode's person variant (e.g. ``male_50th``)."""
         return self.world.active_variant.name
@@ -333,6 +348,61 @@ class AssistiveEnv(gym.Env):
 
             raise KeyError(f"{body} has no link '{link}'; expected one of {one_of(links)}{did_you_mean(link, links)}")
         return links[link]
+
+    def joint_index(self, body: str, joint: str) -> int:
+        """The pybullet joint index of ``joint`` of the body ``body`` (as :meth:`body_id`); welded
+        and merged joints included while they are in the compiled URDF."""
+        joints = self._body(body).joints
+        if joint not in joints:
+            from ..errors import did_you_mean, one_of
+
+            raise KeyError(
+                f"{body} has no joint '{joint}'; expected one of {one_of(joints)}{did_you_mean(joint, joints)}"
+            )
+        return joints[joint]
+
+    def links(self, body: str) -> dict[str, int]:
+        """Every link of the body ``body`` (as :meth:`body_id`) that survived the compile-time merge,
+        by name: its pybullet link index, −1 for the base (a copy)."""
+        return dict(self._body(body).links)
+
+    def joints(self, body: str) -> dict[str, int]:
+        """Every joint of the body ``body`` (as :meth:`body_id`) in its compiled URDF, by name: its
+        pybullet joint index (a copy)."""
+        return dict(self._body(body).joints)
+
+    def link_pose(self, body: str, link: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """World pose of ``link``'s URDF frame (m; quaternion x, y, z, w), the base link's too (not
+        pybullet's centre-of-mass frame). ``body`` and ``link`` as :meth:`link_index`."""
+        handle = self._body(body)
+        return self.world.link_frame(handle, self.link_index(body, link))
+
+    def base_pose(self, body: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """World pose of the body's URDF base frame (m; quaternion x, y, z, w): where the spec
+        places it, not pybullet's centre-of-mass frame."""
+        return self.world.base_frame(self._body(body))
+
+    def particle_ids(self, name: str) -> list[int]:
+        """The pybullet body ids of particle set ``name``'s particles, in the set's order (a copy)."""
+        sets = self.world.particles
+        if name not in sets:
+            from ..errors import did_you_mean, one_of
+
+            raise KeyError(
+                f"no particle set '{name}' in this scene; expected one of {one_of(sets)}{did_you_mean(name, sets)}"
+            )
+        return list(sets[name])
+
+    def body_names(self) -> dict[int, str]:
+        """Pybullet body id → the name a spec uses: every person variant is ``person``, each
+        particle its set's name, the floor ``ground`` (e.g. to name the bodies of contact points)."""
+        w = self.world
+        names = {h.id: name for name, h in w.bodies.items()}
+        names.update({w.variant_bodies[v.name].id: "person" for v in self.manifest.person.variants})
+        for set_name, ids in w.particles.items():
+            names.update({bid: set_name for bid in ids})
+        names[w.ground] = "ground"
+        return names
 
     def _body(self, name: str):
         """The world's handle of body ``name`` (``person``: this episode's variant); a wrong name

@@ -13,6 +13,7 @@ from __future__ import annotations
 import itertools
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pybullet as pb
@@ -51,8 +52,8 @@ def leg_env(tmp_path_factory):
 
 
 def person(env):
-    w = env.world
-    return w.variant_bodies[w.active_variant.name]
+    """This episode's person body: its pybullet id and its links and joints by name."""
+    return SimpleNamespace(id=env.body_id("person"), links=env.links("person"), joints=env.joints("person"))
 
 
 def merged_links(env, variant: int = 0) -> list[str]:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import itertools
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pybullet as pb
@@ -50,8 +51,8 @@ def coop_envs(tmp_path_factory):
 
 
 def person(env):
-    w = env.env.world
-    return w.variant_bodies[w.active_variant.name]
+    """This episode's person body: its pybullet id and its links and joints by name."""
+    return SimpleNamespace(id=env.env.body_id("person"), links=env.env.links("person"), joints=env.env.joints("person"))
 
 
 def angles(env, joints) -> np.ndarray:
@@ -78,7 +79,7 @@ def test_saturated_actions_never_leave_the_limits(task, impairment, coop_envs):
     env = coop_envs(task, impairment)
     side = SIDE[task]
     _, infos = env.reset(seed=3)
-    variant = env.env.world.active_variant
+    variant = env.env.active_variant
     movable = variant.movable_joints
     p, c = person(env), env.env.client
     urdf = np.array([pb.getJointInfo(p.id, p.joints[j], physicsClientId=c)[8:10] for j in movable])

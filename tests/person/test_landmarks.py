@@ -56,9 +56,11 @@ def test_a_landmark_is_a_point_and_a_target_link_in_a_compiled_task(tmp_path):
         for seed in (0, 1, 2):
             env.reset(seed=seed)
             variant = env.person_variant
-            handle = env.world.bodies[env.person_body]
             state = pb.getLinkState(
-                handle.id, handle.links["head"], computeForwardKinematics=1, physicsClientId=env.client
+                env.body_id("person"),
+                env.link_index("person", "head"),
+                computeForwardKinematics=1,
+                physicsClientId=env.client,
             )
             # The nose, which an observation term reads, where the variant's head has it.
             nose = np.asarray(state[4]) + quat_rotate(np.asarray(state[5]), np.asarray(offsets(variant)["nose"][1]))

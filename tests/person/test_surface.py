@@ -174,7 +174,7 @@ def test_a_surface_target_on_the_head_is_drawn_in_its_region_anew_each_episode(t
         spots = []
         for seed in (0, 1, 2, 0):
             env.reset(seed=seed)
-            variant = env.world.active_variant
+            variant = env.active_variant
             nose = np.asarray(landmark_offsets(lib.person_urdf(variant.name))["nose"][1])
             offset = np.asarray(env.snap.target_offsets["spot"])
             assert env.manifest.targets["spot"].link == "head"

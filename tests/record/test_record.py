@@ -53,9 +53,8 @@ def test_replay_reproduces_poses_and_terms(env, recorded):
     )
     assert h["content_hash"] == env.manifest.content_hash and len(h["content_hash"]) == 64
     assert h["gym_id"] == "assistive_compiler/FeedingJaco-v1" and h["dt"] == pytest.approx(0.1)
-    w = env.world
     ee = env.manifest.robot.links["tool_mount"]
-    spoon_link = next(name for name, i in w.bodies["spoon"].links.items() if i == -1)
+    spoon_link = next(name for name, i in env.links("spoon").items() if i == -1)
     policy = make_policy("scripted", env)
     obs, _ = env.reset(seed=0)
     for k in range(rec.steps + 1):
@@ -63,9 +62,9 @@ def test_replay_reproduces_poses_and_terms(env, recorded):
             obs, _, _, _, info = env.step(policy(obs))
             assert [info["terms"][n] for n in h["terms"]] == rec.arrays["terms"][k - 1].tolist()
         pos, quat = rec.pose(k, "robot", ee)
-        assert np.array_equal(pos, w.link_frame(w.robot, w.robot.links[ee])[0])
-        assert np.array_equal(quat, w.link_frame(w.robot, w.robot.links[ee])[1])
-        assert np.array_equal(rec.pose(k, "spoon", spoon_link)[0], w.base_frame(w.bodies["spoon"])[0])
+        assert np.array_equal(pos, env.link_pose("robot", ee)[0])
+        assert np.array_equal(quat, env.link_pose("robot", ee)[1])
+        assert np.array_equal(rec.pose(k, "spoon", spoon_link)[0], env.base_pose("spoon")[0])
         assert np.array_equal(rec.arrays["observations"][k], obs)
         assert np.allclose(
             rec.arrays["target_pos"][k, h["targets"].index("mouth")],

@@ -224,8 +224,7 @@ def test_action_and_observation_sizes_are_the_references(scratch_env):
 
 
 def _drive_state(env):
-    w = env.world
-    return np.array([s[0] for s in pb.getJointStates(w.robot.id, env.drive.idx, physicsClientId=w.client)])
+    return np.array([s[0] for s in pb.getJointStates(env.body_id("robot"), env.drive.idx, physicsClientId=env.client)])
 
 
 def test_equal_wheel_actions_drive_straight_and_opposite_ones_turn_in_place(scratch_env):
@@ -247,10 +246,12 @@ def test_one_action_extends_all_four_tubes(scratch_env):
     # duplication); the inner tubes carry less and get there first, as in the reference.
     env = scratch_env
     env.reset(seed=0)
-    w = env.world
     for _ in range(5):
         env.step(np.array([0.0, 0.0, 0.0, 1.0, 0.0]))
-    tubes = [pb.getJointState(w.robot.id, w.robot.joints[t], physicsClientId=w.client)[0] for t in TUBES]
+    tubes = [
+        pb.getJointState(env.body_id("robot"), env.joint_index("robot", t), physicsClientId=env.client)[0]
+        for t in TUBES
+    ]
     assert min(tubes) > 0.01
 
 
@@ -284,10 +285,9 @@ def _drive_to_goal(env, ahead_m: float, steps: int) -> tuple[list[np.ndarray], f
     policy = ScriptedPolicy(env)
     actions = [policy(obs)]  # the first call reads the episode's start
     track, snap = policy.tracks[0], env.snap
-    w = env.world
-    heading = pb.getMatrixFromQuaternion(pb.getLinkState(w.robot.id, env.drive.base_link, physicsClientId=w.client)[1])[
-        0::3
-    ]
+    heading = pb.getMatrixFromQuaternion(
+        pb.getLinkState(env.body_id("robot"), env.drive.base_link, physicsClientId=env.client)[1]
+    )[0::3]
     goal = snap.position(track.move) + ahead_m * np.asarray(heading)
     # One fixed goal in the world instead of the task's waypoints, held to the end.
     track.waypoints, track.orientations, track.face_normal, track.steps_m, track.repeat_from = (

@@ -87,7 +87,7 @@ def test_events_left_out_of_the_manifest_are_not_applied(artifact):
     try:
         for seed in (0, 1, 2):
             _, info = env.reset(seed=seed)
-            pos = env.world.base_frame(env.world.bodies["bowl"])[0]
+            pos = env.base_pose("bowl")[0]
             assert pos == pytest.approx(still.body("bowl").position, abs=1e-6)
             assert info["person_variant"] in ("male_50th", "female_50th")
     finally:
@@ -99,7 +99,7 @@ def test_reset_info_names_what_the_events_drew(env):
     assert info["person_variant"] == "female_50th" and env.person_variant == "female_50th"
     variant = next(v for v in env.manifest.person.variants if v.name == "female_50th")
     start = variant.starts[info["start"]]
-    assert np.allclose(env.world.base_frame(env.world.robot)[0], start.base_position, atol=1e-6)
+    assert np.allclose(env.base_pose("robot")[0], start.base_position, atol=1e-6)
     assert info["impairment"]["kind"] in {i.kind for i in env.manifest.person.impairments}
 
 

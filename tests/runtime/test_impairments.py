@@ -37,8 +37,8 @@ def env(tmp_path_factory):
 
 
 def head_angles(env) -> dict[str, float]:
-    person = env.world.variant_bodies[env.person_variant]
-    return {j: pb.getJointState(person.id, person.joints[j], physicsClientId=env.client)[0] for j in HEAD}
+    person = env.body_id("person")
+    return {j: pb.getJointState(person, env.joint_index("person", j), physicsClientId=env.client)[0] for j in HEAD}
 
 
 def test_draws_over_500_resets_follow_the_paper(env):
@@ -124,15 +124,14 @@ def test_a_compliant_arm_yields_where_a_held_one_does_not(tmp_path):
         spec.write_text(text)
         env = AssistiveEnv(compile_task(spec, "jaco", tmp_path / name).out_dir)
         env.reset(seed=0)
-        person = env.world.variant_bodies[env.person_variant]
-        c, elbow = env.client, person.joints["right_elbow"]
-        before = pb.getJointState(person.id, elbow, physicsClientId=c)[0]
+        person, c, elbow = env.body_id("person"), env.client, env.joint_index("person", "right_elbow")
+        before = pb.getJointState(person, elbow, physicsClientId=c)[0]
         for _ in range(10):
             for _ in range(env.manifest.sim.frame_skip):
                 pb.applyExternalTorque(
-                    person.id, elbow, (20.0, 0, 0), pb.LINK_FRAME, physicsClientId=c
+                    person, elbow, (20.0, 0, 0), pb.LINK_FRAME, physicsClientId=c
                 )  # on the elbow joint's child link
                 pb.stepSimulation(physicsClientId=c)
-        moved[name] = abs(pb.getJointState(person.id, elbow, physicsClientId=c)[0] - before)
+        moved[name] = abs(pb.getJointState(person, elbow, physicsClientId=c)[0] - before)
         env.close()
     assert moved["compliant"] > 0.1 and moved["held"] < 0.02, moved

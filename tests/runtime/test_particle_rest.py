@@ -94,7 +94,7 @@ def test_held_upright_cup_carries_its_water_for_a_whole_episode(env):
     assert inside_cup(env).all()
     # Carried water is out of the physics: parked far away, touching nothing near the scene.
     c = env.client
-    for pid in env.world.particles["water"]:
+    for pid in env.particle_ids("water"):
         assert pb.getBasePositionAndOrientation(pid, physicsClientId=c)[0][1] > 100
 
 

@@ -61,13 +61,13 @@ def arm_angles(env) -> np.ndarray:
 
 def particle_positions(env) -> np.ndarray:
     c = env.client
-    return np.array([pb.getBasePositionAndOrientation(p, physicsClientId=c)[0] for p in env.world.particles["food"]])
+    return np.array([pb.getBasePositionAndOrientation(p, physicsClientId=c)[0] for p in env.particle_ids("food")])
 
 
 def remove_food(env) -> None:
     """Teleport every food particle far from the spoon: the next step counts them lost and parks them."""
     c = env.client
-    for k, pid in enumerate(env.world.particles["food"]):
+    for k, pid in enumerate(env.particle_ids("food")):
         pb.resetBasePositionAndOrientation(pid, (3.0 + 0.1 * k, 3.0, 1.0), (0, 0, 0, 1), physicsClientId=c)
 
 
@@ -291,7 +291,7 @@ def test_binding_a_new_point_keeps_what_the_snapshot_read(make_env):
     spoon = env.snap.point(LinkPoint(body="spoon", link="spoon"))
     before = where(env, spoon)
     assert np.linalg.norm(before) > 0.5
-    bowl_link = next(iter(env.world.bodies["bowl"].links))
+    bowl_link = next(iter(env.links("bowl")))
     env.snap.point(LinkPoint(body="bowl", link=bowl_link))  # a point the task does not use
     np.testing.assert_array_equal(where(env, spoon), before)
 
@@ -706,3 +706,41 @@ def test_the_env_names_its_bodies_and_links_for_direct_reads(env):
     with pytest.raises(KeyError) as bad:
         env.link_index("spon", "tray")
     assert bad.value.args[0].startswith("no body 'spon' in this scene;")
+
+
+def test_the_env_gives_poses_joints_particles_and_names_by_name(env):
+    """Poses are the URDF frames the spec places (not pybullet's centre-of-mass frames), the base
+    link's pose is the body's, joints and particles are looked up by name, and contact points'
+    body ids name back to the spec's names."""
+    env.reset(seed=3)
+    c = env.client
+    spoon = env.body_id("spoon")
+    base = next(name for name, i in env.links("spoon").items() if i == -1)
+    assert env.link_pose("spoon", base) == env.base_pose("spoon")
+    com = pb.getBasePositionAndOrientation(spoon, physicsClientId=c)[0]
+    inertial = pb.getDynamicsInfo(spoon, -1, physicsClientId=c)[3]
+    assert np.allclose(np.asarray(env.base_pose("spoon")[0]) + inertial, com, atol=1e-9)  # spoon unrotated in its frame
+    ee = env.manifest.robot.links["tool_mount"]
+    state = pb.getLinkState(
+        env.body_id("robot"), env.link_index("robot", ee), computeForwardKinematics=1, physicsClientId=c
+    )
+    assert env.link_pose("robot", ee) == (state[4], state[5])
+    head = env.joint_index("person", "head_x")
+    assert env.joints("person")["head_x"] == head
+    assert pb.getJointInfo(env.body_id("person"), head, physicsClientId=c)[1] == b"head_x"
+    with pytest.raises(KeyError) as bad:
+        env.joint_index("person", "hed_x")
+    assert bad.value.args[0] == (
+        "person has no joint 'hed_x'; expected one of 'head_x', 'head_y', 'head_z', 'neck' (did you mean 'head_x'?)"
+    )
+    food = env.particle_ids("food")
+    assert len(food) == env.manifest.particles[0].count
+    names = env.body_names()
+    assert {names[i] for i in food} == {"food"} and names[env.body_id("person")] == "person"
+    assert names[spoon] == "spoon" and "ground" in names.values()
+    food.clear()  # a copy
+    assert len(env.particle_ids("food")) == env.manifest.particles[0].count
+    with pytest.raises(KeyError) as bad:
+        env.particle_ids("fod")
+    assert bad.value.args[0] == "no particle set 'fod' in this scene; expected one of 'food' (did you mean 'food'?)"
+    assert env.active_variant.name == env.person_variant and env.active_variant.body == env.person_body

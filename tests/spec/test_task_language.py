@@ -57,14 +57,10 @@ def test_itch_is_drawn_on_the_arm_capsules_every_reset(scratch):
     links, normals = [], []
     for seed in range(300):
         scratch.reset(seed=seed) if seed == 0 else scratch.reset()
-        variant = scratch.world.active_variant
+        variant = scratch.active_variant
         caps = {c.link: c for c in variant.surfaces["itch"]}
         slot = snap.target_slots["itch"]
-        link = next(
-            link
-            for link, i in scratch.world.variant_bodies[variant.name].links.items()
-            if snap._slots.get(("person", i)) == slot
-        )
+        link = next(link for link, i in scratch.links("person").items() if snap._slots.get(("person", i)) == slot)
         cap = caps[link]
         offset = snap.target_offsets["itch"]
         start, end = np.asarray(cap.start), np.asarray(cap.end)
@@ -147,8 +143,9 @@ def test_scripted_ik_damping_damps_the_named_joints_only(tmp_path, scratch):
     env = AssistiveEnv(compile_task(TASKS / "scratch_itch.yaml", "pr2", tmp_path / "pr2", force=True).out_dir)
     try:
         policy = ScriptedPolicy(env)
-        robot = env.world.robot
-        named = {policy.movable.index(robot.joints[j]): v for j, v in env.manifest.scripted.ik_damping.items()}
+        named = {
+            policy.movable.index(env.joint_index("robot", j)): v for j, v in env.manifest.scripted.ik_damping.items()
+        }
         assert set(named.values()) == {1.0} and len(named) == 2
         assert all(d == (named[k] if k in named else 0.1) for k, d in enumerate(policy.damping))
     finally:
@@ -420,14 +417,13 @@ def test_person_settles_supine_on_the_mattress(bathing):
     env = bathing
     for seed in (0, 1):
         env.reset(seed=seed)
-        handle = env.world.variant_bodies[env.person_variant]
-        c = env.client
+        person, c = env.body_id("person"), env.client
         bed = env.body_id("bed")
-        gap = min(cp[8] for cp in pb.getClosestPoints(handle.id, bed, 0.1, physicsClientId=c))
+        gap = min(cp[8] for cp in pb.getClosestPoints(person, bed, 0.1, physicsClientId=c))
         assert -0.02 < gap < 0.005  # resting on the bed: touching, not floating, not sunk in
         for link in ("right_shoulder", "right_elbow", "right_wrist"):  # the arm to wipe lies on the 0.73 m mattress
-            assert 0.69 < pb.getAABB(handle.id, handle.links[link], physicsClientId=c)[0][2] < 0.78
-        chest_pos, chest_orn = env.world.base_frame(env.world.variant_bodies[env.person_variant])
+            assert 0.69 < pb.getAABB(person, env.link_index("person", link), physicsClientId=c)[0][2] < 0.78
+        chest_pos, chest_orn = env.base_pose("person")
         up = np.asarray(pb.getMatrixFromQuaternion(chest_orn)).reshape(3, 3)[:, 2]
         assert abs(up[1]) > 0.9  # the body's long axis (chest z) lies along the bed (±Y): supine
 
@@ -451,7 +447,7 @@ def test_markers_lie_on_the_arm_and_are_cleared_once(bathing):
 
     policy = ScriptedPolicy(env)
     obs, _ = env.reset(seed=2)
-    variant = env.world.active_variant
+    variant = env.active_variant
     count = len(variant.markers["wipe_spots"])
     assert env.success_threshold == pytest.approx(0.3 * count)
     # Every marker sits on its limb's capsule surface: radius from the axis, in the world.
@@ -459,9 +455,8 @@ def test_markers_lie_on_the_arm_and_are_cleared_once(bathing):
     assert where.shape == (count, 3) and remaining.all() and env.person_body == variant.body
     remaining[:] = False  # a copy: the env's own is untouched
     assert env.marker_state("wipe_spots")[1].all()
-    person = env.world.variant_bodies[variant.name]
     for link in ("right_shoulder", "right_elbow"):
-        pos, orn = env.world.link_frame(person, person.links[link])
+        pos, orn = env.link_pose("person", link)
         rot = np.asarray(pb.getMatrixFromQuaternion(orn)).reshape(3, 3)
         for k, marker in enumerate(variant.markers["wipe_spots"]):
             if marker.link == link:
@@ -518,7 +513,7 @@ def test_free_standing_robot_has_no_nightstand(tmp_path):
     env = AssistiveEnv(compile_task(TASKS / "bed_bathing.yaml", "sawyer", tmp_path / "bathing-sawyer").out_dir)
     try:
         assert "nightstand" not in {b.name for b in env.manifest.bodies}
-        assert "nightstand" not in env.world.bodies
+        assert "nightstand" not in set(env.body_names().values())
         assert all(isinstance(p, BaseSearch) for p in env.manifest.robot.placement.values())
         obs, _ = env.reset(seed=0)
         obs, *_ = env.step(np.zeros(env.action_space.shape))

@@ -156,7 +156,8 @@ def env(tmp_path_factory):
 
 
 def _nodes(env) -> np.ndarray:
-    return env.world.garment_nodes(env.world.garments[0])
+    (nodes,) = env.garment_nodes().values()
+    return nodes
 
 
 def test_artifact_carries_the_generated_mesh_and_named_nodes(env):

@@ -228,7 +228,7 @@ def test_velocity_cost(snap):
 
 
 def test_force_nontarget_without_and_with_a_target(env, snap):
-    centre = point(snap, "wheelchair", next(iter(env.world.bodies["wheelchair"].links)))  # placed below
+    centre = point(snap, "wheelchair", next(iter(env.links("wheelchair"))))  # placed below
     press_spoon_into_face(env, snap)
     spoon_cps = contacts(env, "spoon", "person")
     total = sum(cp[9] for cp in spoon_cps) + sum(cp[9] for cp in contacts(env, "robot", "person"))
