@@ -30,6 +30,7 @@ from pydantic import (
     Field,
     PrivateAttr,
     SerializerFunctionWrapHandler,
+    ValidationError,
     model_serializer,
     model_validator,
 )
@@ -624,20 +625,22 @@ class Manifest(_Model):
         "what was compiled, whichever compiler source compiled it.",
     )
     sources: list[str] = Field(description="Spec and part files this was compiled from.")
-    sim: Sim
-    bodies: list[Body]
-    person: Person
-    robot: Robot
-    tools: list[ToolAttachment]
-    targets: dict[str, Target]
-    particles: list[ParticleSet]
+    sim: Sim = Field(description="Physics settings: time step, frame skip, solver, gravity, episode length.")
+    bodies: list[Body] = Field(
+        description="Every URDF body the world loads (robot, furniture, tools, each person variant), placed."
+    )
+    person: Person = Field(description="The person: variants, holds, impairments, policy joints, limits.")
+    robot: Robot = Field(description="The robot: action joints and scaling, named links, start configurations.")
+    tools: list[ToolAttachment] = Field(description="Tools held by the robot: which link, where in it.")
+    targets: dict[str, Target] = Field(description="Named target points (a link and an offset), by name.")
+    particles: list[ParticleSet] = Field(description="Particle sets (food, water): size, mass, where they start.")
     markers: list[MarkerSet] = Field(default_factory=list, description="Marker sets on the person.")
     joint_groups: dict[str, JointGroup] = Field(
         description="Joint groups by reference name (``robot.arm``, ``person.head``)."
     )
     observations: dict[str, list[TermUse]] = Field(description="Observation features per agent, in order.")
     reward: list[TermUse] = Field(description="Reward terms including preference costs.")
-    success: Success
+    success: Success = Field(description="The success criterion: which term, how aggregated, the threshold.")
     garments: list[Garment] = Field(
         default_factory=list, description="Soft-body garments (their presence makes the world a deformable one)."
     )
@@ -739,7 +742,7 @@ class Manifest(_Model):
                 manifest._as_written = written
         except (ValueError, UnicodeDecodeError) as exc:
             raise SpecError.at(
-                str(path), f"not a readable manifest ({str(exc).splitlines()[0]}); recompile with 'compile --force'"
+                str(path), f"not a readable manifest ({_first_problem(exc)}); recompile with 'compile --force'"
             ) from None
         problem = manifest.damage(artifact_dir) if verify else None
         if problem:
@@ -748,6 +751,18 @@ class Manifest(_Model):
                 f"damaged artifact: {problem}; recompile it (assistive-compiler compile SPEC --out {artifact_dir} --force)",
             )
         return manifest
+
+
+def _first_problem(exc: Exception) -> str:
+    """One line naming what made a manifest unreadable: the first field pydantic refused, by its
+    dotted path, with pydantic's reason (and how many more there are); else the error's first line."""
+    if isinstance(exc, ValidationError) and exc.errors():
+        errors = exc.errors()
+        first = errors[0]
+        where = ".".join(str(part) for part in first["loc"]) or "the top level"
+        more = f", and {len(errors) - 1} more" if len(errors) > 1 else ""
+        return f"{where}: {first['msg']}{more}"
+    return str(exc).splitlines()[0]
 
 
 def reset_events(
