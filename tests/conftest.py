@@ -15,6 +15,7 @@ from filelock import FileLock
 from assistive_compiler.bullet import connect
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.runtime.env import AssistiveEnv
+from assistive_compiler.runtime.snapshot import Snapshot
 
 REPO = Path(__file__).resolve().parents[1]
 FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
@@ -46,6 +47,17 @@ def built_once(tmp_path_factory, worker_id: str, name: str, build: Callable[[Pat
     return mine
 
 
+@pytest.fixture(scope="session")
+def stretch_scratch_artifact(tmp_path_factory, worker_id) -> Path:
+    """Scratch Itch compiled for Stretch (a mobile base and telescoping tubes), once per session."""
+    return built_once(
+        tmp_path_factory,
+        worker_id,
+        "scratch_itch-stretch",
+        lambda out: compile_task(REPO / "specs" / "tasks" / "scratch_itch.yaml", "stretch", out),
+    )
+
+
 @pytest.fixture
 def cid():
     """A private pybullet DIRECT client for one test, with the package's engine settings."""
@@ -60,6 +72,13 @@ def env(artifact):
     e = AssistiveEnv(artifact)
     yield e
     e.close()
+
+
+@pytest.fixture
+def snap(env) -> Snapshot:
+    """A fresh snapshot of the module's env's world, just reset (seed 0), nothing bound yet."""
+    env.reset(seed=0)
+    return Snapshot(env.world)
 
 
 # Template modules (test_<robot>_kinematics.py) define TEMPLATE; these render and load it once per module.
