@@ -23,6 +23,10 @@ With ``--without-rest`` the compared variant is instead the shipped spec with ev
 ``rest`` switched off (``rest: null`` in a spec that ``extends:`` it: the particles are simulated
 every step), at the shipped solver settings: does carrying resting particles change the outcome?
 
+With ``--against-artifact DIR`` the compared variant is an artifact of the same task and robot
+compiled elsewhere, e.g. by the commit before a compiler change (check out that commit and
+``compile`` the spec into DIR): does the change keep the physics outcomes?
+
 Verdict per metric: the episodes are paired by seed, so the difference (reference − shipped) of
 the per-seed values is bootstrapped (2000 resamples); "within noise" when its 95% interval holds
 0, else "differs". Run e.g.::
@@ -44,6 +48,7 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 
+from assistive_compiler.artifact import Manifest
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.policies.scripted import ScriptedPolicy
 from assistive_compiler.runtime.env import AssistiveEnv
@@ -253,6 +258,12 @@ def main(argv: list[str] | None = None) -> int:
         help="compare against the shipped spec with particle sets' rest switched off (always simulated), "
         "at the shipped solver settings",
     )
+    ap.add_argument(
+        "--against-artifact",
+        metavar="DIR",
+        help="compare against this artifact of the same task and robot (e.g. compiled before a compiler change), "
+        "at its own settings",
+    )
     ap.add_argument("--artifacts", help="where to compile (default: a temporary directory)")
     ap.add_argument("--json", help="write the full result (per-episode figures too) here")
     ap.add_argument("--markdown", help="write the table here")
@@ -317,6 +328,37 @@ def run(args: argparse.Namespace) -> dict | None:
     seeds = list(range(args.first_seed, args.first_seed + args.seeds))
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(args.artifacts or tmp)
+        if args.against_artifact:
+            variant_dir = Path(args.against_artifact)
+            theirs = Manifest.read(variant_dir, verify=True)
+            if (theirs.task, theirs.robot_name) != (spec.name, args.robot):
+                print(
+                    f"{variant_dir}: compiled for {theirs.task} on {theirs.robot_name}, not {spec.name} on {args.robot}",
+                    file=sys.stderr,
+                )
+                return None
+            t0 = time.perf_counter()
+            shipped_dir = compile_task(args.spec, args.robot, root / f"{spec.name}-{args.robot}-shipped").out_dir
+            compile_s = time.perf_counter() - t0
+            shipped = run_episodes(shipped_dir, seeds)
+            other = run_episodes(variant_dir, seeds)
+            return {
+                "task": spec.name,
+                "robot": args.robot,
+                "seeds": len(seeds),
+                "first_seed": args.first_seed,
+                "shipped_solver": solver_settings(spec),
+                "reference_solver": {
+                    "sub_steps": theirs.sim.sub_steps,
+                    "iterations": theirs.sim.solver_iterations,
+                    "contact_breaking_threshold_m": theirs.sim.contact_breaking_threshold,
+                },
+                "variant_label": f"the artifact at {variant_dir}",
+                "command": " ".join(["benchmarks/physics_settings.py", *sys.argv[1:]]),
+                "compile_s": round(compile_s, 1),
+                "rows": compare(shipped, other),
+                "episodes": {"shipped": shipped, "reference": other},
+            }
         if args.without_rest:
             variant_solver = solver_settings(spec)
             label, tag = "rest off (always simulated)", "rest-off"

@@ -30,6 +30,7 @@ from .emit import emit_people, emit_props
 from .person import finish_person, merge_people
 from .placement import precompute
 from .placement.settle_person import settle_people
+from .robot import merge_robot
 from .task import arm_limits_path
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
@@ -73,7 +74,8 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
     emit_people(rt, scene, settled)  # 3. each person variant, its static joints baked at the posture
     manifest = precompute(rt, scene, out_tmp)  # 4. base poses, start configurations, particles, garments
     pairs = merge_people(rt, scene)  # 5. each person's static links merged; self-collision pairs
-    return finish_person(rt, manifest, out_tmp, pairs)  # 6. pairs apart at rest, arm-limit model
+    merge_robot(manifest, scene)  # 6. the robot's links the manifest does not name merged
+    return finish_person(rt, manifest, out_tmp, pairs)  # 7. pairs apart at rest, arm-limit model
 
 
 def compile_task(
