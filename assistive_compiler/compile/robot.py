@@ -11,6 +11,12 @@ tool and garment grips, the drive's base link, terms' and targets' points) or wh
 root. The stage runs after the manifest is built, on the robot URDF the earlier stages (base
 search, start configurations) used, so every name it could refer to is known; those stages'
 results do not change, because the kinematics of the movable joints do not.
+
+Not in a task with a garment. Bullet collides cloth with a rigid link through the link's own
+shapes, and a hand with its fingers merged in is a different collider for the cloth than the hand
+and fingers as links: the shipped Dressing co-optimised pair's return fell from −33.7 to −41.8 on
+12 paired seeds (``docs/physics.md``). There the robot stays as emitted; the cloth is most of
+the step anyway.
 """
 
 from __future__ import annotations
@@ -27,7 +33,9 @@ from .merge import merge_fixed_links
 
 def merge_robot(manifest: Manifest, scene: EmittedScene) -> list[str]:
     """Rewrite the scene's robot URDF with every link the manifest does not name merged into its
-    parent; returns the merged links' names (document order)."""
+    parent (none in a task with a garment); returns the merged links' names (document order)."""
+    if manifest.garments:  # the cloth's contacts are per link: see the module docstring
+        return []
     path = scene.written["robot"]
     xml = path.read_text()
     links = set(urdf_info(xml).links)

@@ -167,6 +167,13 @@ def test_artifact_carries_the_generated_mesh_and_named_nodes(env):
     assert len(g.nodes_in_held) == 48
 
 
+def test_the_robot_that_holds_a_garment_keeps_its_links(env):
+    # compile/robot.py merges a robot's unnamed fixed links, but not where cloth touches them: the
+    # cloth collides per link, and Jaco's fingers merged into its hand changed the gown's contacts.
+    links = env.links("robot")
+    assert {f"j2s7s300_link_finger_{k}" for k in (1, 2, 3)} <= set(links) and len(links) == 15
+
+
 def test_reset_puts_the_settled_sleeve_at_the_hand_exactly(env):
     env.reset(seed=1)
     w = env.world
