@@ -323,11 +323,13 @@ def write_rest_off_variant(spec_path: str | Path, spec, out: Path) -> Path | Non
 
 
 def run(args: argparse.Namespace) -> dict | None:
-    """Compile both settings and run the seeds on each; None when there is nothing to compare."""
+    """Compile both settings (or take ``--against-artifact``) and run the seeds on each; None when
+    there is nothing to compare."""
     spec = load_spec(args.spec).spec
     seeds = list(range(args.first_seed, args.first_seed + args.seeds))
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(args.artifacts or tmp)
+        t0 = time.perf_counter()
         if args.against_artifact:
             variant_dir = Path(args.against_artifact)
             theirs = Manifest.read(variant_dir, verify=True)
@@ -337,53 +339,19 @@ def run(args: argparse.Namespace) -> dict | None:
                     file=sys.stderr,
                 )
                 return None
-            t0 = time.perf_counter()
-            shipped_dir = compile_task(args.spec, args.robot, root / f"{spec.name}-{args.robot}-shipped").out_dir
-            compile_s = time.perf_counter() - t0
-            shipped = run_episodes(shipped_dir, seeds)
-            other = run_episodes(variant_dir, seeds)
-            return {
-                "task": spec.name,
-                "robot": args.robot,
-                "seeds": len(seeds),
-                "first_seed": args.first_seed,
-                "shipped_solver": solver_settings(spec),
-                "reference_solver": {
-                    "sub_steps": theirs.sim.sub_steps,
-                    "iterations": theirs.sim.solver_iterations,
-                    "contact_breaking_threshold_m": theirs.sim.contact_breaking_threshold,
-                },
-                "variant_label": f"the artifact at {variant_dir}",
-                "command": " ".join(["benchmarks/physics_settings.py", *sys.argv[1:]]),
-                "compile_s": round(compile_s, 1),
-                "rows": compare(shipped, other),
-                "episodes": {"shipped": shipped, "reference": other},
+            variant_solver = {
+                "sub_steps": theirs.sim.sub_steps,
+                "iterations": theirs.sim.solver_iterations,
+                "contact_breaking_threshold_m": theirs.sim.contact_breaking_threshold,
             }
-        if args.without_rest:
-            variant_solver = solver_settings(spec)
-            label, tag = "rest off (always simulated)", "rest-off"
-            variant = write_rest_off_variant(args.spec, spec, root / "specs" / f"{spec.name}-{tag}.yaml")
-            if variant is None:
-                print(f"{spec.name}: no particle set rests in a container; nothing to compare", file=sys.stderr)
-                return None
+            label = f"the artifact at {variant_dir}"
         else:
-            ref = reference_solver(spec.name)
-            if ref is None:
-                print(f"{spec.name}: the reference has no such task", file=sys.stderr)
+            variant_spec = _variant_spec(args, spec, root)
+            if variant_spec is None:
                 return None
-            variant_solver = {**ref, **parse_solver(args.solver)}
-            if variant_solver == solver_settings(spec):
-                print(
-                    f"{spec.name}: the shipped solver settings are the compared ones; nothing to compare",
-                    file=sys.stderr,
-                )
-                return None
-            label = "reference" if not args.solver else "reference with " + ", ".join(args.solver)
-            tag = "reference" if not args.solver else "variant-" + "-".join(args.solver).replace("=", "")
-            variant = write_solver_variant(args.spec, variant_solver, root / "specs" / f"{spec.name}-{tag}.yaml")
-        t0 = time.perf_counter()
+            variant, variant_solver, label, tag = variant_spec
+            variant_dir = compile_task(variant, args.robot, root / f"{spec.name}-{args.robot}-{tag}").out_dir
         shipped_dir = compile_task(args.spec, args.robot, root / f"{spec.name}-{args.robot}-shipped").out_dir
-        variant_dir = compile_task(variant, args.robot, root / f"{spec.name}-{args.robot}-{tag}").out_dir
         compile_s = time.perf_counter() - t0
         shipped = run_episodes(shipped_dir, seeds)
         other = run_episodes(variant_dir, seeds)
@@ -400,6 +368,30 @@ def run(args: argparse.Namespace) -> dict | None:
         "rows": compare(shipped, other),
         "episodes": {"shipped": shipped, "reference": other},
     }
+
+
+def _variant_spec(args: argparse.Namespace, spec, root: Path) -> tuple[Path, dict, str, str] | None:
+    """The compared spec file (written under ``root``), its solver settings, its label and its
+    file tag; None (after saying why) when there is nothing to compare."""
+    if args.without_rest:
+        tag = "rest-off"
+        variant = write_rest_off_variant(args.spec, spec, root / "specs" / f"{spec.name}-{tag}.yaml")
+        if variant is None:
+            print(f"{spec.name}: no particle set rests in a container; nothing to compare", file=sys.stderr)
+            return None
+        return variant, solver_settings(spec), "rest off (always simulated)", tag
+    ref = reference_solver(spec.name)
+    if ref is None:
+        print(f"{spec.name}: the reference has no such task", file=sys.stderr)
+        return None
+    variant_solver = {**ref, **parse_solver(args.solver)}
+    if variant_solver == solver_settings(spec):
+        print(f"{spec.name}: the shipped solver settings are the compared ones; nothing to compare", file=sys.stderr)
+        return None
+    label = "reference" if not args.solver else "reference with " + ", ".join(args.solver)
+    tag = "reference" if not args.solver else "variant-" + "-".join(args.solver).replace("=", "")
+    variant = write_solver_variant(args.spec, variant_solver, root / "specs" / f"{spec.name}-{tag}.yaml")
+    return variant, variant_solver, label, tag
 
 
 if __name__ == "__main__":
