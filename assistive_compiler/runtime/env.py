@@ -77,11 +77,13 @@ class AssistiveEnv(gym.Env):
       ``human_action_space`` and ``human_observation_space``;
     * ``manifest`` (the compiled task), ``steps`` (env steps this episode), ``impairment`` (this
       episode's, drawn), ``success_threshold``;
-    * the scene as it is now: :attr:`person_body`, :attr:`person_variant`, :attr:`active_variant`, :meth:`marker_state`,
-      :meth:`particle_state`, :meth:`garment_nodes`, :attr:`arm_limit_reverts`, and the poses of
-      bodies and links by name (:meth:`base_pose`, :meth:`link_pose`; URDF frames, world);
+    * the scene as it is now: :attr:`person_body`, :attr:`person_variant`, :attr:`active_variant`,
+      :meth:`marker_state`, :meth:`particle_state`, :meth:`garment_nodes`, :attr:`arm_limit_reverts`,
+      and the poses of bodies and links by name (:meth:`base_pose`, :meth:`link_pose`; URDF frames,
+      world);
     * reading pybullet directly, by name: :attr:`client`, :meth:`body_id`, :meth:`link_index`,
-      :meth:`joint_index`, :meth:`links`, :meth:`joints`, :meth:`particle_ids`, and back from ids to names, :meth:`body_names`;
+      :meth:`joint_index`, :meth:`links`, :meth:`joints`, :meth:`particle_ids`, and back from ids
+      to names, :meth:`body_names`;
     * ``physics_s``, the time its steps spent in physics (benchmarks);
     * for controllers, renders and benchmarks that work on the physics itself: ``world``
       (:class:`~.world.World`: the pybullet client, body handles, link frames), ``snap`` (the
@@ -350,8 +352,8 @@ class AssistiveEnv(gym.Env):
         return links[link]
 
     def joint_index(self, body: str, joint: str) -> int:
-        """The pybullet joint index of ``joint`` of the body ``body`` (as :meth:`body_id`); welded
-        and merged joints included while they are in the compiled URDF."""
+        """The pybullet joint index of ``joint`` of the body ``body`` (as :meth:`body_id`): any joint
+        of its compiled URDF, welded (fixed) ones included; a merged link's joint is gone."""
         joints = self._body(body).joints
         if joint not in joints:
             from ..errors import did_you_mean, one_of
