@@ -1,10 +1,15 @@
 """Small helpers shared by test modules: where a needle sits in a spec's text (``LINE:COL``, as
 the CLI reports locations), an env of a spec compiled into a fresh directory, and the check that
-an exported co-optimised pair acts as its checkpoint."""
+an exported co-optimised pair acts as its checkpoint, and reads of the person and a mobile base
+through the env's API."""
 
 from __future__ import annotations
 
 from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pybullet as pb
 
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.runtime.env import AssistiveEnv
@@ -68,3 +73,13 @@ def assert_exported_pair_acts_as(checkpoint_pair, exported, artifact: Path, seed
         assert len(observations) > 50
         worst = max(np.abs(exported.agent(name)(o) - checkpoint_pair.agent(name)(o)).max() for o in observations)
         assert worst < 1e-4, (name, worst)
+
+
+def person(env: AssistiveEnv) -> SimpleNamespace:
+    """This episode's person body: its pybullet id and its links and joints by name."""
+    return SimpleNamespace(id=env.body_id("person"), links=env.links("person"), joints=env.joints("person"))
+
+
+def drive_state(env: AssistiveEnv) -> np.ndarray:
+    """A mobile base's planar joints (x, y m; yaw rad) as pybullet reads them."""
+    return np.array([s[0] for s in pb.getJointStates(env.body_id("robot"), env.drive.idx, physicsClientId=env.client)])

@@ -33,7 +33,9 @@ but can differ in the last digits from a replay.
 from __future__ import annotations
 
 import time
+from collections.abc import Iterable, Mapping
 from pathlib import Path
+from typing import TypeVar
 
 import gymnasium as gym
 import numpy as np
@@ -50,6 +52,19 @@ from .markers import MarkerSystem
 from .particles import ParticleSystem
 from .snapshot import Snapshot
 from .world import World
+
+_T = TypeVar("_T")
+
+
+def _named(table: Mapping[str, _T], name: str, missing: str, known: Iterable[str] | None = None) -> _T:
+    """``table[name]``, or a KeyError that says ``missing`` and lists the names (``known``, else the
+    table's) with a did-you-mean: the env's lookups by name."""
+    if name in table:
+        return table[name]
+    from ..errors import did_you_mean, one_of
+
+    names = list(table if known is None else known)
+    raise KeyError(f"{missing}; expected one of {one_of(names)}{did_you_mean(name, names)}")
 
 
 class Features:
@@ -344,24 +359,12 @@ class AssistiveEnv(gym.Env):
     def link_index(self, body: str, link: str) -> int:
         """The pybullet link index of ``link`` of the body ``name`` (as :meth:`body_id`); −1 is the
         base link. Links merged at compile time have none (their frames ride on the link they joined)."""
-        links = self._body(body).links
-        if link not in links:
-            from ..errors import did_you_mean, one_of
-
-            raise KeyError(f"{body} has no link '{link}'; expected one of {one_of(links)}{did_you_mean(link, links)}")
-        return links[link]
+        return _named(self._body(body).links, link, f"{body} has no link '{link}'")
 
     def joint_index(self, body: str, joint: str) -> int:
         """The pybullet joint index of ``joint`` of the body ``body`` (as :meth:`body_id`): any joint
         of its compiled URDF, welded (fixed) ones included; a merged link's joint is gone."""
-        joints = self._body(body).joints
-        if joint not in joints:
-            from ..errors import did_you_mean, one_of
-
-            raise KeyError(
-                f"{body} has no joint '{joint}'; expected one of {one_of(joints)}{did_you_mean(joint, joints)}"
-            )
-        return joints[joint]
+        return _named(self._body(body).joints, joint, f"{body} has no joint '{joint}'")
 
     def links(self, body: str) -> dict[str, int]:
         """Every link of the body ``body`` (as :meth:`body_id`) that survived the compile-time merge,
@@ -377,7 +380,7 @@ class AssistiveEnv(gym.Env):
         """World pose of ``link``'s URDF frame (m; quaternion x, y, z, w), the base link's too (not
         pybullet's centre-of-mass frame). ``body`` and ``link`` as :meth:`link_index`."""
         handle = self._body(body)
-        return self.world.link_frame(handle, self.link_index(body, link))
+        return self.world.link_frame(handle, _named(handle.links, link, f"{body} has no link '{link}'"))
 
     def base_pose(self, body: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
         """World pose of the body's URDF base frame (m; quaternion x, y, z, w): where the spec
@@ -386,14 +389,7 @@ class AssistiveEnv(gym.Env):
 
     def particle_ids(self, name: str) -> list[int]:
         """The pybullet body ids of particle set ``name``'s particles, in the set's order (a copy)."""
-        sets = self.world.particles
-        if name not in sets:
-            from ..errors import did_you_mean, one_of
-
-            raise KeyError(
-                f"no particle set '{name}' in this scene; expected one of {one_of(sets)}{did_you_mean(name, sets)}"
-            )
-        return list(sets[name])
+        return list(_named(self.world.particles, name, f"no particle set '{name}' in this scene"))
 
     def body_names(self) -> dict[int, str]:
         """Pybullet body id → the name a spec uses: every person variant is ``person``, each
@@ -410,12 +406,8 @@ class AssistiveEnv(gym.Env):
         """The world's handle of body ``name`` (``person``: this episode's variant); a wrong name
         lists the scene's bodies."""
         key = self.person_body if name == "person" else name
-        if key not in self.world.bodies:
-            from ..errors import did_you_mean, one_of
-
-            known = ["person", *self.world.bodies]
-            raise KeyError(f"no body '{key}' in this scene; expected one of {one_of(known)}{did_you_mean(key, known)}")
-        return self.world.bodies[key]
+        bodies = self.world.bodies
+        return _named(bodies, key, f"no body '{key}' in this scene", known=["person", *bodies])
 
     def marker_state(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """Marker set ``name``: every marker's position, (N, 3) world m (cleared ones too), and

@@ -13,11 +13,11 @@ from __future__ import annotations
 import itertools
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pybullet as pb
 import pytest
+from helpers import person
 
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.compile.self_collision import person_self_collision
@@ -49,11 +49,6 @@ def leg_env(tmp_path_factory):
     e = AssistiveEnv(compile_task(spec, "jaco", tmp / "out").out_dir)
     yield e
     e.close()
-
-
-def person(env):
-    """This episode's person body: its pybullet id and its links and joints by name."""
-    return SimpleNamespace(id=env.body_id("person"), links=env.links("person"), joints=env.joints("person"))
 
 
 def merged_links(env, variant: int = 0) -> list[str]:

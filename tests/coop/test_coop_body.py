@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import itertools
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pybullet as pb
 import pytest
+from helpers import person
 
 from assistive_compiler.coop import parallel_env
 from assistive_compiler.person.arm_limits import ARM_LIMIT_JOINTS, AnalyticArmLimits
@@ -50,20 +50,15 @@ def coop_envs(tmp_path_factory):
         env.close()
 
 
-def person(env):
-    """This episode's person body: its pybullet id and its links and joints by name."""
-    return SimpleNamespace(id=env.env.body_id("person"), links=env.env.links("person"), joints=env.env.joints("person"))
-
-
 def angles(env, joints) -> np.ndarray:
-    p = person(env)
+    p = person(env.env)
     return np.array(
         [s[0] for s in pb.getJointStates(p.id, [p.joints[j] for j in joints], physicsClientId=env.env.client)]
     )
 
 
 def wrist(env, side: str) -> np.ndarray:
-    p = person(env)
+    p = person(env.env)
     return np.array(pb.getLinkState(p.id, p.links[f"{side}_wrist"], physicsClientId=env.env.client)[4])
 
 
@@ -81,7 +76,7 @@ def test_saturated_actions_never_leave_the_limits(task, impairment, coop_envs):
     _, infos = env.reset(seed=3)
     variant = env.env.active_variant
     movable = variant.movable_joints
-    p, c = person(env), env.env.client
+    p, c = person(env.env), env.env.client
     urdf = np.array([pb.getJointInfo(p.id, p.joints[j], physicsClientId=c)[8:10] for j in movable])
     lo, hi = urdf[:, 0].copy(), urdf[:, 1].copy()
     drawn = infos["human"]["impairment"]
@@ -151,7 +146,7 @@ def into_chest(env, side: str, seed: int, self_collision: bool = True) -> tuple[
     first, until the next seeded reset rebuilds the world). Returns the deepest penetration of forearm or hand into the chest's rigid link
     (m, negative), the number of self-contact points and their largest normal force (N)."""
     env.reset(seed=seed)
-    p, c = person(env), env.env.client
+    p, c = person(env.env), env.env.client
     if not self_collision:
         for i, j in itertools.combinations(sorted(p.links.values()), 2):
             pb.setCollisionFilterPair(p.id, p.id, i, j, 0, physicsClientId=c)

@@ -21,6 +21,7 @@ import pybullet as pb
 import pytest
 import xacro
 from frames import homogeneous, origin_matrix, rot_z
+from helpers import drive_state
 
 from assistive_compiler.bullet import connect
 from assistive_compiler.compile.lint import lint_urdf
@@ -229,10 +230,6 @@ def test_base_search_ranks_poses_by_isotropy_for_a_three_joint_arm(scratch_env):
     assert poses and all(0.0 < p.jlwki <= p.goals_reached + 1e-9 for p in poses)
 
 
-def _drive_state(env):
-    return np.array([s[0] for s in pb.getJointStates(env.body_id("robot"), env.drive.idx, physicsClientId=env.client)])
-
-
 def _drive_to_goal(env, ahead_m: float, steps: int) -> tuple[list[np.ndarray], float]:
     """Scripted actions of ``steps`` steps towards a goal ``ahead_m`` along the base's heading from
     where the scratcher's tip starts (the arm alone reaches about ±0.2 m that way, by the wrist's
@@ -268,7 +265,7 @@ def test_scripted_policy_drives_the_base_to_a_goal_beyond_the_arm(scratch_env):
     # actions are the same when the episode is replayed.
     env = scratch_env
     actions, miss = _drive_to_goal(env, 0.5, 60)
-    x, y, yaw = _drive_state(env)
+    x, y, yaw = drive_state(env)
     assert miss < 0.03
     assert x > 0.2  # it drove forward (and turned, the wrist yawing back: the IK's choice)
     assert any(abs(a[0]) > 0.5 and abs(a[1]) > 0.5 for a in actions)

@@ -9,6 +9,7 @@ import math
 import numpy as np
 import pybullet as pb
 import pytest
+from helpers import drive_state
 
 from assistive_compiler.runtime.env import AssistiveEnv
 
@@ -26,21 +27,17 @@ def tubes(env) -> list[str]:
     return [*dict.fromkeys(followers.values()), *followers]
 
 
-def _drive_state(env):
-    return np.array([s[0] for s in pb.getJointStates(env.body_id("robot"), env.drive.idx, physicsClientId=env.client)])
-
-
 def test_equal_wheel_actions_drive_straight_and_opposite_ones_turn_in_place(scratch_env):
     env = scratch_env
     env.reset(seed=0)
     for _ in range(5):
         env.step(np.array([1.0, 1.0, 0.0, 0.0, 0.0]))
-    x, y, yaw = _drive_state(env)
+    x, y, yaw = drive_state(env)
     assert x > 0.02 and abs(y) < 1e-3 and abs(yaw) < 1e-3  # forward along the heading, never sideways
     env.reset(seed=0)
     for _ in range(5):
         env.step(np.array([1.0, -1.0, 0.0, 0.0, 0.0]))
-    x, y, yaw = _drive_state(env)
+    x, y, yaw = drive_state(env)
     assert yaw > 0.05 and math.hypot(x, y) < 1e-3  # right wheel forward, left back: counter-clockwise in place
 
 
@@ -75,7 +72,7 @@ def test_pose_targets_start_from_the_measured_pose_and_stay_within_the_joints(sc
     env.reset(seed=0)
     drive = env.drive
     x, y, yaw = drive.pose()
-    assert np.allclose((x, y, yaw), _drive_state(env))
+    assert np.allclose((x, y, yaw), drive_state(env))
     forward, turn = drive.motion(np.array([0.4, 0.2]))
     heading = yaw + turn / 2  # the base moves along its heading at mid-turn
     assert drive.targets(np.array([0.4, 0.2])) == pytest.approx(
