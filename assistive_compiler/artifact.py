@@ -311,13 +311,27 @@ class Robot(_Model):
 
 
 class ToolAttachment(_Model):
-    """A tool fixed to a robot link by a constraint."""
+    """A tool held in a robot's hand: welded into the robot's URDF, or its own body held by a
+    fixed constraint (see :mod:`assistive_compiler.compile.robot`)."""
 
     body: str = Field(description="Tool body name.")
     parent_link: str = Field(description="Robot link it is attached to.")
     position: Vec3 = Field(description="Tool frame origin in the parent link frame, m.")
     orientation: Quat = Field(description="Tool frame orientation in the parent link frame.")
     links: dict[str, str] = Field(description="Semantic → URDF link names of the tool.")
+    welded: bool = Field(
+        False,
+        description="True: its links are links of the robot's URDF, on a fixed joint '<body>_grip' at this pose, and its "
+        "body's urdf is the robot's; False: its own body, held at this pose by a fixed constraint of at most 500 N.",
+    )
+
+    @model_serializer(mode="wrap")
+    def _drop_unwelded(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """A held tool's manifest entry as before ``welded`` existed, so its artifact keeps its content hash."""
+        data: dict[str, Any] = handler(self)
+        if not data.get("welded"):
+            data.pop("welded", None)
+        return data
 
 
 class Target(_Model):
@@ -653,8 +667,9 @@ class Manifest(_Model):
         "(person variant, surface targets, robot start, furniture noise, floor friction) and the "
         "components' episode starts (:func:`reset_events`)."
     )
-    #: The manifest as its file holds it, when that was an older format (migrated on reading):
-    #: its content hash covers that form.
+    #: The manifest as its file holds it, when that differs from how it reads (an older format,
+    #: migrated on reading, or one written before a field with a default was added): its content
+    #: hash covers that form.
     _as_written: dict[str, Any] | None = PrivateAttr(None)
 
     @model_validator(mode="before")
@@ -695,7 +710,7 @@ class Manifest(_Model):
         return b"".join(Path(artifact_dir, b.urdf).read_bytes() for b in sorted(self.bodies, key=lambda b: b.urdf))
 
     def _hash(self, files: bytes, *, with_input_hash: bool, as_written: bool = False) -> str:
-        """``as_written``: of the manifest in the form its file holds (an older format's), not today's."""
+        """``as_written``: of the manifest in the form its file holds (an older one's), not today's."""
         blank = {"content_hash": ""} if with_input_hash else {"content_hash": "", "input_hash": ""}
         if as_written and self._as_written is not None:
             text = json.dumps(self._as_written | blank, indent=1, sort_keys=True) + "\n"
@@ -738,7 +753,9 @@ class Manifest(_Model):
             text = path.read_text()
             manifest = cls.model_validate_json(text)  # pydantic's own messages for malformed JSON
             written = json.loads(text)
-            if manifest.format_version != written.get("format_version"):
+            if (
+                manifest.model_dump(mode="json") != written
+            ):  # an older format, or fields added since (at their defaults)
                 manifest._as_written = written
         except (ValueError, UnicodeDecodeError) as exc:
             raise SpecError.at(

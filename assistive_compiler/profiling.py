@@ -90,7 +90,6 @@ def profile_episode(env, actions: list[np.ndarray], seed: int) -> tuple[dict[str
     (:func:`stage_shares`) and the contact points per env step by body pair (``"a – b"``, the last
     physics step's, most first)."""
     c = env.client
-    names = env.body_names()
     contacts: collections.Counter = collections.Counter()
     env.reset(seed=seed)
     with tempfile.TemporaryDirectory() as tmp:
@@ -100,7 +99,7 @@ def profile_episode(env, actions: list[np.ndarray], seed: int) -> tuple[dict[str
             for a in actions:
                 env.step(a)
                 for point in pb.getContactPoints(physicsClientId=c):
-                    pair = sorted((names.get(point[1], str(point[1])), names.get(point[2], str(point[2]))))
+                    pair = sorted((env.link_owner(point[1], point[3]), env.link_owner(point[2], point[4])))
                     contacts[" – ".join(pair)] += 1
         finally:
             with captured_c_output():  # Bullet prints "Writing N timings" from C; dropped

@@ -58,6 +58,17 @@ def stretch_scratch_artifact(tmp_path_factory, worker_id) -> Path:
     )
 
 
+@pytest.fixture(scope="session")
+def itch_artifact(tmp_path_factory, worker_id) -> Path:
+    """Scratch Itch compiled for Jaco (its scratcher welded to the hand), once per session."""
+    return built_once(
+        tmp_path_factory,
+        worker_id,
+        "scratch_itch-jaco",
+        lambda out: compile_task(REPO / "specs" / "tasks" / "scratch_itch.yaml", "jaco", out),
+    )
+
+
 @pytest.fixture
 def cid():
     """A private pybullet DIRECT client for one test, with the package's engine settings."""

@@ -78,6 +78,8 @@ def render_people(artifact_dir: Path, width: int = 360, height: int = 480) -> np
     m, c = world.m, world.client
     world.set_base_frame(world.robot, (PARK[0], PARK[1] - 20, PARK[2]), (0, 0, 0, 1))  # the robot is not the subject
     for att in m.tools:
+        if att.welded:  # parked with the robot
+            continue
         world.set_base_frame(world.bodies[att.body], (PARK[0], PARK[1] - 25, PARK[2]), (0, 0, 0, 1))
     seat_xy = np.asarray(m.body(m.person.variants[0].body).position[:2])
     for k, body in enumerate(b for b in m.bodies if b.kind == "furniture"):

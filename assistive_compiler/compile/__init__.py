@@ -13,7 +13,8 @@ stages in order (:func:`.compiler.build`):
    by IK, particles and garments settled; the manifest built (:mod:`.manifest`).
 5. :mod:`.person` — each person's static links merged (:func:`.merge.merge_fixed_links`), keeping
    the links self-collision needs (:mod:`.self_collision`).
-6. :mod:`.robot` — the robot's fixed links merged likewise, keeping every link the manifest names.
+6. :mod:`.robot` — tools that nothing with weight presses on welded into the robot, and the
+   robot's fixed links merged likewise, keeping every link the manifest names.
 7. :mod:`.person` — self-collision pairs apart at rest, a user's arm-limit model copied.
 
 Shared questions about the resolved task (present furniture, joint groups, seeds, rounding) live

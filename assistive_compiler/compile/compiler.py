@@ -30,7 +30,7 @@ from .emit import emit_people, emit_props
 from .person import finish_person, merge_people
 from .placement import precompute
 from .placement.settle_person import settle_people
-from .robot import merge_robot
+from .robot import merge_robot, weld_tools
 from .task import arm_limits_path
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
@@ -74,7 +74,8 @@ def build(rt: ResolvedTask, out_tmp: Path, lib: Library) -> Manifest:
     emit_people(rt, scene, settled)  # 3. each person variant, its static joints baked at the posture
     manifest = precompute(rt, scene, out_tmp)  # 4. base poses, start configurations, particles, garments
     pairs = merge_people(rt, scene)  # 5. each person's static links merged; self-collision pairs
-    merge_robot(manifest, scene)  # 6. the robot's links the manifest does not name merged
+    manifest = weld_tools(manifest, scene)  # 6. tools nothing with weight presses on welded in,
+    merge_robot(manifest, scene)  # and the robot's links the manifest does not name merged
     return finish_person(rt, manifest, out_tmp, pairs)  # 7. pairs apart at rest, arm-limit model
 
 

@@ -353,7 +353,9 @@ class AssistiveEnv(gym.Env):
 
     def body_id(self, name: str) -> int:
         """The pybullet body id of the scene's body ``name``: ``robot``, ``person`` (this episode's
-        variant), a variant's own name (``person_<variant>``), a tool or a piece of furniture."""
+        variant), a variant's own name (``person_<variant>``), a tool or a piece of furniture. A
+        tool welded to the robot (``manifest.tools[].welded``) has the robot's id; its links
+        (:meth:`links`) are links of that body."""
         return self._body(name).id
 
     def link_index(self, body: str, link: str) -> int:
@@ -393,14 +395,23 @@ class AssistiveEnv(gym.Env):
 
     def body_names(self) -> dict[int, str]:
         """Pybullet body id → the name a spec uses: every person variant is ``person``, each
-        particle its set's name, the floor ``ground`` (e.g. to name the bodies of contact points)."""
+        particle its set's name, the floor ``ground`` (e.g. to name the bodies of contact points).
+        A welded tool's links are the robot's body: :meth:`link_owner` tells them apart."""
         w = self.world
-        names = {h.id: name for name, h in w.bodies.items()}
+        names = {h.id: name for name, h in w.bodies.items() if h.base_link == -1}
         names.update({w.variant_bodies[v.name].id: "person" for v in self.manifest.person.variants})
         for set_name, ids in w.particles.items():
             names.update({bid: set_name for bid in ids})
         names[w.ground] = "ground"
         return names
+
+    def link_owner(self, body_id: int, link: int) -> str:
+        """The name a spec uses for link ``link`` of pybullet body ``body_id``: as :meth:`body_names`,
+        except that a welded tool's links are the tool's (e.g. to name a contact point's bodies)."""
+        for name, h in self.world.bodies.items():
+            if h.id == body_id and h.link_set is not None and link in h.link_set and h.base_link >= 0:
+                return name
+        return self.body_names().get(body_id, str(body_id))
 
     def _body(self, name: str):
         """The world's handle of body ``name`` (``person``: this episode's variant); a wrong name

@@ -118,7 +118,9 @@ def robot_start(env: AssistiveEnv, episode: Episode, event: RobotStartEvent) -> 
     episode.start_index = k
     w.set_base_frame(w.robot, start.base_position, start.base_orientation)
     env.command_start(list(start.joints))
-    for att in m.tools:  # tools follow the hand exactly
+    for att in m.tools:  # tools follow the hand exactly (a welded one is a part of it)
+        if att.welded:
+            continue
         link_pos, link_orn = w.link_frame(w.robot, w.robot.links[att.parent_link])
         pos, orn = pb.multiplyTransforms(link_pos, link_orn, att.position, att.orientation)
         w.set_base_frame(w.bodies[att.body], pos, orn)

@@ -52,7 +52,7 @@ from ..rotation import quat_matrix, vec_angle
 from ..terms.reads import ParticleEvents
 from .component import EnvStep, Episode, EpisodeComponent
 from .snapshot import Snapshot
-from .world import PARK, World
+from .world import PARK, World, own_points
 
 _AXIS = np.array([0.0, 0.0, 1.0])  # a container's axis in its frame, towards its opening
 
@@ -308,12 +308,11 @@ class ParticleSystem(EpisodeComponent):
             centre = snap.position(target) if target is not None else None
             hit_ids: set[int] = set()
             if ps.hit_body:
-                hb = snap.handle(snap.body_key(ps.hit_body)).id
-                hit_ids = {cp[2] for cp in pb.getContactPoints(bodyA=hb, physicsClientId=c)}
-            lost_id = anchor = None
+                hb = snap.handle(snap.body_key(ps.hit_body))
+                hit_ids = {cp[2] for cp in own_points(pb.getContactPoints(bodyA=hb.id, physicsClientId=c), hb)}
+            lost_to = anchor = None
             if ps.lost_body:
-                holder = snap.handle(snap.body_key(ps.lost_body))
-                lost_id = holder.id
+                holder = lost_to = snap.handle(snap.body_key(ps.lost_body))
                 frame = w.link_frame(holder, holder.links[ps.lost_link])
                 anchor = np.asarray(pb.multiplyTransforms(*frame, ps.lost_anchor, (0, 0, 0, 1))[0])
             inside = np.zeros(len(idx), dtype=bool)
@@ -337,9 +336,9 @@ class ParticleSystem(EpisodeComponent):
                     active[k] = False
                     self._park(pid, int(k))
                 elif (
-                    lost_id is not None
+                    lost_to is not None
                     and to_anchor[j] >= ps.lost_distance
-                    and not closest(pid, lost_id, ps.lost_distance, physicsClientId=c)
+                    and not own_points(closest(lost_to.id, pid, ps.lost_distance, physicsClientId=c), lost_to)
                 ):
                     # Within lost_distance of a point inside the holder means certainly near it;
                     # only otherwise is the exact closest-points query needed.

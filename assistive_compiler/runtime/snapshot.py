@@ -21,7 +21,7 @@ import pybullet as pb
 from ..references import JointGroup, JointsHandle, NodeSet, NodesHandle, Point, PointHandle, TargetPoint
 from ..rotation import quat_conj, quat_matrix, quat_mul, quat_rotate  # noqa: F401  (re-exported)
 from ..terms.reads import ContactPoint, ParticleEvents, SceneReads
-from .world import BodyHandle, World
+from .world import BodyHandle, World, own_points
 
 CLOSEST_SLACK_M = (
     0.05  # closest_distance first looks this far beyond its last answer (m); any value gives the same result
@@ -56,9 +56,9 @@ class Snapshot:
         self._joint_cache: dict[JointsHandle, np.ndarray] = {}
         self.pos, self.orn, self.vel = np.zeros((0, 3)), np.zeros((0, 4)), np.zeros((0, 3))
         self.frames: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-        self._ids: dict[tuple[str, ...], tuple[int, ...]] = {}
+        self._handles: dict[tuple[str, ...], tuple[BodyHandle, ...]] = {}
         # last closest_distance per (body, bodies): where the next query starts
-        self._closest_hint: dict[tuple[str, tuple[int, ...]], float] = {}
+        self._closest_hint: dict[tuple[str, tuple[str, ...]], float] = {}
         self._garment_nodes: dict[int, np.ndarray] = {}
         # pybullet reports a soft body's contact forces of its last solver sub-step only: scale them
         # back to the physics step (docs/dressing-study.md: then Σ|f_n| ≈ the weight it rests on).
@@ -239,17 +239,17 @@ class Snapshot:
             self._contacts[key] = pb.getContactPoints(bodyA=a, bodyB=b, physicsClientId=self.world.client)
         return self._contacts[key]
 
-    def body_ids(self, names: Sequence[str]) -> tuple[int, ...]:
-        """pybullet ids of named bodies ('person' = the active variant), cached for the episode."""
+    def body_handles(self, names: Sequence[str]) -> tuple[BodyHandle, ...]:
+        """Handles of named bodies ('person' = the active variant), cached for the episode."""
         key = tuple(names)
-        ids = self._ids.get(key)
-        if ids is None:
-            ids = self._ids[key] = tuple(self.handle(self.body_key(n)).id for n in names)
-        return ids
+        handles = self._handles.get(key)
+        if handles is None:
+            handles = self._handles[key] = tuple(self.handle(self.body_key(n)) for n in names)
+        return handles
 
     def begin_episode(self) -> None:
         """Forget what depended on the last episode's person variant."""
-        self._ids.clear()
+        self._handles.clear()
         self._pooled.clear()
         self._closest_hint.clear()
 
@@ -260,9 +260,9 @@ class Snapshot:
         out = self._pooled.get(key)
         if out is None:
             out = []
-            for ia in self.body_ids(a):
-                for ib in self.body_ids(b):
-                    out.extend(self._contact_points(ia, ib))
+            for ha in self.body_handles(a):
+                for hb in self.body_handles(b):
+                    out.extend(own_points(self._contact_points(ha.id, hb.id), ha, hb))
             self._pooled[key] = out
         return out
 
@@ -273,26 +273,26 @@ class Snapshot:
         pairs then drop out in the broadphase instead of each returning its closest points), and
         within ``max_distance`` only when nothing that near is found: the same minimum, since every
         pair nearer than the first query's reach is reported by it."""
-        ia = self.body_ids([a])[0]
-        ids = self.body_ids(b)
-        key = (a, ids)
+        ha = self.body_handles([a])[0]
+        hbs = self.body_handles(b)
+        key = (a, tuple(h.name for h in hbs))
         hint = self._closest_hint.get(key)
         if hint is not None and hint + CLOSEST_SLACK_M < max_distance:
             reach = hint + CLOSEST_SLACK_M
-            best = self._closest(ia, ids, reach)
+            best = self._closest(ha, hbs, reach)
             if best is not None and best <= reach:
                 self._closest_hint[key] = best
                 return best
-        best = self._closest(ia, ids, max_distance)
+        best = self._closest(ha, hbs, max_distance)
         best = max_distance if best is None else min(best, max_distance)
         self._closest_hint[key] = best
         return best
 
-    def _closest(self, ia: int, ids: tuple[int, ...], reach: float) -> float | None:
-        """Smallest distance (m) of the closest points of body ``ia`` and bodies ``ids`` within ``reach``; None if none."""
+    def _closest(self, ha: BodyHandle, hbs: tuple[BodyHandle, ...], reach: float) -> float | None:
+        """Smallest distance (m) of the closest points of body ``ha`` and bodies ``hbs`` within ``reach``; None if none."""
         client, best = self.world.client, None
-        for ib in ids:
-            points = pb.getClosestPoints(ia, ib, reach, physicsClientId=client)
+        for hb in hbs:
+            points = own_points(pb.getClosestPoints(ha.id, hb.id, reach, physicsClientId=client), ha, hb)
             if points:
                 d = min([cp[8] for cp in points])
                 best = d if best is None or d < best else best
@@ -313,9 +313,10 @@ class Snapshot:
 
     def contact_force_and_count(self, a: str, b: Sequence[str], distance: float) -> tuple[float, int]:
         """Contact force of body ``a`` on ``b`` (N) and the number of closest points within ``distance``."""
-        ia = self.body_ids([a])[0]
+        ha = self.body_handles([a])[0]
         count = sum(
-            len(pb.getClosestPoints(ia, ib, distance, physicsClientId=self.world.client)) for ib in self.body_ids(b)
+            len(own_points(pb.getClosestPoints(ha.id, hb.id, distance, physicsClientId=self.world.client), ha, hb))
+            for hb in self.body_handles(b)
         )
         return self.contact_force([a], b), count
 

@@ -57,6 +57,21 @@ class BodyHandle:
     joints: dict[str, int]
     inertial_inv: tuple  # inverse of the base's local inertial frame (COM → URDF frame)
     pose_id: int | None = None  # body whose base pose is this body's frame (a garment: its anchor; None: id itself)
+    #: A welded tool: the link of ``id`` (the robot) that is its base; −1: its own body's base.
+    base_link: int = -1
+    #: The links of ``id`` that are this body's when it shares its pybullet body with another (a
+    #: welded tool and the robot it is welded to: contacts and distances are filtered to them);
+    #: None: every link of ``id``.
+    link_set: frozenset[int] | None = None
+
+
+def own_points(points, a: BodyHandle, b: BodyHandle | None = None) -> list:
+    """Those of pybullet's contact or closest points between ``a.id`` (bodyA) and ``b.id`` (bodyB)
+    that lie on the links of ``a`` and ``b`` themselves (see :attr:`BodyHandle.link_set`)."""
+    keep_a, keep_b = a.link_set, b.link_set if b is not None else None
+    if keep_a is None and keep_b is None:
+        return list(points)
+    return [cp for cp in points if (keep_a is None or cp[3] in keep_a) and (keep_b is None or cp[4] in keep_b)]
 
 
 @dataclass
@@ -122,7 +137,10 @@ class World:
         self.ground = pb.createMultiBody(0, floor, floor_visual, [0, 0, 0], physicsClientId=c)
 
         self.bodies: dict[str, BodyHandle] = {}
+        welded = {att.body for att in self.m.tools if att.welded}
         for body in self.m.bodies:
+            if body.name in welded:  # its links are the robot's: see _weld_handles
+                continue
             flags = pb.URDF_USE_INERTIA_FROM_FILE
             self_collision = body.kind == "person" and bool(self.m.person.self_collision)
             if self_collision:
@@ -148,6 +166,7 @@ class World:
                     bid, joints, pb.VELOCITY_CONTROL, forces=[0.0] * len(joints), physicsClientId=c
                 )
 
+        self._weld_handles()
         self._skip_immovable_pairs()
         self.robot = self.bodies["robot"]
         self.variant_bodies = {v.name: self.bodies[v.body] for v in self.m.person.variants}
@@ -180,6 +199,41 @@ class World:
             links[info[12].decode()] = j
         ipos, iorn = pb.getDynamicsInfo(bid, -1, physicsClientId=c)[3:5]
         return BodyHandle(name, bid, links, joints, pb.invertTransform(ipos, iorn))
+
+    def _weld_handles(self) -> None:
+        """A handle per welded tool on its links of the robot's multibody (the tool's root, on the
+        fixed joint ``<tool>_grip``, and every link below it); the robot's handle keeps the rest.
+        Both get a :attr:`BodyHandle.link_set`, so contacts and distances stay each one's own."""
+        tools = [att for att in self.m.tools if att.welded]
+        if not tools:
+            return
+        c, robot = self.client, self.bodies["robot"]
+        parent = {j: pb.getJointInfo(robot.id, j, physicsClientId=c)[16] for j in robot.joints.values()}
+        owner: dict[int, str] = {}
+        for att in tools:
+            root = robot.links[att.links["base"]]
+            for link in sorted(parent):  # a child's index is larger than its parent's
+                if link == root or owner.get(parent[link]) == att.body:
+                    owner[link] = att.body
+        for att in tools:
+            mine = {link for link, tool in owner.items() if tool == att.body}
+            self.bodies[att.body] = BodyHandle(
+                att.body,
+                robot.id,
+                {name: i for name, i in robot.links.items() if i in mine},
+                {name: j for name, j in robot.joints.items() if j in mine},
+                ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)),
+                base_link=robot.links[att.links["base"]],
+                link_set=frozenset(mine),
+            )
+        self.bodies["robot"] = BodyHandle(
+            "robot",
+            robot.id,
+            {name: i for name, i in robot.links.items() if i not in owner},
+            {name: j for name, j in robot.joints.items() if j not in owner},
+            robot.inertial_inv,
+            link_set=frozenset(i for i in robot.links.values() if i not in owner),
+        )
 
     def _skip_immovable_pairs(self) -> None:
         """No collision between links that can never move, of different bodies.
@@ -244,6 +298,8 @@ class World:
         c = self.client
         self.tool_constraints: dict[str, int] = {}
         for att in self.m.tools:
+            if att.welded:  # already a part of the robot
+                continue
             tool = self.bodies[att.body]
             parent = self.robot.links[att.parent_link]
             # Constraint frames are relative to centres of mass: convert from URDF link frames.
@@ -378,7 +434,12 @@ class World:
         """Choose the world gravity needing the fewest compensated links; list those links."""
         c = self.client
         candidates: dict[float, list[tuple[int, int, float]]] = {}
-        declared = {b.name: (self.m.sim.gravity if b.gravity is None else b.gravity) for b in self.m.bodies}
+        welded = {att.body for att in self.m.tools if att.welded}  # they feel the robot's gravity (the compiler checks)
+        declared = {
+            b.name: (self.m.sim.gravity if b.gravity is None else b.gravity)
+            for b in self.m.bodies
+            if b.name not in welded
+        }
         for ps in self.m.particles:
             for k in range(len(self.particles[ps.name])):
                 declared[f"{ps.name}#{k}"] = self.m.sim.gravity
@@ -444,7 +505,7 @@ class World:
 
     def _is_fixed_base(self, bid: int) -> bool:
         for b in self.m.bodies:
-            if self.bodies[b.name].id == bid:
+            if self.bodies[b.name].id == bid and self.bodies[b.name].base_link == -1:
                 return b.fixed_base
         return False
 
@@ -528,14 +589,20 @@ class World:
 
     # -- frames --------------------------------------------------------------------------------
     def base_frame(self, handle: BodyHandle):
-        """World pose of a body's URDF base frame (a garment's: its held frame)."""
+        """World pose of a body's URDF base frame (a garment's: its held frame; a welded tool's: its
+        root link's)."""
+        if handle.base_link >= 0:
+            return self.link_frame(handle, handle.base_link)
         com_pos, com_orn = pb.getBasePositionAndOrientation(
             handle.id if handle.pose_id is None else handle.pose_id, physicsClientId=self.client
         )
         return pb.multiplyTransforms(com_pos, com_orn, *handle.inertial_inv)
 
     def set_base_frame(self, handle: BodyHandle, pos, orn) -> None:
-        """Place a body so that its URDF base frame is at (pos, orn)."""
+        """Place a body so that its URDF base frame is at (pos, orn); not a welded tool, which goes
+        where the robot's hand goes."""
+        if handle.base_link >= 0:
+            raise ValueError(f"'{handle.name}' is welded to the robot: it moves with the robot's hand")
         inv = pb.invertTransform(*handle.inertial_inv)
         com_pos, com_orn = pb.multiplyTransforms(pos, orn, *inv)
         pb.resetBasePositionAndOrientation(handle.id, com_pos, com_orn, physicsClientId=self.client)

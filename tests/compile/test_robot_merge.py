@@ -1,8 +1,11 @@
 """The robot's fixed links merged at compile time (:mod:`assistive_compiler.compile.robot`): every
 link the manifest names survives, nothing else hangs on a fixed joint, and the robot's dynamics
-(mass matrix, gravity torques) are those of the robot as emitted before the merge."""
+(mass matrix, gravity torques) are those of the robot as emitted, with its tool welded on, before
+the merge."""
 
 from __future__ import annotations
+
+import xml.etree.ElementTree as ET
 
 import numpy as np
 import pybullet as pb
@@ -11,7 +14,7 @@ from conftest import REPO
 
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.compile.emit import emit_props
-from assistive_compiler.compile.robot import _names_in
+from assistive_compiler.compile.robot import _names_in, _weld
 from assistive_compiler.library import Library
 from assistive_compiler.resolve import resolve
 from assistive_compiler.spec.load import load_spec
@@ -22,7 +25,8 @@ ITCH = REPO / "specs" / "tasks" / "scratch_itch.yaml"
 
 @pytest.fixture(scope="module", params=["pr2", "jaco"])
 def merged_and_emitted(request, tmp_path_factory):
-    """(the artifact's robot URDF, the robot URDF as stage 1 emits it, the manifest)."""
+    """(the artifact's robot URDF, the robot URDF as stage 1 emits it with the artifact's welded
+    tools on it and unmerged, the manifest)."""
     robot = request.param
     tmp = tmp_path_factory.mktemp(f"robot-merge-{robot}")
     result = compile_task(ITCH, robot, tmp / "artifact")
@@ -31,7 +35,11 @@ def merged_and_emitted(request, tmp_path_factory):
         resolve(loaded, robot, Library.for_spec(loaded.path)), tmp / "emitted", Library.for_spec(loaded.path)
     )
     merged = (result.out_dir / result.manifest.body("robot").urdf).read_text()
-    return merged, scene.written["robot"].read_text(), result.manifest
+    emitted = ET.fromstring(scene.written["robot"].read_text())
+    for att in result.manifest.tools:
+        assert att.welded  # the scratcher: nothing rests in it
+        _weld(emitted, att, ET.parse(scene.written[att.body]).getroot())
+    return merged, ET.tostring(emitted, encoding="unicode"), result.manifest
 
 
 def test_named_links_survive_and_no_other_hangs_on_a_fixed_joint(merged_and_emitted):

@@ -104,5 +104,5 @@ def test_person_follows_the_episode_variant(env, snap):
     for variant in ("female_50th", "male_50th"):
         env.reset(seed=1, options={"person_variant": variant})
         snap.begin_episode()
-        assert snap.body_ids(["person"]) == (env.body_id(f"person_{variant}"),)
+        assert [h.id for h in snap.body_handles(["person"])] == [env.body_id(f"person_{variant}")]
         assert snap.handle("person").id == env.body_id("person")

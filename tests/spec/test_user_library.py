@@ -53,9 +53,10 @@ def test_readme_walkthrough_runs_through_the_cli_outside_the_package(tmp_path):
         "long_scratch for jaco  policy=scripted" in outputs[2]
     )  # a user's spec has no id of its own (it is made as Task-v1)
     assert (tmp_path / "long_scratch.png").stat().st_size > 10_000
-    tool = tmp_path / "build" / "long_scratch" / "urdf"
-    urdf = next(p for p in tool.glob("*.urdf") if "long_scratcher" in p.read_text())
-    assert '<joint name="tip_joint"' in urdf.read_text()  # the user's template, not the shipped scratcher
+    # The user's template, not the shipped scratcher: its links, welded into the robot's URDF.
+    robot = (tmp_path / "build" / "long_scratch" / "urdf" / "robot.urdf").read_text()
+    assert '<joint name="scratcher_grip"' in robot and '<link name="handle"' in robot
+    assert '<joint name="tip_joint"' in robot and '<link name="scratcher"' not in robot
 
 
 def test_a_library_outside_the_spec_folder_is_found_with_library_and_the_environment(tmp_path):
@@ -93,10 +94,11 @@ def test_python_make_finds_the_same_parts(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     env = assistive_compiler.make(project / "specs" / "tasks" / "long_scratch.yaml", "jaco", out_dir=tmp_path / "out")
     assert env.manifest.gym_id == "assistive_compiler/Task-v1" and env.manifest.label == "long_scratch for jaco"
-    assert any(
-        b.name == "scratcher" and "long_scratcher" in (tmp_path / "out" / b.urdf).read_text()
-        for b in env.manifest.bodies
+    (tool,) = env.manifest.tools  # the user's long_scratcher, welded to the hand
+    assert (
+        tool.body == "scratcher" and tool.welded and tool.links == {"base": "handle", "handle": "handle", "tip": "tip"}
     )
+    assert '<link name="handle"' in (tmp_path / "out" / env.manifest.body("scratcher").urdf).read_text()
     env.close()
 
 
