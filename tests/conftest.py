@@ -47,26 +47,22 @@ def built_once(tmp_path_factory, worker_id: str, name: str, build: Callable[[Pat
     return mine
 
 
+def shipped_once(tmp_path_factory, worker_id: str, task: str, robot: str) -> Path:
+    """The shipped task ``task`` compiled for ``robot``, once per test session (:func:`built_once`)."""
+    spec = REPO / "specs" / "tasks" / f"{task}.yaml"
+    return built_once(tmp_path_factory, worker_id, f"{task}-{robot}", lambda out: compile_task(spec, robot, out))
+
+
 @pytest.fixture(scope="session")
 def stretch_scratch_artifact(tmp_path_factory, worker_id) -> Path:
     """Scratch Itch compiled for Stretch (a mobile base and telescoping tubes), once per session."""
-    return built_once(
-        tmp_path_factory,
-        worker_id,
-        "scratch_itch-stretch",
-        lambda out: compile_task(REPO / "specs" / "tasks" / "scratch_itch.yaml", "stretch", out),
-    )
+    return shipped_once(tmp_path_factory, worker_id, "scratch_itch", "stretch")
 
 
 @pytest.fixture(scope="session")
 def itch_artifact(tmp_path_factory, worker_id) -> Path:
     """Scratch Itch compiled for Jaco (its scratcher welded to the hand), once per session."""
-    return built_once(
-        tmp_path_factory,
-        worker_id,
-        "scratch_itch-jaco",
-        lambda out: compile_task(REPO / "specs" / "tasks" / "scratch_itch.yaml", "jaco", out),
-    )
+    return shipped_once(tmp_path_factory, worker_id, "scratch_itch", "jaco")
 
 
 @pytest.fixture

@@ -64,9 +64,9 @@ def test_the_welded_tool_is_at_its_grip_on_the_robots_body(itch):
 def test_contacts_and_distances_stay_the_tools_own(itch):
     """The scripted policy scratches: every contact of the robot's pybullet body with the person is
     either the scratcher's (on its links) or the arm's, never both, and distances follow."""
-    snap, person = itch.snap, itch.body_id("person")
     policy = make_policy("scripted", itch)
     obs, _ = itch.reset(seed=0)
+    snap, person = itch.snap, itch.body_id("person")  # this episode's variant
     tool_set = set(itch.links("scratcher").values())
     touched = 0
     for _ in range(itch.manifest.sim.episode_steps):
