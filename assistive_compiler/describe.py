@@ -76,7 +76,12 @@ def describe_scene(env) -> dict:
         },
         "robot_links": {role: link for role, link in sorted(m.robot.links.items())},
         "tools": [
-            {"body": t.body, "held_by": f"robot.{t.parent_link}", "links": dict(sorted(t.links.items()))}
+            {
+                "body": t.body,
+                "held_by": f"robot.{t.parent_link}",
+                "held_as": "welded" if t.welded else "constraint",
+                "links": dict(sorted(t.links.items())),
+            }
             for t in m.tools
         ],
         "targets": [
@@ -102,6 +107,12 @@ def describe_scene(env) -> dict:
     return out
 
 
+_HELD_AS = {
+    "welded": "welded to it: links of the robot's body",
+    "constraint": "a fixed constraint of at most 500 N",
+}
+
+
 def describe_text(d: dict) -> str:
     """:func:`describe_scene`'s dict as the lines ``describe`` prints."""
     p = d["person"]
@@ -114,7 +125,8 @@ def describe_text(d: dict) -> str:
     )
     for t in d["tools"]:
         lines.append(
-            f"tool {t['body']}: held by {t['held_by']}; links " + ", ".join(f"{k} = {v}" for k, v in t["links"].items())
+            f"tool {t['body']}: held by {t['held_by']} ({_HELD_AS[t['held_as']]}); links "
+            + ", ".join(f"{k} = {v}" for k, v in t["links"].items())
         )
     for t in d["targets"]:
         where = "drawn on the surface of " if t["drawn_on_surface"] else "on "

@@ -44,6 +44,7 @@ def test_describe_reports_the_scene_as_pybullet_has_it(artifact, capsys):
         assert len(parked) == 1 and parked[0]["links"] == []
         assert scene["robot_links"]["end_effector"] == "j2s7s300_end_effector"
         assert scene["tools"][0]["body"] == "spoon" and scene["particles"][0]["count"] == 8
+        assert scene["tools"][0]["held_as"] == "constraint"  # the food rests in it: held as the reference holds it
     finally:
         env.close()
 

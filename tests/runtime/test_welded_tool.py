@@ -13,6 +13,7 @@ import pytest
 
 import assistive_compiler  # noqa: F401  (registers the ids)
 from assistive_compiler.artifact import Manifest
+from assistive_compiler.describe import describe_scene, describe_text
 from assistive_compiler.policies import make_policy
 from assistive_compiler.runtime.env import AssistiveEnv
 
@@ -57,6 +58,10 @@ def test_the_welded_tool_is_at_its_grip_on_the_robots_body(itch):
     for pose in (itch.base_pose("scratcher"), itch.link_pose("scratcher", "scratcher")):  # pybullet reads: float32
         assert np.allclose(pose[0], expected[0], atol=1e-6)
         assert abs(abs(float(np.dot(pose[1], expected[1]))) - 1.0) < 1e-6  # the grip's quaternion has 6 digits
+    assert (
+        f"tool scratcher: held by robot.{att.parent_link} (welded to it: links of the robot's body)"
+        in describe_text(describe_scene(itch))
+    )
     with pytest.raises(ValueError, match="'scratcher' is welded to the robot: it moves with the robot's hand"):
         itch.world.set_base_frame(itch.world.bodies["scratcher"], (0, 0, 1), (0, 0, 0, 1))
 
