@@ -667,9 +667,8 @@ class Manifest(_Model):
         "(person variant, surface targets, robot start, furniture noise, floor friction) and the "
         "components' episode starts (:func:`reset_events`)."
     )
-    #: The manifest as its file holds it, when that differs from how it reads (an older format,
-    #: migrated on reading, or one written before a field with a default was added): its content
-    #: hash covers that form.
+    #: The manifest as its file holds it, when that was an older format (migrated on reading):
+    #: its content hash covers that form.
     _as_written: dict[str, Any] | None = PrivateAttr(None)
 
     @model_validator(mode="before")
@@ -710,7 +709,7 @@ class Manifest(_Model):
         return b"".join(Path(artifact_dir, b.urdf).read_bytes() for b in sorted(self.bodies, key=lambda b: b.urdf))
 
     def _hash(self, files: bytes, *, with_input_hash: bool, as_written: bool = False) -> str:
-        """``as_written``: of the manifest in the form its file holds (an older one's), not today's."""
+        """``as_written``: of the manifest in the form its file holds (an older format's), not today's."""
         blank = {"content_hash": ""} if with_input_hash else {"content_hash": "", "input_hash": ""}
         if as_written and self._as_written is not None:
             text = json.dumps(self._as_written | blank, indent=1, sort_keys=True) + "\n"
@@ -753,9 +752,7 @@ class Manifest(_Model):
             text = path.read_text()
             manifest = cls.model_validate_json(text)  # pydantic's own messages for malformed JSON
             written = json.loads(text)
-            if (
-                manifest.model_dump(mode="json") != written
-            ):  # an older format, or fields added since (at their defaults)
+            if manifest.format_version != written.get("format_version"):
                 manifest._as_written = written
         except (ValueError, UnicodeDecodeError) as exc:
             raise SpecError.at(

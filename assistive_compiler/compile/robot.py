@@ -66,10 +66,11 @@ def weld_tools(manifest: Manifest, scene: EmittedScene) -> Manifest:
         return manifest
     robot_path = scene.written["robot"]
     robot = ET.fromstring(robot_path.read_text())
-    tools, bodies = [], []
+    tools = []
     for att in manifest.tools:
-        if _weldable(manifest, att, robot, ET.parse(scene.written[att.body]).getroot()):
-            _weld(robot, att, ET.parse(scene.written[att.body]).getroot())
+        tool = ET.parse(scene.written[att.body]).getroot()
+        if _weldable(manifest, att, robot, tool):
+            _weld(robot, att, tool)
             scene.written.pop(att.body).unlink()
             att = att.model_copy(update={"welded": True})
         tools.append(att)

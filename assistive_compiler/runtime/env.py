@@ -409,7 +409,7 @@ class AssistiveEnv(gym.Env):
         """The name a spec uses for link ``link`` of pybullet body ``body_id``: as :meth:`body_names`,
         except that a welded tool's links are the tool's (e.g. to name a contact point's bodies)."""
         for name, h in self.world.bodies.items():
-            if h.id == body_id and h.link_set is not None and link in h.link_set and h.base_link >= 0:
+            if h.base_link >= 0 and h.id == body_id and link in (h.link_set or ()):
                 return name
         return self.body_names().get(body_id, str(body_id))
 

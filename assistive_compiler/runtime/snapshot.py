@@ -275,7 +275,7 @@ class Snapshot:
         pair nearer than the first query's reach is reported by it."""
         ha = self.body_handles([a])[0]
         hbs = self.body_handles(b)
-        key = (a, tuple(h.name for h in hbs))
+        key = (a, tuple(b))
         hint = self._closest_hint.get(key)
         if hint is not None and hint + CLOSEST_SLACK_M < max_distance:
             reach = hint + CLOSEST_SLACK_M

@@ -28,7 +28,7 @@ Frames: pybullet reports a base's pose at its centre of mass; :meth:`base_frame`
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -65,12 +65,13 @@ class BodyHandle:
     link_set: frozenset[int] | None = None
 
 
-def own_points(points, a: BodyHandle, b: BodyHandle | None = None) -> list:
+def own_points(points: Sequence, a: BodyHandle, b: BodyHandle | None = None) -> Sequence:
     """Those of pybullet's contact or closest points between ``a.id`` (bodyA) and ``b.id`` (bodyB)
-    that lie on the links of ``a`` and ``b`` themselves (see :attr:`BodyHandle.link_set`)."""
+    that lie on the links of ``a`` and ``b`` themselves (see :attr:`BodyHandle.link_set`); ``points``
+    itself when neither shares its pybullet body (the common case, on every step: no copy)."""
     keep_a, keep_b = a.link_set, b.link_set if b is not None else None
     if keep_a is None and keep_b is None:
-        return list(points)
+        return points
     return [cp for cp in points if (keep_a is None or cp[3] in keep_a) and (keep_b is None or cp[4] in keep_b)]
 
 
