@@ -39,32 +39,66 @@ print(json.dumps({"import_s": import_s, "heavy_modules_on_import": heavy,
 """
 
 
-SIDE_BY_SIDE = (
-    "measured side by side on 2026-11-27: quiet 2-core machine, one core each, interleaved fresh processes, "
-    "the reference at its own solver settings on stock pybullet with its fork-only gravity emulation's time removed "
-    "(the reference harness); random actions"
+REFERENCE_SESSION = (
+    "measured side by side on 2026-11-29 with the reference harness (quiet 2-core machine, each side in a fresh "
+    "process pinned to one core, interleaved; the reference at its own solver settings on stock pybullet, its "
+    "fork-only gravity emulation's time removed; the harness's episodes of random actions)"
 )
 LOADED_ONCE = (
     "measured once, not side by side, on a shared 2-core machine under load (stock pybullet, random actions, "
-    "200-step episodes): lower than the reference does on a quiet machine, so the ratio overstates ours there"
+    "200-step episodes), before the machine probe existed, so not carried over to this machine: lower than the "
+    "reference does on a quiet machine, so the ratio overstates ours there (the reference's Baxter and Sawyer "
+    "no longer load in the harness to measure them again)"
 )
 
-#: Env steps/s of the reference implementation (Assistive Gym v1.0) per (task, robot), with how each
-#: figure was taken (the ratio is only as good as that). Dressing does not run on stock pybullet.
-#: ``--reference-json`` replaces them with figures measured beside ours.
+REFERENCE_PROBE_STEPS_PER_S = (1778.0, 1)
+"""The machine probe (:mod:`assistive_compiler.machine_probe`: its steps/s, its version) in
+:data:`REFERENCE_SESSION`: the median of 30 probe runs pinned to the harness's core, one after each
+pair of harness runs."""
+
+#: Env steps/s of the reference implementation (Assistive Gym v1.0) per (task, robot) on its own
+#: pybullet fork, and how each was taken. Those of :data:`REFERENCE_SESSION` (medians of 3–4
+#: interleaved rounds) are carried over to the machine as it runs now by the machine probe; the
+#: reference has no Panda or Stretch, and its Dressing needs its fork. ``--reference-json``
+#: replaces them with figures measured beside ours.
 REFERENCE_STEPS_PER_S: dict[tuple[str, str], tuple[float, str]] = {
-    ("feeding", "jaco"): (348, SIDE_BY_SIDE),
-    ("scratch_itch", "jaco"): (620, SIDE_BY_SIDE),
-    ("drinking", "jaco"): (44, SIDE_BY_SIDE),
-    ("bed_bathing", "jaco"): (170, SIDE_BY_SIDE),
-    ("arm_manipulation", "jaco"): (338, SIDE_BY_SIDE),
-    ("scratch_itch", "pr2"): (188, LOADED_ONCE),
+    ("feeding", "jaco"): (182.6, REFERENCE_SESSION),
+    ("scratch_itch", "jaco"): (328.0, REFERENCE_SESSION),
+    ("drinking", "jaco"): (25.5, REFERENCE_SESSION),
+    ("bed_bathing", "jaco"): (86.4, REFERENCE_SESSION),
+    ("arm_manipulation", "jaco"): (199.8, REFERENCE_SESSION),
+    ("feeding", "pr2"): (97.7, REFERENCE_SESSION),
+    ("scratch_itch", "pr2"): (159.5, REFERENCE_SESSION),
+    ("drinking", "pr2"): (20.3, REFERENCE_SESSION),
+    ("bed_bathing", "pr2"): (69.4, REFERENCE_SESSION),
+    ("arm_manipulation", "pr2"): (118.9, REFERENCE_SESSION),
     ("scratch_itch", "sawyer"): (428, LOADED_ONCE),
     ("scratch_itch", "baxter"): (312, LOADED_ONCE),
-    ("feeding", "pr2"): (135, LOADED_ONCE),
     ("feeding", "sawyer"): (237, LOADED_ONCE),
     ("feeding", "baxter"): (199, LOADED_ONCE),
 }
+
+
+def reference_now(task: str, robot: str, probe_now: float) -> tuple[float, float | None, float, str] | None:
+    """The stored reference figure of (task, robot) for this machine now: (the figure as stored,
+    this machine's speed now over the stored session's by the probe, the figure carried over by it,
+    how it was taken). A figure from before the probe, or from a probe of another version, is not
+    carried over (speed None, the figure as stored); None where the reference was not measured."""
+    from ..machine_probe import PROBE_VERSION
+
+    if (task, robot) not in REFERENCE_STEPS_PER_S:
+        return None
+    stored, how = REFERENCE_STEPS_PER_S[(task, robot)]
+    probe_then, version = REFERENCE_PROBE_STEPS_PER_S
+    if how != REFERENCE_SESSION or version != PROBE_VERSION:
+        return stored, None, stored, how
+    speed = probe_now / probe_then
+    return (
+        stored,
+        speed,
+        stored * speed,
+        f"{how}; carried over to this machine's speed now by the machine probe (machine_speed_vs_reference_session)",
+    )
 
 
 def load_reference_json(path: str) -> dict[str, float]:
@@ -168,6 +202,32 @@ def _percent(shares: dict[str, float]) -> str:
     return ", ".join(f"{stage} {100 * share:.0f}%" for stage, share in shares.items()) or MISSING
 
 
+def measure_harness_protocol(env) -> float:
+    """Env steps/s the way the reference harness measures both implementations, so that the ratio
+    to its figures compares like with like: ``reset(seed=1001)``, ten resets, then two episodes
+    (each after an unseeded reset) of 200 steps of uniform random actions in [-1, 1] from numpy's
+    ``default_rng(0)``, only ``step`` timed. Episodes differ in cost (in Arm Manipulation the
+    male person's costs a quarter more than the female's), so a figure from other episodes is not
+    comparable to the reference's."""
+    import numpy as np
+
+    env.reset(seed=1001)
+    for _ in range(10):
+        env.reset()
+    rng = np.random.default_rng(0)
+    n = env.action_space.shape[0]
+    spent, steps = 0.0, 0
+    for _ in range(2):
+        env.reset()
+        for _ in range(200):
+            action = rng.uniform(-1, 1, n).astype(np.float32)
+            t0 = time.perf_counter()
+            env.step(action)
+            spent += time.perf_counter() - t0
+            steps += 1
+    return steps / spent
+
+
 def measure_process(artifact_dir: Path) -> dict:
     """In a fresh interpreter: ``import assistive_compiler`` time (s), heavy modules it imported, and
     peak RSS (MB) of one env stepped 200 times."""
@@ -210,8 +270,12 @@ def bench(
     Env steps/s is measured at the spec's solver settings and, where they differ, at the reference
     implementation's (:mod:`~assistive_compiler.spec.reference_solver`: an artifact compiled from
     an ``extends:`` variant), the same episodes and actions, repeats interleaved; each against the
-    reference's measured rate, so no speed claim rests on simulating less."""
+    reference's measured rate, so no speed claim rests on simulating less. The ratio to the
+    reference is taken on the reference harness's own episodes (:func:`measure_harness_protocol`),
+    and a stored reference figure is first carried over to this machine's speed now
+    (:func:`reference_now`, the :mod:`~assistive_compiler.machine_probe`)."""
     from ..compile.compiler import compile_task
+    from ..machine_probe import probe_steps_per_s
     from ..runtime.env import AssistiveEnv
     from ..spec.load import load_spec
     from ..spec.reference_solver import reference_solver, solver_settings, write_reference_variant
@@ -235,6 +299,7 @@ def bench(
         raw_loop = measure_raw_loop(env, steps)
         reset_ms, seeded_ms = measure_resets(env, resets)
         stages = measure_stages(env, steps, seed)
+        harness_rate = measure_harness_protocol(env)
         m = env.manifest
         env.close()
         proc = measure_process(cold.out_dir)
@@ -242,14 +307,17 @@ def bench(
     raw_med = statistics.median(raw_rates)
     reset_med, reset_p95 = _median_p95(reset_ms)
     env_name = m.gym_id.rpartition("/")[2].removesuffix("-v1")
+    probe_now = probe_steps_per_s()
+    stored = reference = speed = None
+    reference_figure = None
     if reference_json is not None:
         reference = reference_json.get(env_name)
-        reference_figure = (
-            f"{reference_file}: measured beside ours with the reference harness" if reference is not None else None
-        )
-        reference = round(reference, 1) if reference is not None else None
+        if reference is not None:
+            reference_figure = f"{reference_file}: measured beside ours with the reference harness"
     else:
-        reference, reference_figure = REFERENCE_STEPS_PER_S.get((m.task, m.robot_name), (None, None))
+        carried = reference_now(m.task, m.robot_name, probe_now)
+        if carried is not None:
+            stored, speed, reference, reference_figure = carried
     ref_solver = reference_solver(m.task)
     # At the reference's solver settings: measured on the variant's artifact, or the same figure when
     # the spec already uses them (None: the reference has no such task).
@@ -265,14 +333,18 @@ def bench(
         "obs_size": sum(t.size for t in m.observations["robot"]),
         "action_size": m.robot.action_size,
         "env_steps_per_s": round(env_med, 1),
-        "reference_env_steps_per_s": reference,
+        "env_steps_per_s_harness_episodes": round(harness_rate, 1),
+        "reference_env_steps_per_s": round(reference, 1) if reference is not None else None,
         "reference_figure": reference_figure,
-        "vs_reference": round(env_med / reference, 2) if reference is not None else None,
+        "reference_env_steps_per_s_as_stored": stored,
+        "machine_probe_steps_per_s": round(probe_now, 1),
+        "machine_speed_vs_reference_session": round(speed, 3) if speed is not None else None,
+        "vs_reference": round(harness_rate / reference, 2) if reference is not None else None,
         "solver": solver_settings(loaded),
         "reference_solver": ref_solver,
         "reference_solver_is_shipped": ref_solver is not None and variant is None,
         "env_steps_per_s_reference_solver": round(at_ref, 1) if at_ref is not None else None,
-        "vs_reference_at_reference_solver": round(at_ref / reference, 2)
+        "vs_reference_at_reference_solver": round(harness_rate * (at_ref / env_med) / reference, 2)
         if at_ref is not None and reference is not None
         else None,
         "raw_physics_steps_per_s": round(raw_med, 1),
@@ -291,7 +363,11 @@ def bench(
         "peak_rss_mb_one_env": round(proc["peak_rss_mb"], 1),
         "steps_per_repeat": steps,
         "repeats": repeats,
-        "notes": "env/raw: the same episodes, physics timed inside env.step (stepSimulation + gravity compensation) vs the whole step; "
+        "notes": "vs_reference: our env steps/s on the reference harness's episodes over the reference's on them, "
+        "its stored figure carried over to this machine's speed now by the machine probe (or a --reference-json "
+        "figure measured beside ours as it is); at the reference's solver: that ratio times the reference-settings "
+        "variant's speed over the shipped spec's on the paired episodes; "
+        "env/raw: the same episodes, physics timed inside env.step (stepSimulation + gravity compensation) vs the whole step; "
         "reference_solver: the same episodes and actions on an artifact compiled with the reference's sim.solver, repeats "
         "interleaved with the shipped ones (when reference_solver_is_shipped, the same figure as env_steps_per_s); random actions; "
         "medians over repeats; physics_stages: each stage's share of stepSimulation by Bullet's profiler over one more "
@@ -308,7 +384,9 @@ BENCH_TABLE = (
     "raw_physics_steps_per_s",
     "env_over_raw",
     "reset_ms_median",
+    "env_steps_per_s_harness_episodes",
     "reference_env_steps_per_s",
+    "machine_speed_vs_reference_session",
     "vs_reference",
     "vs_reference_at_reference_solver",
 )

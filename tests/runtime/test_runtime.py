@@ -527,11 +527,13 @@ def test_cli_run_json(artifact, capsys):
 
 @pytest.mark.slow
 def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, tmp_path):
-    """bench puts the reference's measured rate beside ours (Feeding Jaco 348 env steps/s, measured
-    side by side, with the date and conditions said), at the spec's solver settings and at the
+    """bench puts the reference's measured rate beside ours: the stored figure (Feeding Jaco, measured
+    side by side, with the date and conditions said) carried over to this machine's speed now by the
+    machine probe, and ours on the harness's own episodes; at the spec's solver settings and at the
     reference's: measured again where they differ, one figure where they are the same; with several
-    specs it prints a table. --reference-json takes figures measured beside ours instead."""
+    specs it prints a table. --reference-json takes figures measured beside ours instead, as they are."""
     from assistive_compiler.cli import main
+    from assistive_compiler.cli.bench import REFERENCE_PROBE_STEPS_PER_S, REFERENCE_STEPS_PER_S
 
     fewer = tmp_path / "feeding_fewer_iterations.yaml"  # a user's spec of the reference's task, at settings of its own
     fewer.write_text(f"extends: {SPEC}\nsim:\n  solver: {{iterations: 10, contact_breaking_threshold_m: 0.002}}\n")
@@ -554,10 +556,17 @@ def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, 
     assert rc == 0
     feeding, fewer_r = json.loads(capsys.readouterr().out)
     reference = {"sub_steps": 0, "iterations": 50, "contact_breaking_threshold_m": 0.02}
-    assert feeding["reference_env_steps_per_s"] == fewer_r["reference_env_steps_per_s"] == 348
-    assert feeding["reference_figure"].startswith("measured side by side on 2026-11-27: quiet 2-core machine")
-    # the ratio is of the unrounded rate: within half a cent of the printed (one-decimal) rate's
-    assert feeding["vs_reference"] == pytest.approx(feeding["env_steps_per_s"] / 348, abs=0.0051)
+    stored = REFERENCE_STEPS_PER_S[("feeding", "jaco")][0]
+    assert feeding["reference_env_steps_per_s_as_stored"] == fewer_r["reference_env_steps_per_s_as_stored"] == stored
+    assert feeding["reference_figure"].startswith("measured side by side on 2026-11-29 with the reference harness")
+    # The stored figure, carried over by the machine probe's speed now against its speed in that session.
+    speed = feeding["machine_probe_steps_per_s"] / REFERENCE_PROBE_STEPS_PER_S[0]
+    assert feeding["machine_speed_vs_reference_session"] == pytest.approx(speed, abs=0.0006)
+    assert feeding["reference_env_steps_per_s"] == pytest.approx(stored * speed, abs=0.06)
+    # Ours on the harness's episodes over the reference's (unrounded rates: within half a cent).
+    assert feeding["vs_reference"] == pytest.approx(
+        feeding["env_steps_per_s_harness_episodes"] / feeding["reference_env_steps_per_s"], abs=0.006
+    )
     # The shipped Feeding runs at the reference's settings: one measurement, reported for both.
     assert feeding["solver"] == feeding["reference_solver"] == reference
     assert feeding["reference_solver_is_shipped"] is True
@@ -568,8 +577,9 @@ def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, 
     assert fewer_r["reference_solver"] == reference and fewer_r["reference_solver_is_shipped"] is False
     assert fewer_r["env_steps_per_s_reference_solver"] > 0
     assert fewer_r["env_steps_per_s_reference_solver"] != fewer_r["env_steps_per_s"]
+    # at the reference's settings: the harness-episode ratio times the variant's speed over the spec's
     assert fewer_r["vs_reference_at_reference_solver"] == pytest.approx(
-        fewer_r["env_steps_per_s_reference_solver"] / 348, abs=0.0051
+        fewer_r["vs_reference"] * fewer_r["env_steps_per_s_reference_solver"] / fewer_r["env_steps_per_s"], rel=0.02
     )
     # Where Feeding's physics goes: solving the rows of the food resting in the spoon, no cloth. The
     # soft-body world's empty pass still opens its zones: a tenth of a percent, never the work of a cloth.
@@ -586,18 +596,20 @@ def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, 
         "raw_physics_steps_per_s",
         "env_over_raw",
         "reset_ms_median",
+        "env_steps_per_s_harness_episodes",
         "reference_env_steps_per_s",
+        "machine_speed_vs_reference_session",
         "vs_reference",
         "vs_reference_at_reference_solver",
     ]
     speeds, stage_table = out.split("where the physics goes (share of stepSimulation, Bullet's profiler):")
     rows = [line.split() for line in speeds.splitlines() if line.split()[:1] == ["feeding"]]
-    assert len(rows) == 2 and all(r[1] == "jaco" and r[7] == "348" for r in rows)
+    assert len(rows) == 2 and all(r[1] == "jaco" and float(r[8]) > 0 and float(r[9]) > 0 for r in rows)
     assert [line.split()[:2] for line in stage_table.splitlines() if line.startswith("feeding")] == [
         ["feeding", "jaco"]
     ] * 2
     assert float(rows[0][2]) == float(rows[0][3])  # shipped = reference settings: the same figure in both columns
-    assert "reference_env_steps_per_s of feeding/jaco, feeding/jaco: measured side by side on 2026-11-27" in out
+    assert "reference_env_steps_per_s of feeding/jaco, feeding/jaco: measured side by side on 2026-11-29" in out
     # Figures measured beside ours: the harness's lines, the reference on its fork (gravity emulation's share removed).
     lines = tmp_path / "reference.jsonl"
     lines.write_text(
@@ -625,7 +637,10 @@ def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, 
     beside = json.loads(capsys.readouterr().out)
     assert rc == 0 and beside["reference_env_steps_per_s"] == 420.0  # median of 400 and 440
     assert beside["reference_figure"] == f"{lines}: measured beside ours with the reference harness"
-    assert beside["vs_reference"] == round(beside["env_steps_per_s"] / 420.0, 2)
+    assert beside["vs_reference"] == round(beside["env_steps_per_s_harness_episodes"] / 420.0, 2)
+    assert (
+        beside["reference_env_steps_per_s_as_stored"] is None and beside["machine_speed_vs_reference_session"] is None
+    )
 
 
 @pytest.mark.slow
@@ -658,8 +673,8 @@ def test_cli_bench_takes_several_robots_one_row_per_spec_and_robot(capsys):
         ("feeding", "stretch", 5),
     ]
     assert (
-        rows[0]["reference_env_steps_per_s"] == 348 and rows[1]["reference_env_steps_per_s"] is None
-    )  # not measured for Stretch
+        rows[0]["reference_env_steps_per_s"] > 0 and rows[1]["reference_env_steps_per_s"] is None
+    )  # the reference has no Stretch
     assert rows[1]["reference_figure"] is None
     for r in rows:
         assert r["env_over_raw"] == pytest.approx(r["env_steps_per_s"] / r["raw_physics_steps_per_s"], abs=2e-3)
