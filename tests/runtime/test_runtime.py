@@ -676,6 +676,7 @@ def test_cli_bench_takes_several_robots_one_row_per_spec_and_robot(capsys):
         rows[0]["reference_env_steps_per_s"] > 0 and rows[1]["reference_env_steps_per_s"] is None
     )  # the reference has no Stretch
     assert rows[1]["reference_figure"] is None
+    assert rows[1]["env_steps_per_s_harness_episodes"] is None  # nothing to divide by: not measured
     for r in rows:
         assert r["env_over_raw"] == pytest.approx(r["env_steps_per_s"] / r["raw_physics_steps_per_s"], abs=2e-3)
 
