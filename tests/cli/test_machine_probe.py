@@ -63,3 +63,41 @@ def test_harness_episodes_are_the_same_episodes_every_time(env):
         return pb.getLinkState(env.world.robot.id, env.arm_idx[-1], physicsClientId=env.client)[0]
 
     assert final_state() == final_state()
+
+
+def _side_by_side_script():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / "reference_side_by_side.py"
+    spec = importlib.util.spec_from_file_location("reference_side_by_side", path)
+    module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
+    spec.loader.exec_module(module)  # type: ignore[union-attr]
+    return module
+
+
+def test_the_side_by_side_script_summarizes_into_the_stored_figures():
+    """benchmarks/reference_side_by_side.py turns the harness's lines and the probe's into the figures
+    bench stores: the reference on its fork (its gravity emulation's share removed), medians over
+    rounds; an env measured on our side only (the reference failed to load it) is left out."""
+    script = _side_by_side_script()
+    lines = [
+        {"side": "ag", "env": "ArmManipulationPR2", "steps_per_s": 60.0, "gravity_shim_share": 0.5},
+        {"side": "ag", "env": "ArmManipulationPR2", "steps_per_s": 66.0, "gravity_shim_share": 0.5},
+        {"side": "ag", "env": "ArmManipulationPR2", "steps_per_s": 70.0, "gravity_shim_share": 0.5},
+        {"side": "ours", "env": "ArmManipulationPR2", "steps_per_s": 400.0},
+        {"side": "ours", "env": "ArmManipulationPR2", "steps_per_s": 420.0},
+        {"side": "ours", "env": "ArmManipulationPR2", "steps_per_s": 390.0},
+        {"side": "ours", "env": "FeedingBaxter", "steps_per_s": 460.0},
+        {"side": "probe", "probe_version": 1, "steps_per_s": 1700.0},
+        {"side": "probe", "probe_version": 1, "steps_per_s": 1800.0},
+    ]
+    summary = script.summarize(lines)
+    assert summary["envs"] == {"ArmManipulationPR2": {"reference": 132.0, "ours": 400.0, "ratio": 3.03, "rounds": 3}}
+    assert summary["probe_steps_per_s"] == 1750.0 and summary["probe_versions"] == [1]
+    assert script.stored_lines(summary) == [
+        '    ("arm_manipulation", "pr2"): (132.0, REFERENCE_SESSION),',
+        "REFERENCE_PROBE_STEPS_PER_S = (1750.0, 1)",
+    ]
+    assert script.task_robot("BedBathingSawyer") == ("bed_bathing", "sawyer")
+    assert script.task_robot("DressingJaco") is None  # not one of the five rigid tasks
