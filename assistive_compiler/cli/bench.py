@@ -44,60 +44,67 @@ REFERENCE_SESSION = (
     "process pinned to one core, interleaved; the reference at its own solver settings on stock pybullet, its "
     "fork-only gravity emulation's time removed; the harness's episodes of random actions)"
 )
-LOADED_ONCE = (
-    "measured once, not side by side, on a shared 2-core machine under load (stock pybullet, random actions, "
-    "200-step episodes), before the machine probe existed, so not carried over to this machine: lower than the "
-    "reference does on a quiet machine, so the ratio overstates ours there (the reference's Baxter and Sawyer "
-    "no longer load in the harness to measure them again)"
-)
-
-REFERENCE_PROBE_STEPS_PER_S = (1778.0, 1)
+REFERENCE_PROBE_STEPS_PER_S = (1778.1, 1)
 """The machine probe (:mod:`assistive_compiler.machine_probe`: its steps/s, its version) in
-:data:`REFERENCE_SESSION`: the median of 30 probe runs pinned to the harness's core, one after each
+:data:`REFERENCE_SESSION`: the median of 60 probe runs pinned to the harness's core, one after each
 pair of harness runs."""
 
 #: Env steps/s of the reference implementation (Assistive Gym v1.0) per (task, robot) on its own
-#: pybullet fork, and how each was taken. Those of :data:`REFERENCE_SESSION` (medians of 3–4
-#: interleaved rounds) are carried over to the machine as it runs now by the machine probe; the
-#: reference has no Panda or Stretch, and its Dressing needs its fork. ``--reference-json``
-#: replaces them with figures measured beside ours.
-REFERENCE_STEPS_PER_S: dict[tuple[str, str], tuple[float, str]] = {
-    ("feeding", "jaco"): (182.6, REFERENCE_SESSION),
-    ("scratch_itch", "jaco"): (328.0, REFERENCE_SESSION),
-    ("drinking", "jaco"): (25.5, REFERENCE_SESSION),
-    ("bed_bathing", "jaco"): (86.4, REFERENCE_SESSION),
-    ("arm_manipulation", "jaco"): (199.8, REFERENCE_SESSION),
-    ("feeding", "pr2"): (97.7, REFERENCE_SESSION),
-    ("scratch_itch", "pr2"): (159.5, REFERENCE_SESSION),
-    ("drinking", "pr2"): (20.3, REFERENCE_SESSION),
-    ("bed_bathing", "pr2"): (69.4, REFERENCE_SESSION),
-    ("arm_manipulation", "pr2"): (118.9, REFERENCE_SESSION),
-    ("scratch_itch", "sawyer"): (428, LOADED_ONCE),
-    ("scratch_itch", "baxter"): (312, LOADED_ONCE),
-    ("feeding", "sawyer"): (237, LOADED_ONCE),
-    ("feeding", "baxter"): (199, LOADED_ONCE),
+#: pybullet fork, taken in :data:`REFERENCE_SESSION` (medians of 3–4 interleaved rounds;
+#: ``benchmarks/reference_side_by_side.py`` takes them again) and carried over to the machine as it
+#: runs now by the machine probe. The reference has no Panda or Stretch, and its Dressing needs its
+#: fork. ``--reference-json`` replaces them with figures measured beside ours.
+REFERENCE_STEPS_PER_S: dict[tuple[str, str], float] = {
+    ("feeding", "jaco"): 182.6,
+    ("scratch_itch", "jaco"): 328.0,
+    ("drinking", "jaco"): 25.5,
+    ("bed_bathing", "jaco"): 86.4,
+    ("arm_manipulation", "jaco"): 199.8,
+    ("feeding", "pr2"): 97.7,
+    ("scratch_itch", "pr2"): 159.5,
+    ("drinking", "pr2"): 20.3,
+    ("bed_bathing", "pr2"): 69.4,
+    ("arm_manipulation", "pr2"): 118.9,
+    ("feeding", "baxter"): 174.0,
+    ("scratch_itch", "baxter"): 234.1,
+    ("drinking", "baxter"): 23.9,
+    ("bed_bathing", "baxter"): 94.7,
+    ("arm_manipulation", "baxter"): 145.4,
+    ("feeding", "sawyer"): 195.7,
+    ("scratch_itch", "sawyer"): 278.8,
+    ("drinking", "sawyer"): 25.0,
+    ("bed_bathing", "sawyer"): 85.7,
+    ("arm_manipulation", "sawyer"): 158.9,
 }
 
 
 def reference_now(task: str, robot: str, probe_now: float) -> tuple[float, float | None, float, str] | None:
     """The stored reference figure of (task, robot) for this machine now: (the figure as stored,
     this machine's speed now over the stored session's by the probe, the figure carried over by it,
-    how it was taken). A figure from before the probe, or from a probe of another version, is not
-    carried over (speed None, the figure as stored); None where the reference was not measured."""
+    how it was taken). With a probe of another version than the stored figures were taken beside,
+    it is not carried over (speed None, the figure as stored, and the text says so); None where
+    the reference was not measured."""
     from ..machine_probe import PROBE_VERSION
 
     if (task, robot) not in REFERENCE_STEPS_PER_S:
         return None
-    stored, how = REFERENCE_STEPS_PER_S[(task, robot)]
+    stored = REFERENCE_STEPS_PER_S[(task, robot)]
     probe_then, version = REFERENCE_PROBE_STEPS_PER_S
-    if how != REFERENCE_SESSION or version != PROBE_VERSION:
-        return stored, None, stored, how
+    if version != PROBE_VERSION:
+        return (
+            stored,
+            None,
+            stored,
+            f"{REFERENCE_SESSION}; not carried over: taken beside machine probe version {version}, "
+            f"this is version {PROBE_VERSION} (measure them again: benchmarks/reference_side_by_side.py)",
+        )
     speed = probe_now / probe_then
     return (
         stored,
         speed,
         stored * speed,
-        f"{how}; carried over to this machine's speed now by the machine probe (machine_speed_vs_reference_session)",
+        f"{REFERENCE_SESSION}; carried over to this machine's speed now by the machine probe "
+        "(machine_speed_vs_reference_session)",
     )
 
 

@@ -556,7 +556,7 @@ def test_cli_bench_compares_with_the_reference_and_tables_several_tasks(capsys, 
     assert rc == 0
     feeding, fewer_r = json.loads(capsys.readouterr().out)
     reference = {"sub_steps": 0, "iterations": 50, "contact_breaking_threshold_m": 0.02}
-    stored = REFERENCE_STEPS_PER_S[("feeding", "jaco")][0]
+    stored = REFERENCE_STEPS_PER_S[("feeding", "jaco")]
     assert feeding["reference_env_steps_per_s_as_stored"] == fewer_r["reference_env_steps_per_s_as_stored"] == stored
     assert feeding["reference_figure"].startswith("measured side by side on 2026-11-29 with the reference harness")
     # The stored figure, carried over by the machine probe's speed now against its speed in that session.
