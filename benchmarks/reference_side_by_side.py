@@ -25,19 +25,29 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
 from pathlib import Path
 
-TASKS = {
-    "Feeding": "feeding",
-    "ScratchItch": "scratch_itch",
-    "Drinking": "drinking",
-    "BedBathing": "bed_bathing",
-    "ArmManipulation": "arm_manipulation",
-}
-ROBOTS = {"Jaco": "jaco", "PR2": "pr2", "Baxter": "baxter", "Sawyer": "sawyer"}
+from assistive_compiler.cli.bench import reference_on_fork
+from assistive_compiler.registration import shipped_tasks
+
+RIGID_TASKS = ("feeding", "scratch_itch", "drinking", "bed_bathing", "arm_manipulation")
+"""The reference's tasks that run on stock pybullet (its Dressing needs its fork)."""
+
+
+def env_names() -> dict[str, tuple[str, str]]:
+    """Harness env name (a Gymnasium id's, ``FeedingJaco``) -> (task, robot), for the rigid tasks."""
+    return {
+        env_id.rpartition("/")[2].removesuffix("-v1"): (task.name, robot)
+        for task in shipped_tasks()
+        if task.name in RIGID_TASKS
+        for robot, env_id in zip(task.robots, task.ids)
+    }
+
+
 PROBE = (
     "import json; from assistive_compiler.machine_probe import PROBE_VERSION, probe_steps_per_s; "
     "print(json.dumps({'side': 'probe', 'probe_version': PROBE_VERSION, 'steps_per_s': round(probe_steps_per_s(), 1)}))"
@@ -56,8 +66,6 @@ def _last_json(stdout: str) -> dict | None:
 
 
 def _run(cmd: list[str], cwd: Path, env_path: str | None = None) -> tuple[dict | None, str]:
-    import os
-
     env = os.environ | ({"PYTHONPATH": env_path} if env_path else {})
     done = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=1800)
     row = _last_json(done.stdout) if done.returncode == 0 else None
@@ -102,7 +110,7 @@ def summarize(lines: list[dict]) -> dict:
             probes.append(float(row["steps_per_s"]))
             versions.add(row.get("probe_version"))
         elif row.get("side") == "ag":
-            ref.setdefault(row["env"], []).append(row["steps_per_s"] / (1.0 - row.get("gravity_shim_share", 0.0)))
+            ref.setdefault(row["env"], []).append(reference_on_fork(row))
         elif row.get("side") == "ours":
             ours.setdefault(row["env"], []).append(float(row["steps_per_s"]))
     envs = {}
@@ -125,10 +133,7 @@ def summarize(lines: list[dict]) -> dict:
 
 def task_robot(env_name: str) -> tuple[str, str] | None:
     """(task, robot) of a harness env name, e.g. ``ArmManipulationPR2`` -> ("arm_manipulation", "pr2")."""
-    for prefix, task in TASKS.items():
-        if env_name.startswith(prefix) and env_name[len(prefix) :] in ROBOTS:
-            return task, ROBOTS[env_name[len(prefix) :]]
-    return None
+    return env_names().get(env_name)
 
 
 def stored_lines(summary: dict) -> list[str]:
@@ -137,7 +142,7 @@ def stored_lines(summary: dict) -> list[str]:
     for name, fig in summary["envs"].items():
         pair = task_robot(name)
         if pair is not None:
-            out.append(f'    ("{pair[0]}", "{pair[1]}"): ({fig["reference"]}, REFERENCE_SESSION),')
+            out.append(f'    ("{pair[0]}", "{pair[1]}"): {fig["reference"]},')
     if summary["probe_steps_per_s"] is not None and len(summary["probe_versions"]) == 1:
         out.append(f"REFERENCE_PROBE_STEPS_PER_S = ({summary['probe_steps_per_s']}, {summary['probe_versions'][0]})")
     return out
@@ -147,7 +152,11 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--harness", type=Path, help="the reference harness's folder (measure.py, agshim.py)")
     parser.add_argument("--reference", type=Path, help="the folder with the reference's assistive_gym/ and venv/")
-    parser.add_argument("--envs", default=",".join(t + r for r in ("Jaco", "PR2") for t in TASKS))
+    parser.add_argument(
+        "--envs",
+        default=",".join(name for robot in ("jaco", "pr2") for name, pair in env_names().items() if pair[1] == robot),
+        help="harness env names, comma-separated (default: the five rigid tasks with Jaco and PR2)",
+    )
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--core", type=int, default=1, help="the core every run is pinned to")
     parser.add_argument("--out", type=Path, help="write the measured lines here (JSON lines)")

@@ -108,6 +108,13 @@ def reference_now(task: str, robot: str, probe_now: float) -> tuple[float, float
     )
 
 
+def reference_on_fork(row: dict) -> float:
+    """Env steps/s of the reference on its own pybullet fork from one harness line (``measure.py ag
+    ENV``): its figure on stock pybullet without the time of the harness's gravity emulation, which
+    the fork does natively."""
+    return float(row["steps_per_s"]) / (1.0 - float(row.get("gravity_shim_share", 0.0)))
+
+
 def load_reference_json(path: str) -> dict[str, float]:
     """Reference figures measured beside ours: the reference harness's ``measure.py ag ENV`` lines
     (a JSON list or one JSON object per line). Env name (``FeedingJaco``) -> env steps/s of the
@@ -134,9 +141,7 @@ def load_reference_json(path: str) -> dict[str, float]:
             )
         if row.get("side", "ag") != "ag":
             continue  # our own side's lines, if the file holds both
-        figures.setdefault(str(row["env"]), []).append(
-            float(row["steps_per_s"]) / (1.0 - float(row.get("gravity_shim_share", 0.0)))
-        )
+        figures.setdefault(str(row["env"]), []).append(reference_on_fork(row))
     return {env: statistics.median(v) for env, v in figures.items()}
 
 
