@@ -249,7 +249,15 @@ class TrainingConfig(Strict):
     total_steps: int = Field(
         ge=1, description="Env steps to train for, over all env processes (the paper: 10,000,000)."
     )
-    envs: int = Field(1, ge=1, le=1024, description="Env processes collecting experience in parallel (the paper: 36).")
+    envs: int = Field(1, ge=1, le=1024, description="Envs collecting experience in parallel (the paper: 36).")
+    vec_env: Literal["processes", "in_process"] = Field(
+        "processes",
+        description="Where the envs step: 'processes' runs each env in a process of its own (SB3's SubprocVecEnv: "
+        "one core per env; one env alone runs in the trainer's process); 'in_process' steps all of them in turn in "
+        "the trainer's process (SB3's DummyVecEnv: one core, no inter-process traffic, and the policy acts for "
+        "all envs in one batched forward pass), so the paper's 36 envs train on one core. SB3 engine only; RLlib "
+        "runs one env per env runner.",
+    )
     seed: int = Field(0, ge=0, description="Seed of the policy's initialisation, the envs and the sampling.")
     checkpoint_every_steps: int = Field(
         ge=1, description="Env steps between checkpoints (a checkpoint is also written at the end and on Ctrl-C)."

@@ -184,6 +184,11 @@ SAC_ITERATION_STEPS = 1000
 def check_supported(config: TrainingConfig) -> None:
     """Refuse, with what to do, the settings that only the SB3 engine builds. ``train`` calls this
     before it writes the run directory, so a refused config leaves nothing behind."""
+    if config.vec_env == "in_process":
+        raise UsageError(
+            "vec_env: in_process steps every env in the trainer's process, which is built for the sb3 engine only; "
+            "use --engine sb3, or set vec_env: processes (RLlib runs one env per env runner)"
+        )
     s = config.sac
     if s is None:
         return

@@ -48,12 +48,14 @@ def make_monitored_env(artifact_dir: str, in_worker: bool = False, coop: bool = 
     return Monitor(AssistiveEnv(artifact_dir))
 
 
-def make_vec_env(artifact_dir: Path, n_envs: int, seed: int, coop: bool = False):
-    """``n_envs`` envs (processes when more than one), seeded ``seed``, ``seed + 1``, ..."""
+def make_vec_env(artifact_dir: Path, n_envs: int, seed: int, coop: bool = False, in_process: bool = False):
+    """``n_envs`` envs seeded ``seed``, ``seed + 1``, ...: each in a process of its own when more
+    than one, or all in this process (``in_process``: stepped in turn, one core)."""
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
-    fns = [functools.partial(make_monitored_env, str(artifact_dir), n_envs > 1, coop) for _ in range(n_envs)]
-    venv = SubprocVecEnv(fns, start_method="forkserver") if n_envs > 1 else DummyVecEnv(fns)
+    processes = n_envs > 1 and not in_process
+    fns = [functools.partial(make_monitored_env, str(artifact_dir), processes, coop) for _ in range(n_envs)]
+    venv = SubprocVecEnv(fns, start_method="forkserver") if processes else DummyVecEnv(fns)
     venv.seed(seed)
     return venv
 
@@ -222,8 +224,11 @@ def train(
     stop=None,
     demonstrations=None,
     coop: bool = False,
+    timer=None,
 ) -> dict:
     """Train (or continue) the run to ``config.total_steps``; returns the session's figures.
+    ``timer`` (:class:`.throughput.StageTimer`, for ``bench --training``) times the env steps and
+    the learner's updates of this session.
     ``coop`` (SAC): the robot and the person together, one actor each and one critic.
 
     A new run given ``demonstrations`` (:class:`.demonstrations.DemonstrationData`) starts from
@@ -246,7 +251,11 @@ def train(
         raise UsageError(
             f"{latest[1] / REPLAY_BUFFER}: --resume of a SAC run needs the newest checkpoint's replay buffer, which is missing"
         )
-    venv = make_vec_env(run.artifact, config.envs, config.seed + start_steps, coop)
+    venv = make_vec_env(
+        run.artifact, config.envs, config.seed + start_steps, coop, in_process=config.vec_env == "in_process"
+    )
+    if timer is not None:
+        venv = timer.wrap_env(venv)
     venv = _normalized(venv, config, latest[1] if latest else None)
     if latest:
         model = algorithm_class(config).load(str(latest[1] / "model.zip"), env=venv, device="cpu")
@@ -288,6 +297,8 @@ def train(
     interrupted = False
     try:
         remaining = max(0, config.total_steps - model.num_timesteps)
+        if timer is not None:
+            timer.watch_updates(model)
         if remaining:
             model.learn(
                 remaining,
@@ -299,6 +310,8 @@ def train(
     except KeyboardInterrupt:  # a second Ctrl-C: stop at once
         interrupted = True
     finally:
+        if timer is not None:
+            timer.unwatch(model)
         steps = model.num_timesteps
         save_checkpoint(run, model, steps)
         wall = progress.wall_s()
