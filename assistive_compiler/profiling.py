@@ -16,6 +16,7 @@ import collections
 import json
 import re
 import tempfile
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -49,26 +50,51 @@ STEP_ZONE = "CMD_STEP_FORWARD_SIMULATION"
 """The zone around one ``stepSimulation`` call: the whole the shares are of."""
 
 
-def _intervals(trace: dict) -> list[tuple[float, float, str]]:
-    """(start µs, end µs, zone) of every profiler zone, numbered suffixes dropped, sorted to nest."""
+_COUNTED = (STEP_ZONE, *(zone for zones in STAGES.values() for zone in zones))
+"""Prefixes of the zones :func:`stage_shares` reads; the rest (most of a trace: every pybullet call's
+client command) are skipped. Leaving them out changes no share: a zone that counts toward no stage
+passes its ancestor's stage on unchanged."""
+
+
+def trace_events(path: str | Path, names: tuple[str, ...] | None = None) -> Iterator[dict]:
+    """The events of a Chrome-format trace that Bullet's profiler wrote, read one line at a time
+    (Bullet writes one event a line); with ``names``, only the events of zones whose names start
+    with one of them. A 400-step episode's trace holds over a million events; parsed as one
+    document they took a gigabyte (``bench``'s peak memory was this)."""
+    with open(path) as f:
+        for line in f:
+            at = line.find('"name":"')
+            if at < 0 or (names is not None and not line.startswith(names, at + 8)):
+                continue
+            yield json.loads(line.strip().rstrip(","))
+
+
+def _intervals(events: Iterable[dict]) -> list[tuple[float, float, str]]:
+    """(start µs, end µs, zone) of every profiler zone that :func:`stage_shares` reads, numbered
+    suffixes dropped, sorted to nest."""
     opened: dict[str, float] = {}
     out = []
-    for e in trace["traceEvents"]:
+    for e in events:
+        name = e["name"]
+        if not name.startswith(_COUNTED):
+            continue
         if e["ph"] == "B":
-            opened[e["name"]] = e["ts"]
-        elif e["ph"] == "E" and e["name"] in opened:
-            out.append((opened.pop(e["name"]), e["ts"], re.sub(r"\d+$", "", e["name"])))
+            opened[name] = e["ts"]
+        elif e["ph"] == "E" and name in opened:
+            out.append((opened.pop(name), e["ts"], re.sub(r"\d+$", "", name)))
     out.sort(key=lambda iv: (iv[0], -iv[1]))
     return out
 
 
-def stage_shares(trace: dict) -> dict[str, float]:
-    """Each stage's share of stepSimulation's time in a Chrome-format trace of Bullet's profiler
-    (the remainder: ``other``); empty when the trace holds no step."""
+def stage_shares(trace: dict | Iterable[dict]) -> dict[str, float]:
+    """Each stage's share of stepSimulation's time in a Chrome-format trace of Bullet's profiler (the
+    parsed document, or its events: :func:`trace_events`); the remainder is ``other``; empty when the
+    trace holds no step."""
     step = 0.0
     spent: collections.Counter = collections.Counter()
     stack: list[tuple[float, float, str, str | None]] = []  # (start, end, zone, stage it counts toward)
-    for start, end, zone in _intervals(trace):
+    events = trace["traceEvents"] if isinstance(trace, dict) else trace
+    for start, end, zone in _intervals(events):
         while stack and stack[-1][1] <= start:
             stack.pop()
         inherited = stack[-1][3] if stack else None
@@ -105,6 +131,6 @@ def profile_episode(env, actions: list[np.ndarray], seed: int) -> tuple[dict[str
             with captured_c_output():  # Bullet prints "Writing N timings" from C; dropped
                 pb.stopStateLogging(log, physicsClientId=c)
         written = sorted(Path(tmp).glob(f"{trace_file.name}_*.json"))  # Bullet appends _<thread>.json
-        shares = stage_shares(json.loads(written[0].read_text())) if written else {}
+        shares = stage_shares(trace_events(written[0], _COUNTED)) if written else {}
     steps = max(1, len(actions))
     return shares, {pair: n / steps for pair, n in contacts.most_common()}

@@ -24,7 +24,7 @@ from ..errors import SpecError
 from .common import EXIT_OK, add_library_argument
 
 _CHILD = r"""
-import json, resource, sys, time, numpy as np
+import json, sys, time, numpy as np
 t = time.perf_counter()
 import assistive_compiler
 import_s = time.perf_counter() - t
@@ -34,8 +34,21 @@ env = AssistiveEnv(sys.argv[1])
 env.reset(seed=0)
 for _ in range(200):
     env.step(env.action_space.sample())
-print(json.dumps({"import_s": import_s, "heavy_modules_on_import": heavy,
-                  "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+
+def peak_rss_mb():
+    # VmHWM: this process's own high-water mark, which starts afresh at exec. Not getrusage's
+    # ru_maxrss: Linux carries the parent's high-water mark over fork and exec into it (bench's
+    # own ~1 GB was reported as the env's). None where there is no /proc to read it from.
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024
+    except OSError:
+        pass
+    return None
+
+print(json.dumps({"import_s": import_s, "heavy_modules_on_import": heavy, "peak_rss_mb": peak_rss_mb()}))
 """
 
 
@@ -242,7 +255,9 @@ def measure_harness_protocol(env) -> float:
 
 def measure_process(artifact_dir: Path) -> dict:
     """In a fresh interpreter: ``import assistive_compiler`` time (s), heavy modules it imported, and
-    peak RSS (MB) of one env stepped 200 times."""
+    peak RSS (MB) of that process, which builds one env and steps it 200 times: its own high-water
+    mark (``VmHWM``), never the caller's, which ``getrusage`` would carry over; None where the system
+    has no ``/proc/self/status``."""
     child = subprocess.run(
         [sys.executable, "-c", _CHILD, str(artifact_dir)],
         capture_output=True,
@@ -373,7 +388,7 @@ def bench(
         "compile_s_cached": round(cached.seconds, 3),
         "import_s": round(proc["import_s"], 4),
         "heavy_modules_on_import": proc["heavy_modules_on_import"],
-        "peak_rss_mb_one_env": round(proc["peak_rss_mb"], 1),
+        "peak_rss_mb_one_env": round(proc["peak_rss_mb"], 1) if proc["peak_rss_mb"] is not None else None,
         "steps_per_repeat": steps,
         "repeats": repeats,
         "notes": "vs_reference: our env steps/s on the reference harness's episodes over the reference's on them, "
@@ -385,7 +400,8 @@ def bench(
         "interleaved with the shipped ones (when reference_solver_is_shipped, the same figure as env_steps_per_s); random actions; "
         "medians over repeats; physics_stages: each stage's share of stepSimulation by Bullet's profiler over one more "
         "episode of the first repeat's seed (the profiler's cost inflates every stage alike: read the shares); "
-        "both agents acting: bench --coop",
+        "both agents acting: bench --coop; peak_rss_mb_one_env: the high-water mark (VmHWM) of a fresh process that "
+        "imports the package, builds one env and steps it 200 times (none where /proc/self/status is absent)",
     }
 
 
