@@ -21,6 +21,7 @@ import time
 from pathlib import Path
 
 from ..errors import SpecError
+from .bench_training import add_arguments as add_training_arguments
 from .common import EXIT_OK, add_library_argument
 
 _CHILD = r"""
@@ -450,8 +451,12 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from .output import cell, print_table, progress
 
     results = []
-    reference_json = load_reference_json(args.reference_json) if args.reference_json else None
     pairs = [(spec, robot) for spec in args.specs for robot in bench_robots(args)]
+    if args.training:
+        from .bench_training import cmd_bench_training
+
+        return cmd_bench_training(args, pairs)
+    reference_json = load_reference_json(args.reference_json) if args.reference_json else None
     with progress("bench", len(pairs)) as tracker:
         for spec, robot in pairs:
             if args.coop:
@@ -524,6 +529,7 @@ def add_commands(sub) -> None:
         help="multi-agent (PettingZoo, both agents acting) vs single-agent env steps/s, in one run",
     )
     p.add_argument("--json", action="store_true")
+    add_training_arguments(p)
     p.add_argument(
         "--reference-json",
         dest="reference_json",
