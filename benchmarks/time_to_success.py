@@ -92,6 +92,12 @@ def plot(runs: dict[str, list[dict]], args: argparse.Namespace) -> None:
         hours = [0.0] + [p["hours"] for p in points]
         ax.plot(hours, [0.0] + [p["mean"] for p in points], "-o", ms=3, color=color, label=f"{label}: mean action")
         ax.plot(hours, [0.0] + [p["sampled"] for p in points], "--", color=color, alpha=0.8, label=f"{label}: sampled")
+    for i, item in enumerate(args.point or []):
+        label, _, where = item.rpartition("=")
+        hours, success = (float(v) for v in where.split(","))
+        ax.plot(
+            [hours], [success], marker="*", ms=12, ls="none", color=colors[(len(runs) + i) % len(colors)], label=label
+        )
     if args.target is not None:
         ax.axhline(args.target, color="black", lw=1, ls=":", label=args.target_label or f"target {args.target:.0%}")
         if args.target_hours:
@@ -122,6 +128,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--target-label")
     p.add_argument("--target-hours", type=float, help="the shipped run's wall time: a line at a fifth of it")
     p.add_argument("--paper", type=float, help="the paper's best-robot success")
+    p.add_argument(
+        "--point",
+        action="append",
+        metavar="LABEL=HOURS,SUCCESS",
+        help="a single measured point, e.g. a shipped policy's success at its run's wall time",
+    )
     args = p.parse_args(argv)
     runs: dict[str, list[dict]] = {}
     for item in args.run:

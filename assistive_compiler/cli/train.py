@@ -14,7 +14,9 @@ from pathlib import Path
 from ..run_dir import engine_modules
 from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, add_library_argument, require_extra
 
-SHIPPED_CONFIGS = "sac_laptop, sac_low_entropy, sac_demos, ppo_paper, ppo_laptop, ppo_quick, ppo_rllib_reference"
+SHIPPED_CONFIGS = (
+    "ppo_one_core, sac_laptop, sac_low_entropy, sac_demos, ppo_paper, ppo_laptop, ppo_quick, ppo_rllib_reference"
+)
 
 
 def training_config_path(name: str) -> str:
@@ -81,7 +83,15 @@ def cmd_train(args: argparse.Namespace) -> int:
 
 
 def add_commands(sub) -> None:
-    p = sub.add_parser("train", help="learn a policy with PPO (SB3 on one machine; RLlib for --coop and Ray clusters)")
+    p = sub.add_parser(
+        "train",
+        help="learn a policy with PPO or SAC (SB3 on one machine; RLlib for --coop and Ray clusters)",
+        description="Learn a policy for a task. Which config, by the clock (docs/results.md, 'The recipe by the "
+        "clock'): ppo_one_core buys about five times sac_laptop's env steps per core-hour on the tasks whose env "
+        "steps fast (Feeding, Scratch Itch, Bed Bathing, Arm Manipulation) and gives a working policy soonest; "
+        "sac_laptop holds the shipped cells' higher figures (in 1.7-1.9 h) and suits the slow envs (Drinking, "
+        "Dressing), where an env step costs as much as an update. One run per core (taskset -c N).",
+    )
     add_library_argument(p)
     p.add_argument("spec", help="task spec file")
     p.add_argument("--robot", help="robot name (default: the spec's default robot)")
@@ -97,7 +107,11 @@ def add_commands(sub) -> None:
     p.add_argument("--address", help="attach to a running Ray cluster at HOST:PORT (or ray://HOST:PORT, or auto)")
     p.add_argument("--steps", type=int, help="total env steps (overrides the config's total_steps)")
     p.add_argument("--seed", type=int, help="seed (overrides the config's)")
-    p.add_argument("--envs", type=int, help="env processes (overrides the config's)")
+    p.add_argument(
+        "--envs",
+        type=int,
+        help="envs collecting experience (overrides the config's; each a process, or all in the trainer's process under vec_env: in_process)",
+    )
     p.add_argument("--out", help="run directory (default: runs/<task>-<robot>[-coop]-s<seed>)")
     p.add_argument("--resume", action="store_true", help="continue the run in --out from its newest checkpoint")
     p.add_argument(
