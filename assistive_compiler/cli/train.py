@@ -87,7 +87,7 @@ def add_commands(sub) -> None:
         "train",
         help="learn a policy with PPO or SAC (SB3 on one machine; RLlib for --coop and Ray clusters)",
         description="Learn a policy for a task. Which config, by the clock (docs/results.md, 'The recipe by the "
-        "clock'): ppo_one_core buys about five times sac_laptop's env steps per core-hour on the tasks whose env "
+        "clock'): ppo_one_core buys 7-11 times sac_laptop's env steps per core-hour on the tasks whose env "
         "steps fast (Feeding, Scratch Itch, Bed Bathing, Arm Manipulation) and gives a working policy soonest; "
         "sac_laptop holds the shipped cells' higher figures (in 1.7-1.9 h) and suits the slow envs (Drinking, "
         "Dressing), where an env step costs as much as an update. One run per core (taskset -c N).",
