@@ -21,6 +21,81 @@ REPO = Path(__file__).resolve().parents[1]
 FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
 
 
+# pytest-xdist grouping (pyproject: -n auto --dist loadgroup). xdist's scheduler keeps the tests
+# of one group on one worker, reading the group from a "@group" suffix of the node id, which its
+# worker plugin adds by writing Item._nodeid; pytest 9.2 keeps the id in Item._id, so that write
+# is lost and no group (not even an explicit xdist_group mark) reached the scheduler
+# (pytest-dev/pytest-xdist#1386). The hook below runs on each xdist worker after xdist's own.
+
+
+def _module_fixture_groups(items: list[pytest.Item]) -> dict[pytest.Item, str]:
+    """For each test that uses a module- or class-scoped fixture defined in its own module, a group
+    name shared by every test of that module linked to it through such fixtures, so that the
+    fixture is built on one worker only (and, being a group of several tests, early: xdist hands
+    out its largest groups first). That holds for one built across workers by :func:`built_once`
+    too: spread over both workers, the second would wait idle for the first one's build."""
+    parent: dict[str, str] = {}  # union-find over "<module>::<fixture>"
+
+    def root(key: str) -> str:
+        while parent.setdefault(key, key) != key:
+            key = parent[key]
+        return key
+
+    used: dict[pytest.Item, str] = {}
+    for item in items:
+        module = item.getparent(pytest.Module)
+        info = getattr(item, "_fixtureinfo", None)
+        if module is None or info is None:
+            continue
+        keys = [
+            f"{module.nodeid}::{name}"
+            for name, defs in info.name2fixturedefs.items()
+            if defs and defs[-1].scope in ("module", "class") and defs[-1].baseid.split("::")[0] == module.nodeid
+        ]
+        for key in keys:
+            parent[root(key)] = root(keys[0])
+        if keys:
+            used[item] = keys[0]
+    members: dict[str, list[str]] = {}
+    for key in list(parent):
+        members.setdefault(root(key), []).append(key.rpartition("::")[2])
+    return {
+        item: f"{Path(key.partition('::')[0]).stem}.{'+'.join(sorted(members[root(key)]))}".replace("@", "_")
+        for item, key in used.items()
+    }
+
+
+def _xdist_group(item: pytest.Item) -> str | None:
+    """The group xdist's worker plugin names for ``item``: its xdist_group marks, joined."""
+    names = {str(m.args[0] if m.args else m.kwargs.get("name", "default")) for m in item.iter_markers("xdist_group")}
+    return "_".join(sorted(names)) or None
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """On an xdist worker under --dist loadgroup, after xdist's own hook: mark the tests that share
+    an expensive module fixture as one group (:func:`_module_fixture_groups`; a test with a group
+    of its own keeps it), then give every grouped test the "@group" suffix the scheduler reads,
+    where xdist's write did not take (a pytest that keeps the id where xdist writes it, or a
+    fixed xdist, leaves nothing to do)."""
+    if not getattr(config.option, "loadgroup", False):  # set on xdist workers under --dist loadgroup
+        return
+    for item, group in _module_fixture_groups(items).items():
+        if not item.get_closest_marker("xdist_group"):
+            item.add_marker(pytest.mark.xdist_group(group))
+    for item in items:
+        group = _xdist_group(item)
+        if group is None or item.nodeid.endswith(f"@{group}"):
+            continue
+        grouped = f"{item.nodeid}@{group}"
+        if hasattr(item, "_id"):  # pytest >= 9.2: a structured NodeId
+            item._id = type(item._id).parse(grouped)
+        else:
+            item._nodeid = grouped
+        if item.nodeid != grouped:
+            raise pytest.UsageError(f"cannot give {item.nodeid} its xdist group: this pytest keeps node ids elsewhere")
+
+
 @pytest.fixture(scope="session")
 def artifact(tmp_path_factory) -> Path:
     """Feeding compiled for Jaco, once per test session."""

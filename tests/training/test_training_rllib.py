@@ -14,8 +14,8 @@ import pytest
 from PIL import Image
 
 pytest.importorskip("ray", reason='needs the "train" extra (README: Training); CI installs it')
-# Meant to run Ray clusters one at a time on one xdist worker; --dist loadgroup is a no-op under
-# pytest 9.2 with xdist 3.8 (the group never reaches the scheduler), so the clusters do overlap.
+# Ray clusters run one at a time: under pytest-xdist every Ray test goes to the same worker
+# (tests/conftest.py gives the group to the scheduler, which xdist 3.8 alone fails to under pytest 9.2).
 pytestmark = pytest.mark.xdist_group("ray")
 
 from helpers import assert_exported_pair_acts_as  # noqa: E402 (after the importorskip)
