@@ -45,17 +45,21 @@ def shipped_tasks() -> list[ShippedTask]:
     """Every shipped task (``specs/tasks/*.yaml``), read with plain YAML (no validation, no compile)."""
     out: list[ShippedTask] = []
     robots_dir = specs_dir() / "robots"
+    robot_titles: dict[str, str] = {}  # each robot file read once, not once per task supporting it
+
+    def robot_title(robot: str) -> str:
+        if robot not in robot_titles:
+            robot_file = robots_dir / f"{robot}.yaml"
+            robot_titles[robot] = (
+                (yaml.safe_load(robot_file.read_text()) or {}).get("title", robot) if robot_file.is_file() else robot
+            )
+        return robot_titles[robot]
+
     for spec in sorted((specs_dir() / "tasks").glob("*.yaml")):
         data = yaml.safe_load(spec.read_text()) or {}
         title = str(data.get("title", spec.stem))
         robots = list((data.get("robot") or {}).get("supported", []))
-        ids = []
-        for robot in robots:
-            robot_file = robots_dir / f"{robot}.yaml"
-            robot_title = (
-                (yaml.safe_load(robot_file.read_text()) or {}).get("title", robot) if robot_file.is_file() else robot
-            )
-            ids.append(f"{NAMESPACE}/{title.replace(' ', '')}{robot_title}-v1")
+        ids = [f"{NAMESPACE}/{title.replace(' ', '')}{robot_title(robot)}-v1" for robot in robots]
         out.append(ShippedTask(str(data.get("name", spec.stem)), title, spec, robots, ids))
     return out
 

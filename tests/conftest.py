@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import shutil
 from collections.abc import Callable
 from pathlib import Path
@@ -126,6 +127,36 @@ def shipped_once(tmp_path_factory, worker_id: str, task: str, robot: str) -> Pat
     """The shipped task ``task`` compiled for ``robot``, once per test session (:func:`built_once`)."""
     spec = REPO / "specs" / "tasks" / f"{task}.yaml"
     return built_once(tmp_path_factory, worker_id, f"{task}-{robot}", lambda out: compile_task(spec, robot, out))
+
+
+@pytest.fixture
+def shared_cache(tmp_path_factory, monkeypatch) -> Callable[[str], FileLock]:
+    """One artifact cache ($ASSISTIVE_COMPILER_CACHE) for the whole test session, every xdist worker
+    and every test file that makes shipped envs by name, so each shipped task × robot compiles once
+    (a Gymnasium id and its co-optimisation name share one folder); returns the lock, by either
+    name, to hold while making such an env (the first maker compiles, the others wait)."""
+    cache = tmp_path_factory.getbasetemp().parent / "shipped-ids-cache"
+    cache.mkdir(exist_ok=True)
+    monkeypatch.setenv("ASSISTIVE_COMPILER_CACHE", str(cache))
+    return lambda name: artifact_lock(*_shipped_envs()[name])
+
+
+@functools.cache
+def _shipped_envs() -> dict[str, tuple[Path, str]]:
+    """(task spec, robot) of every shipped env, by Gymnasium id and by co-optimisation name."""
+    from assistive_compiler.coop import coop_name
+    from assistive_compiler.registration import shipped_ids
+
+    ids = shipped_ids()
+    return ids | {coop_name(env_id): where for env_id, where in ids.items()}
+
+
+def artifact_lock(spec: Path, robot: str) -> FileLock:
+    """The lock of the folder of the artifact cache ($ASSISTIVE_COMPILER_CACHE) that ``spec`` for
+    ``robot`` compiles into, made by name or by ``compile_task(spec, robot, cached_artifact_dir(...))``."""
+    from assistive_compiler.registration import cached_artifact_dir
+
+    return FileLock(f"{cached_artifact_dir(spec, robot)}.lock")
 
 
 @pytest.fixture(scope="session")

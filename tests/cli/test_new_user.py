@@ -11,11 +11,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import artifact_lock
 from helpers import cli
 
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.errors import SpecError
 from assistive_compiler.paths import specs_dir
+from assistive_compiler.registration import cached_artifact_dir
 from assistive_compiler.runtime.env import AssistiveEnv
 from assistive_compiler.terms.registry import terms
 
@@ -145,8 +147,7 @@ def test_camera_option_is_parsed_and_misuse_is_explained(feeding, tmp_path):
     env.close(), default.close()
 
 
-def _returns(command: str, spec: Path, robot: str, tmp_path: Path) -> float:
-    out = tmp_path / f"{spec.stem}-{robot}"
+def _returns(command: str, spec: Path, robot: str, out: Path, tmp_path: Path) -> float:
     if command == "run":
         status, text, err = cli(
             "run", str(spec), "--robot", robot, "--episodes", "1", "--json", "--quiet", "--out", str(out)
@@ -175,9 +176,14 @@ def _returns(command: str, spec: Path, robot: str, tmp_path: Path) -> float:
 
 @pytest.mark.slow
 @pytest.mark.parametrize("spec,robot", [(p.stem, "jaco") for p in sorted(TASKS.glob("*.yaml"))] + [("drinking", "pr2")])
-def test_render_never_changes_the_simulation(spec, robot, tmp_path):
+def test_render_never_changes_the_simulation(spec, robot, tmp_path, shared_cache):
     """The same seed gives the same return whether every step is rendered or none is (printed to
-    0.1 by render; run's JSON rounded alike)."""
-    ran = _returns("run", TASKS / f"{spec}.yaml", robot, tmp_path)
-    rendered = _returns("render", TASKS / f"{spec}.yaml", robot, tmp_path)
+    0.1 by render; run's JSON rounded alike). Both play the task compiled in the session's shared
+    cache (conftest's ``shared_cache``: compiled once, for this test and the shipped-id tests)."""
+    path = TASKS / f"{spec}.yaml"
+    out = cached_artifact_dir(path, robot)
+    with artifact_lock(path, robot):
+        compile_task(path, robot, out)
+    ran = _returns("run", path, robot, out, tmp_path)
+    rendered = _returns("render", path, robot, out, tmp_path)
     assert f"{ran:.1f}" == f"{rendered:.1f}"

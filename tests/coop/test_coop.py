@@ -3,8 +3,9 @@ PettingZoo API and seed tests for every shipped task × robot, the shared reward
 end, bit-for-bit replay, the located error for a person with nothing to control, the fixed-partner
 Gymnasium wrapper and the coop rollout. Real compiles, real pybullet.
 
-Envs made by name compile into ``<pytest basetemp>/cache``, the directory ``test_all_envs.py``
-uses, so each shipped task × robot compiles once per session.
+Envs made by name compile into the session's shared cache (conftest's ``shared_cache``), which
+``test_all_envs.py`` also uses, so each shipped task × robot compiles once per session, not once
+per file and xdist worker.
 """
 
 from __future__ import annotations
@@ -40,11 +41,6 @@ REFERENCE_HUMAN = {
 }
 
 
-@pytest.fixture
-def cache(tmp_path_factory, monkeypatch):
-    monkeypatch.setenv("ASSISTIVE_COMPILER_CACHE", str(tmp_path_factory.getbasetemp() / "cache"))
-
-
 @pytest.fixture(scope="module")
 def feeding(artifact):
     env = AssistiveParallelEnv(artifact)
@@ -71,8 +67,9 @@ def test_package_attributes():
 
 
 @pytest.mark.parametrize("task", sorted(REFERENCE_HUMAN))
-def test_human_sizes_match_the_reference(task, cache):
-    env = coop.make(f"{task}JacoHuman-v1")
+def test_human_sizes_match_the_reference(task, shared_cache):
+    with shared_cache(f"{task}JacoHuman-v1"):
+        env = coop.make(f"{task}JacoHuman-v1")
     try:
         assert env.possible_agents == ["robot", "human"]
         assert (env.action_space("human").shape[0], env.observation_space("human").shape[0]) == REFERENCE_HUMAN[task]
@@ -86,8 +83,9 @@ def test_human_sizes_match_the_reference(task, cache):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)
-def test_pettingzoo_api_and_seed(name, cache):
-    env = coop.make(name)
+def test_pettingzoo_api_and_seed(name, shared_cache):
+    with shared_cache(name):
+        env = coop.make(name)
     try:
         parallel_api_test(env, num_cycles=4)
     finally:

@@ -9,7 +9,6 @@ import json
 import gymnasium as gym
 import pytest
 from episode_digests import STORE, first_difference, rollouts
-from filelock import FileLock
 from gymnasium.utils.env_checker import check_env
 
 import assistive_compiler  # noqa: F401  (registers the ids)
@@ -27,16 +26,6 @@ def test_shipped_task_robot_pairs_are_registered():
         for robot in robots
     }
     assert tasks == expected and len(IDS) == 36
-
-
-@pytest.fixture
-def shared_cache(tmp_path_factory, monkeypatch):
-    """One artifact cache for the whole test session (every xdist worker), so each id compiles
-    once; returns a lock to hold while making an env (the first maker compiles, the others wait)."""
-    cache = tmp_path_factory.getbasetemp().parent / "shipped-ids-cache"
-    cache.mkdir(exist_ok=True)
-    monkeypatch.setenv("ASSISTIVE_COMPILER_CACHE", str(cache))
-    return lambda env_id: FileLock(cache / f"{env_id.replace('/', '_')}.lock")
 
 
 @pytest.mark.slow

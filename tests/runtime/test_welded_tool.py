@@ -25,7 +25,7 @@ def itch(itch_artifact):
     env.close()
 
 
-def test_a_tool_nothing_with_weight_presses_on_is_welded_and_a_loaded_one_is_not(itch_artifact, artifact):
+def test_a_tool_nothing_with_weight_presses_on_is_welded_and_a_loaded_one_is_not(itch_artifact, artifact, shared_cache):
     itch = Manifest.read(itch_artifact, verify=True)
     (scratcher,) = itch.tools
     assert scratcher.welded and itch.body("scratcher").urdf == itch.body("robot").urdf
@@ -40,7 +40,8 @@ def test_a_tool_nothing_with_weight_presses_on_is_welded_and_a_loaded_one_is_not
     feeding = Manifest.read(artifact)
     (spoon,) = feeding.tools
     assert not spoon.welded and (artifact / feeding.body("spoon").urdf).is_file()  # the food rests in it
-    arm = gym.make("assistive_compiler/ArmManipulationJaco-v1").unwrapped  # the limp arm's weight on the scooper
+    with shared_cache("assistive_compiler/ArmManipulationJaco-v1"):
+        arm = gym.make("assistive_compiler/ArmManipulationJaco-v1").unwrapped  # the limp arm's weight on the scooper
     assert [t.welded for t in arm.manifest.tools] == [False] and arm.body_id("scooper_right") != arm.body_id("robot")
     arm.close()
 
