@@ -14,9 +14,10 @@ import numpy as np
 import pytest
 from conftest import FEEDING
 from PIL import Image
+from pretrained_regression import STORE, Regression, outcomes
+from pretrained_regression import episodes as record_episodes
 
 from assistive_compiler.cli import main
-from assistive_compiler.episode import rollout
 from assistive_compiler.policies import make_policy
 from assistive_compiler.policies.pretrained import pretrained_dir, shipped_info, shipped_names
 from assistive_compiler.runtime.env import AssistiveEnv
@@ -28,6 +29,7 @@ SHIPPED = shipped_names()
 #: the figure is reproduced exactly; a change of physics or runtime moves single episodes.
 TOLERANCE = 0.2
 MAX_BYTES = 2 * 1024 * 1024
+REGRESSION = json.loads(STORE.read_text()) if STORE.is_file() else {}
 
 
 def _env(name: str, **kwargs) -> AssistiveEnv:
@@ -73,34 +75,30 @@ def test_shipped_policy_is_small_and_says_what_it_is(name):
     env.close()
 
 
-#: Regression episodes of a task with a garment: its cloth makes an episode ~40 s here, so the
-#: check replays the first 4 of the 10 regression seeds (against the figures recorded for those
-#: same seeds) instead of all 10, which took 6-7 minutes a policy.
-CLOTH_EPISODES = 4
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("name", SHIPPED)
 def test_shipped_policy_still_succeeds_on_the_current_code(name):
     """Success on the regression seeds may fall by TOLERANCE at most, and the mean return by half
     the evaluation's episode-to-episode spread (which also guards policies that rarely succeed).
-    Evaluation is deterministic, so the figures compared are those recorded for the same seeds."""
+    Evaluation is deterministic, so the figures compared are those recorded for the same seeds.
+    The first seeds are replayed; where they give the outcomes recorded for the current code
+    (tests/pretrained_regression.py), so do the others, and those are taken from the record."""
     info = shipped_info(name)
     reg = info["regression"]
-    env = _env(name)
-    episodes = CLOTH_EPISODES if env.manifest.garments else reg["episodes"]
-    if info["coop"]:  # the pair plays both agents, as export evaluated it
-        from assistive_compiler.policies.pretrained import load_trained
-        from assistive_compiler.training.evaluate import play_episodes
-
-        pair, _ = load_trained(f"pretrained:{name}")
-        runs = play_episodes(env.artifact_dir, pair, True, episodes, reg["seed"])
-    else:
-        policy = make_policy(f"pretrained:{name}", env)
-        runs = [rollout(env, policy, reg["seed"] + k) for k in range(episodes)]
-    env.close()
     evaluation = info["evaluation"]
     assert evaluation["seed"] == reg["seed"]  # the regression seeds are the evaluation's first ones
+    regression = Regression(name)
+    episodes, replayed = regression.episodes, regression.replayed
+    recorded = REGRESSION.get(name, {"returns": [], "successes": []})
+    try:
+        runs = regression.play(0, replayed)
+        as_recorded = {k: v[:replayed] for k, v in recorded.items()}
+        if len(recorded["returns"]) == episodes and outcomes(runs) == as_recorded:  # the code plays as recorded
+            runs += record_episodes({k: v[replayed:] for k, v in recorded.items()})
+        else:  # a change since the record (or none): replay every regression seed
+            runs += regression.play(replayed, episodes - replayed)
+    finally:
+        regression.close()
     recorded_success = float(np.mean(evaluation["successes"][:episodes]))
     recorded_return = float(np.mean(evaluation["returns"][:episodes]))
     seeds = f"seeds {reg['seed']}..{reg['seed'] + episodes - 1}"
