@@ -65,9 +65,12 @@ def package_versions() -> dict[str, str | None]:
     return out
 
 
-def engine_modules(engine: str) -> tuple[str, ...]:
-    """The modules a training engine (``sb3``, ``rllib``) needs to train, or to play its checkpoints."""
-    return ("torch", "stable_baselines3" if engine == "sb3" else "ray")
+def engine_modules(engine: str, library: str = "sb3") -> tuple[str, ...]:
+    """The modules a training engine (``sb3``, ``rllib``) needs to train, or to play its checkpoints;
+    ``library`` ``sbx``: the SB3 engine learning with SBX (JAX) as well."""
+    if engine != "sb3":
+        return ("torch", "ray")
+    return ("torch", "stable_baselines3") + (("jax", "sbx") if library == "sbx" else ())
 
 
 @dataclass(frozen=True)
@@ -91,6 +94,11 @@ class RunInfo:
         """The trained algorithm's name (``ppo``, ``sac``); the whole config is
         :func:`assistive_compiler.training.config.run_config`."""
         return str(self.config["algorithm"])
+
+    @property
+    def library(self) -> str:
+        """The implementation that learned an SB3-engine run: ``sb3`` (PyTorch) or ``sbx`` (JAX)."""
+        return str((self.config.get("sac") or {}).get("library", "sb3"))
 
 
 class RunDir:

@@ -14,6 +14,7 @@ TRAINING_TABLE = (
     "robot",
     "config",
     "algorithm",
+    "library",
     "network",
     "envs",
     "vec_env",
@@ -29,15 +30,18 @@ TRAINING_TABLE = (
 def cmd_bench_training(args: argparse.Namespace, pairs: list[tuple[str, str | None]]) -> int:
     """Measure every config in ``args.training`` on every spec × robot pair, one after another in
     this process (run it on an otherwise idle core: ``taskset -c 1 assistive-compiler bench ...``)."""
+    from ..run_dir import engine_modules
+    from ..training.config import load_training_config
     from .common import EXIT_FAILED, require_extra
-
-    if not require_extra("torch", "stable_baselines3"):
-        return EXIT_FAILED
-    from ..training.throughput import measure_training
-    from .output import cell, print_table, progress
     from .train import training_config_path
 
     configs = [training_config_path(name) for name in args.training]
+    needed = dict.fromkeys(m for c in configs for m in engine_modules("sb3", load_training_config(c).library))
+    if not require_extra(*needed):
+        return EXIT_FAILED
+    from ..training.throughput import measure_training
+    from .output import cell, print_table, progress
+
     results = []
     with progress("bench --training", len(pairs) * len(configs)) as tracker:
         for spec, robot in pairs:
@@ -67,7 +71,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         action="append",
         metavar="CONFIG",
         help="measure training instead: env steps/s including learning of this training config (a file, or a "
-        "shipped one by name, e.g. ppo_fast_envs); give several to compare them side by side. Needs the train extra",
+        "shipped one by name, e.g. ppo_one_core); give several to compare them side by side. Needs the train extra",
     )
     p.add_argument(
         "--training-steps",

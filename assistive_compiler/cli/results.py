@@ -15,7 +15,8 @@ from .common import EXIT_FAILED, EXIT_OK, require_extra
 def cmd_export(args: argparse.Namespace) -> int:
     from ..run_dir import RunDir
 
-    if not require_extra(*engine_modules(RunDir(args.run_dir).info().engine)):
+    info = RunDir(args.run_dir).info()
+    if not require_extra(*engine_modules(info.engine, info.library)):
         return EXIT_FAILED
     from ..paths import display
     from ..training.export import export_run

@@ -49,6 +49,11 @@ def cmd_train(args: argparse.Namespace) -> int:
         check_coop_spec(load_spec(args.spec))
     if not require_extra(*engine_modules(engine)):
         return EXIT_FAILED
+    from ..training.config import load_training_config
+
+    library = load_training_config(training_config_path(args.config)).library
+    if library != "sb3" and not require_extra(*engine_modules(engine, library)):
+        return EXIT_FAILED
     from ..training.train import train
 
     # With --json, stdout holds the summary alone: whatever training prints (and Ray's forwarded

@@ -20,9 +20,15 @@ SINGLE_MODULE = "default_policy"
 ACTOR_AVERAGE = "actor_average.pt"
 
 
-def algorithm_class(config_or_name):
-    """SB3's class for the config's algorithm (or an algorithm name)."""
+def algorithm_class(config_or_name, library: str | None = None):
+    """The learning library's class for the config's algorithm (or an algorithm name): SB3's, or
+    with ``library`` ``sbx`` (the config's own, given a config) SBX's JAX one."""
     name = getattr(config_or_name, "algorithm", config_or_name)
+    library = library or getattr(config_or_name, "library", "sb3")
+    if name == "sac" and library == "sbx":
+        from sbx import SAC as SBXSAC
+
+        return SBXSAC
     if name == "sac":
         from stable_baselines3 import SAC
 
@@ -36,15 +42,21 @@ class SB3Policy:
     """A trained SB3 policy as a function of raw observations (normalised as during training):
     the distribution's mode, or with ``stochastic`` a sample of it as in training (seeded)."""
 
-    def __init__(self, checkpoint: Path, algorithm: str = "ppo", stochastic: bool = False, seed: int = 0):
+    def __init__(
+        self, checkpoint: Path, algorithm: str = "ppo", stochastic: bool = False, seed: int = 0, library: str = "sb3"
+    ):
         self.algorithm, self.stochastic = algorithm, stochastic
         if stochastic:  # SB3 samples with torch's generator: seeded, the same seed gives the same episodes
             import torch
 
             torch.manual_seed(seed)
-        self.model = algorithm_class(algorithm).load(
+        self.model = algorithm_class(algorithm, library).load(
             str(checkpoint / "model.zip"), device="cpu", custom_objects={"replay_buffer_class": None}
         )
+        if library == "sbx":  # SBX samples with a JAX key of the policy's own: seeded the same way
+            import jax
+
+            self.model.policy.key = jax.random.PRNGKey(seed)
         average = checkpoint / ACTOR_AVERAGE
         if average.is_file():  # trained with an averaged actor: the average acts
             import torch
@@ -143,7 +155,9 @@ def load_policy(info: RunInfo, checkpoint: Path, stochastic: bool = False, seed:
     deterministic, or with ``stochastic`` sampling its actions as training did (from a generator
     seeded with ``seed``)."""
     if info.engine == "sb3":
-        return (SB3PairPolicy if info.coop else SB3Policy)(checkpoint, info.algorithm, stochastic=stochastic, seed=seed)
+        if info.coop:
+            return SB3PairPolicy(checkpoint, info.algorithm, stochastic=stochastic, seed=seed)
+        return SB3Policy(checkpoint, info.algorithm, stochastic=stochastic, seed=seed, library=info.library)
     return RLlibPolicy(checkpoint, coop=info.coop, algorithm=info.algorithm, stochastic=stochastic, seed=seed)
 
 
@@ -155,7 +169,7 @@ def load_run(path: Path, source: str):
 
     run = RunDir(path)
     run_info = run.info()
-    missing = [m for m in engine_modules(run_info.engine) if importlib.util.find_spec(m) is None]
+    missing = [m for m in engine_modules(run_info.engine, run_info.library) if importlib.util.find_spec(m) is None]
     if missing:
         raise UsageError(
             f"--policy {source}: playing a run directory needs its training library ({', '.join(missing)} not "

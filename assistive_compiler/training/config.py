@@ -150,6 +150,37 @@ class SAC(Strict):
         "the actor itself. 0: off (SB3 engine only).",
     )
 
+    library: Literal["sb3", "sbx"] = Field(
+        "sb3",
+        description="Which implementation learns: 'sb3' (Stable-Baselines3, PyTorch: every option here) or 'sbx' "
+        "(SBX, the Stable-Baselines3 team's JAX port, package sbx-rl: the same SAC with jit-compiled updates, about "
+        "twice as many updates per core-second for small networks; the same checkpoints, callbacks, resume and "
+        "export, but not critic_layer_norm, conservative_weight, actor_average_tau, actor_learning_rate, "
+        "demonstrations or co-optimisation). SB3 engine only.",
+    )
+
+    @model_validator(mode="after")
+    def _sbx_options(self) -> SAC:
+        if self.library != "sbx":
+            return self
+        unsupported = [
+            name
+            for name, default in (
+                ("critic_layer_norm", False),
+                ("conservative_weight", 0.0),
+                ("actor_average_tau", 0.0),
+                ("actor_learning_rate", None),
+            )
+            if getattr(self, name) != default
+        ]
+        if unsupported:
+            raise ValueError(
+                f"@library: {', '.join(unsupported)} {'is' if len(unsupported) == 1 else 'are'} built on SB3's "
+                "PyTorch SAC; library 'sbx' does not have it: set library: sb3, or leave "
+                f"{'it' if len(unsupported) == 1 else 'them'} at the default"
+            )
+        return self
+
     @model_validator(mode="after")
     def _positive_temperature(self) -> SAC:
         if not isinstance(self.ent_coef, str) and self.ent_coef <= 0:
@@ -314,6 +345,11 @@ class TrainingConfig(Strict):
                 f"@demonstrations: starting from demonstrations fits SAC's actor and fills its replay buffer; "
                 f"algorithm is '{self.algorithm}' (use a SAC config, e.g. sac_laptop)"
             )
+        if self.demonstrations is not None and self.sac is not None and self.sac.library == "sbx":
+            raise ValueError(
+                "@demonstrations: starting from demonstrations clones into SB3's PyTorch actor; "
+                "sac.library is 'sbx' (set library: sb3)"
+            )
         if self.demonstrations is not None and self.envs != 1:
             raise ValueError(
                 f"@demonstrations: starting from demonstrations needs envs: 1 (the replay buffer is filled as one "
@@ -327,6 +363,11 @@ class TrainingConfig(Strict):
         if self.ppo is not None:
             return self.ppo.rollout_steps * self.envs
         return self.sac.train_freq * self.envs
+
+    @property
+    def library(self) -> str:
+        """The implementation that learns on the SB3 engine: ``sb3`` (PyTorch) or ``sbx`` (JAX; SAC only)."""
+        return self.sac.library if self.sac is not None else "sb3"
 
     @property
     def gamma(self) -> float:

@@ -192,6 +192,11 @@ def check_supported(config: TrainingConfig) -> None:
     s = config.sac
     if s is None:
         return
+    if s.library == "sbx":
+        raise UsageError(
+            "sac.library: sbx is the SB3 engine's JAX SAC; use --engine sb3, or set library: sb3 (RLlib learns with "
+            "its own PyTorch SAC)"
+        )
     if s.ent_coef != "auto":
         raise UsageError(
             f"sac.ent_coef {s.ent_coef}: the rllib engine learns the entropy temperature; use ent_coef: auto"

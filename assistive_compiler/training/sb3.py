@@ -61,10 +61,16 @@ def make_vec_env(artifact_dir: Path, n_envs: int, seed: int, coop: bool = False,
 
 
 def policy_kwargs(config: TrainingConfig) -> dict:
-    import torch.nn as nn
-
+    """The network's shape and activation as the learning library takes them (a PyTorch module
+    class for SB3, a JAX function for SBX)."""
     hidden = list(config.network.hidden)
     arch = {"pi": hidden, "vf": hidden} if config.algorithm == "ppo" else {"pi": hidden, "qf": hidden}
+    if config.library == "sbx":
+        import flax.linen
+
+        return {"net_arch": arch, "activation_fn": getattr(flax.linen, config.network.activation)}
+    import torch.nn as nn
+
     return {"net_arch": arch, "activation_fn": getattr(nn, ACTIVATIONS[config.network.activation])}
 
 
@@ -99,13 +105,23 @@ def sac_policy(config: TrainingConfig, agent_split: tuple[int, int] | None) -> t
     return policy, kwargs | {"agent_split": agent_split}
 
 
+def _one_xla_thread() -> None:
+    """JAX on one CPU thread, as torch is (``XLA_FLAGS``; it takes effect only where JAX has not
+    started its CPU backend yet, as when ``train`` runs from the command line)."""
+    import os
+
+    flags = os.environ.get("XLA_FLAGS", "")
+    if "xla_cpu_multi_thread_eigen" not in flags:
+        os.environ["XLA_FLAGS"] = f"{flags} --xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1".strip()
+
+
 def _new_model(venv, config: TrainingConfig, run: RunDir, agent_split: tuple[int, int] | None = None):
-    from stable_baselines3 import PPO, SAC
+    from stable_baselines3 import PPO
 
     if config.sac is not None:
         s = config.sac
-        policy, kwargs = sac_policy(config, agent_split)
-        return SAC(
+        policy, kwargs = sac_policy(config, agent_split) if s.library == "sb3" else ("MlpPolicy", policy_kwargs(config))
+        return algorithm_class(config)(
             policy,
             venv,
             learning_rate=s.learning_rate,
@@ -243,6 +259,8 @@ def train(
     import torch
 
     torch.set_num_threads(1)  # small MLPs: more threads only contend with the env processes
+    if config.library == "sbx":
+        _one_xla_thread()
     latest = run.latest_checkpoint() if resume else None
     start_steps = latest[0] if latest else 0
     if latest and config.sac is not None and not (latest[1] / REPLAY_BUFFER).is_file():

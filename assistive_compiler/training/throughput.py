@@ -135,6 +135,7 @@ def measure_training(spec: str, robot: str, config_path: str, steps: int) -> dic
     return {
         "config": Path(config_path).stem,
         "algorithm": config.algorithm,
+        "library": config.library,
         "network": "×".join(str(w) for w in config.network.hidden),
         "envs": config.envs,
         "vec_env": config.vec_env,

@@ -97,6 +97,11 @@ def train(
             f"--coop --engine sb3 trains SAC (one actor per agent, one shared critic); {display(Path(config_path))} is "
             f"{config.algorithm.upper()}: use --engine rllib (or auto) for {config.algorithm.upper()} co-optimisation"
         )
+    if engine == "sb3" and coop and config.library == "sbx":
+        raise UsageError(
+            f"--coop --engine sb3 trains one actor per agent, built on SB3's PyTorch SAC; {display(Path(config_path))} "
+            "learns with sbx (sac.library): use a config with library: sb3 (e.g. sac_laptop)"
+        )
     if engine == "rllib":
         from .rllib import check_supported
 

@@ -126,7 +126,7 @@ def test_rich_is_imported_only_when_the_cli_prints(module):
     if module == "assistive_compiler.cli":
         code += "assistive_compiler.cli.build_parser().parse_args(['train', 'x.yaml', '--config', 'ppo_quick'])\n"
     code += (
-        "heavy = [m for m in ('rich', 'torch', 'ray', 'stable_baselines3', 'matplotlib', 'tensorboard') if m in sys.modules]\n"
+        "heavy = [m for m in ('rich', 'torch', 'ray', 'stable_baselines3', 'jax', 'sbx', 'matplotlib', 'tensorboard') if m in sys.modules]\n"
         "assert not heavy, heavy\n"
     )
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
