@@ -12,6 +12,7 @@ from ..artifact import AGENTS
 from ..errors import UsageError
 from ..paths import display
 from ..run_dir import RunDir, RunInfo, engine_modules
+from .mlp import MLPPolicy
 
 #: RLlib's module id of a single-agent run (``ray.rllib.core.DEFAULT_MODULE_ID``).
 SINGLE_MODULE = "default_policy"
@@ -38,6 +39,33 @@ def algorithm_class(config_or_name, library: str | None = None):
     return PPO
 
 
+def sbx_sac_actor(model, activation: str) -> MLPPolicy:
+    """SBX's SAC actor (flax ``Dense_0`` .. ``Dense_{n-1}`` hidden, then the mean's layer and the
+    log-std's, both on the last hidden features) as a NumPy policy: its mean through tanh, with the
+    log-std layer for sampling. Flax keeps a kernel as (inputs, outputs), the policy (outputs, inputs)."""
+    from sbx.sac.policies import SquashedGaussianActor
+
+    dense = model.policy.actor_state.params["params"]
+    actor = model.policy.actor
+    if not isinstance(actor, SquashedGaussianActor) or len(dense) != len(actor.net_arch) + 2:
+        raise UsageError(f"{type(actor).__name__}: not SBX's SAC actor (hidden layers, a mean and a log-std layer)")
+
+    def layer(k: int) -> tuple[np.ndarray, np.ndarray]:
+        weights = dense[f"Dense_{k}"]
+        return np.asarray(weights["kernel"], dtype=np.float64).T, np.asarray(weights["bias"], dtype=np.float64)
+
+    space = model.action_space
+    return MLPPolicy(
+        [layer(k) for k in range(len(dense) - 1)],
+        activation,
+        "tanh",
+        space.low,
+        space.high,
+        log_std=layer(len(dense) - 1),
+        log_std_bounds=(float(actor.log_std_min), float(actor.log_std_max)),
+    )
+
+
 class SB3Policy:
     """A trained SB3 policy as a function of raw observations (normalised as during training):
     the distribution's mode, or with ``stochastic`` a sample of it as in training (seeded)."""
@@ -53,10 +81,12 @@ class SB3Policy:
         self.model = algorithm_class(algorithm, library).load(
             str(checkpoint / "model.zip"), device="cpu", custom_objects={"replay_buffer_class": None}
         )
-        if library == "sbx":  # SBX samples with a JAX key of the policy's own: seeded the same way
-            import jax
-
-            self.model.policy.key = jax.random.PRNGKey(seed)
+        # SBX's actor acts in NumPy (its own JAX call hands each action to XLA's thread: slow on a
+        # busy core), sampling from a generator seeded with ``seed``
+        self.numpy_actor = None
+        if library == "sbx":
+            actor = sbx_sac_actor(self.model, self.model.policy.actor.activation_fn.__name__)
+            self.numpy_actor = actor.sampling(seed) if stochastic else actor
         average = checkpoint / ACTOR_AVERAGE
         if average.is_file():  # trained with an averaged actor: the average acts
             import torch
@@ -73,6 +103,8 @@ class SB3Policy:
             self.clip, self.eps = vn.clip_obs, vn.epsilon
 
     def __call__(self, obs: np.ndarray) -> np.ndarray:
+        if self.numpy_actor is not None:
+            return self.numpy_actor(np.asarray(obs, dtype=np.float64))
         if self.obs_rms is not None:
             obs = np.clip((obs - self.obs_rms.mean) / np.sqrt(self.obs_rms.var + self.eps), -self.clip, self.clip)
         action, _ = self.model.predict(obs.astype(np.float32), deterministic=not self.stochastic)

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..policies.checkpoint import sbx_sac_actor
 from ..policies.mlp import MLPPolicy
 from ..run_dir import RunDir
 from .config import run_config
@@ -53,33 +54,6 @@ def _sac_actor(actor, activation: str, low: np.ndarray, high: np.ndarray) -> MLP
     return MLPPolicy(layers, activation, "tanh", low, high, log_std=log_std, log_std_bounds=(LOG_STD_MIN, LOG_STD_MAX))
 
 
-def _sbx_sac_actor(model, activation: str) -> MLPPolicy:
-    """SBX's SAC actor (flax ``Dense_0`` .. ``Dense_{n-1}`` hidden, then the mean's layer and the
-    log-std's, both on the last hidden features) as its mean through tanh, with the log-std layer.
-    Flax keeps a kernel as (inputs, outputs): transposed to the (outputs, inputs) of the export."""
-    from sbx.sac.policies import SquashedGaussianActor
-
-    dense = model.policy.actor_state.params["params"]
-    count = len(dense)
-
-    def layer(k: int) -> tuple[np.ndarray, np.ndarray]:
-        d = dense[f"Dense_{k}"]
-        return np.asarray(d["kernel"], dtype=np.float64).T, np.asarray(d["bias"], dtype=np.float64)
-
-    actor = model.policy.actor
-    assert isinstance(actor, SquashedGaussianActor) and count == len(actor.net_arch) + 2, "not SBX's SAC actor"
-    space = model.action_space
-    return MLPPolicy(
-        [layer(k) for k in range(count - 1)],
-        activation,
-        "tanh",
-        space.low,
-        space.high,
-        log_std=layer(count - 1),
-        log_std_bounds=(float(actor.log_std_min), float(actor.log_std_max)),
-    )
-
-
 def pair_from_sb3(loaded, activation: str) -> dict[str, MLPPolicy]:
     """Each agent's deterministic policy of a co-optimised SB3 SAC checkpoint
     (:class:`~assistive_compiler.policies.checkpoint.SB3PairPolicy`), by agent name."""
@@ -98,7 +72,7 @@ def mlp_from_sb3(loaded, algorithm: str, activation: str) -> MLPPolicy:
     model = loaded.model
     low, high = model.action_space.low, model.action_space.high
     if algorithm == "sac" and type(model).__module__.startswith("sbx"):
-        return _sbx_sac_actor(model, activation)
+        return sbx_sac_actor(model, activation)
     if algorithm == "sac":
         return _sac_actor(model.actor, activation, low, high)
     layers = _layers(_linears(model.policy.mlp_extractor.policy_net) + [model.policy.action_net])

@@ -78,12 +78,15 @@ def test_an_sbx_run_resumes_with_its_replay_buffer_exports_and_plays_as_its_chec
     assert model.replay_buffer.size() == 3 * CHECKPOINT_EVERY
     assert not (run.path / "checkpoints" / f"step_{2 * CHECKPOINT_EVERY}" / "replay_buffer.pkl").exists()
 
-    # export: NumPy actions (tanh of the mean) equal the checkpoint's, and the log-std goes with them
+    # export: NumPy actions (tanh of the mean) equal the checkpoint's as SBX itself computes them,
+    # and the log-std goes with them
     record = export_run(sbx_run, tmp_path / "exported", episodes=2, seed=11, label="sbx")
     exported, original = MLPPolicy.load(tmp_path / "exported"), SB3Policy(checkpoint, "sac", library="sbx")
     assert record["trained_steps"] == steps and exported.samples and record["export_max_action_difference"] < 1e-5
+    jax_actor = sbx.SAC.load(str(checkpoint / "model.zip"), device="cpu", custom_objects={"replay_buffer_class": None})
     for obs in np.random.default_rng(0).normal(0, 2, (40, exported.obs_dim)).astype(np.float32):
         assert np.allclose(exported(obs), original(obs), atol=1e-5)
+        assert np.allclose(exported(obs), jax_actor.predict(obs, deterministic=True)[0], atol=1e-5)  # SBX's own
 
     # --policy RUN_DIR plays the newest checkpoint: the same episodes as evaluate and the export
     capsys.readouterr()
