@@ -105,16 +105,6 @@ def sac_policy(config: TrainingConfig, agent_split: tuple[int, int] | None) -> t
     return policy, kwargs | {"agent_split": agent_split}
 
 
-def _one_xla_thread() -> None:
-    """JAX on one CPU thread, as torch is (``XLA_FLAGS``; it takes effect only where JAX has not
-    started its CPU backend yet, as when ``train`` runs from the command line)."""
-    import os
-
-    flags = os.environ.get("XLA_FLAGS", "")
-    if "xla_cpu_multi_thread_eigen" not in flags:
-        os.environ["XLA_FLAGS"] = f"{flags} --xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1".strip()
-
-
 def _new_model(venv, config: TrainingConfig, run: RunDir, agent_split: tuple[int, int] | None = None):
     from stable_baselines3 import PPO
 
@@ -259,8 +249,6 @@ def train(
     import torch
 
     torch.set_num_threads(1)  # small MLPs: more threads only contend with the env processes
-    if config.library == "sbx":
-        _one_xla_thread()
     latest = run.latest_checkpoint() if resume else None
     start_steps = latest[0] if latest else 0
     if latest and config.sac is not None and not (latest[1] / REPLAY_BUFFER).is_file():
