@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..episode import rollout
-from .common import EXIT_BAD_INPUT, EXIT_OK, add_library_argument, add_spec_arguments, make_env
+from .common import EXIT_BAD_INPUT, EXIT_OK, add_artifact_argument, add_library_argument, add_spec_arguments, make_env
 
 
 def _yes_no(flag: bool) -> str:
@@ -178,7 +178,7 @@ def add_commands(sub) -> None:
     p = sub.add_parser("run", help="roll out a policy and report returns, success and the largest terms")
     add_spec_arguments(p)
     p.add_argument("--episodes", type=int, default=5)
-    p.add_argument("--out", help="artifact directory (default generated/<task>-<robot>)")
+    add_artifact_argument(p)
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument(

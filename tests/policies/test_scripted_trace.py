@@ -28,7 +28,7 @@ def _reach_with(tmp_path: Path, first: str) -> Path:
 
 
 def _run(spec: Path, *more: str) -> tuple[int, str, str]:
-    return cli("run", str(spec), "--robot", "jaco", "--episodes", "1", "--out", str(spec.parent / "art"), *more)
+    return cli("run", str(spec), "--robot", "jaco", "--episodes", "1", "--out-dir", str(spec.parent / "art"), *more)
 
 
 @pytest.fixture(scope="module")
