@@ -586,17 +586,26 @@ class ScriptWaypoint(_Model):
     step_m: float | None = Field(None, description="Straight-line look-ahead per step, m (none: straight to the goal).")
     face_normal_level: bool = Field(False, description="Turn about the vertical only (keep the tool level).")
     turn_step_rad: float | None = Field(None, description="Most the tool turns per step, rad (none: no limit).")
+    # The defaults are the spec's (spec.models.scripted.STALL_STEPS, STALL_PROGRESS_M).
+    stall_steps: int = Field(
+        10, description="Moved on (stalled) after this many steps without stall_progress_m of progress."
+    )
+    stall_progress_m: float = Field(0.002, description="Progress that restarts the stall count, m.")
 
     @model_serializer(mode="wrap")
     def _without_unset_additions(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
-        """``step_m``, ``face_normal_level`` and ``turn_step_rad`` are left out when unset (the form
-        artifacts were first written in)."""
+        """``step_m``, ``face_normal_level`` and ``turn_step_rad`` are left out when unset, and
+        ``stall_steps`` and ``stall_progress_m`` at their defaults (the form artifacts were first
+        written in)."""
         data: dict[str, Any] = handler(self)
         for key in ("step_m", "turn_step_rad"):
             if data.get(key) is None:
                 data.pop(key, None)
         if not data.get("face_normal_level"):
             data.pop("face_normal_level", None)
+        for key in ("stall_steps", "stall_progress_m"):
+            if data.get(key) == type(self).model_fields[key].default:
+                data.pop(key, None)
         return data
 
 

@@ -66,6 +66,27 @@ def add_spec_arguments(p: argparse.ArgumentParser, policy: bool = True) -> None:
     p.add_argument("--seed", type=int, default=0, help="first episode seed")
 
 
+class _ArtifactOut(argparse.Action):
+    """``--out`` where it names the artifact directory (``run``, ``view``, ``compare``): the older
+    spelling of ``--out-dir``, still read, with a note on stderr (``--out`` is what a command
+    writes: ``render``'s picture, ``compile``'s artifact)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(
+            f"{parser.prog}: --out here is the older spelling of --out-dir (the artifact directory, as in render, "
+            "where --out is the picture); it still works",
+            file=sys.stderr,
+        )
+        setattr(namespace, self.dest, values)
+
+
+def add_artifact_argument(p: argparse.ArgumentParser, what: str = "artifact directory") -> None:
+    """``--out-dir DIR``: where the task is compiled to (every command that compiles as a means, not
+    as its product, spells it so); ``--out`` is accepted as its older spelling, with a note."""
+    p.add_argument("--out-dir", dest="out", metavar="DIR", help=f"{what} (default generated/<task>-<robot>)")
+    p.add_argument("--out", dest="out", action=_ArtifactOut, help=argparse.SUPPRESS)
+
+
 def make_env(spec: str, robot: str | None, out: str | None = None, **kwargs):
     """The env of ``spec`` for ``robot``, compiled into ``out`` first (a cache hit when unchanged)."""
     from ..runtime.env import AssistiveEnv

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..artifact import BaseSearch, Mounted
 from ..episode import rollout
-from .common import EXIT_OK, add_library_argument
+from .common import EXIT_OK, add_artifact_argument, add_library_argument
 
 COLUMNS = ("robot", "placement", "goals_reached", "jlwki", "compile_s", "success", "return")
 #: ``--policy pretrained``: each robot plays its own shipped policy, ``pretrained:<task>-<robot>``.
@@ -159,6 +159,6 @@ def add_commands(sub) -> None:
         "pretrained:<task>-<robot> or a training run directory",
     )
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--out", help="artifact root (default generated/<task>-<robot>)")
+    add_artifact_argument(p, "artifact root")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_compare)

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..episode import rollout
-from .common import EXIT_BAD_INPUT, EXIT_OK, add_library_argument, add_spec_arguments, make_env
+from .common import EXIT_BAD_INPUT, EXIT_OK, add_artifact_argument, add_library_argument, add_spec_arguments, make_env
 
 
 def _yes_no(flag: bool) -> str:
@@ -51,6 +51,13 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.coop and args.record:
         print("run: --record writes single-agent episodes; it cannot be combined with --coop", file=sys.stderr)
         return EXIT_BAD_INPUT
+    if args.trace and (args.policy != "scripted" or args.coop):
+        print(
+            f"run: --trace follows the scripted policy's waypoints; it needs --policy scripted"
+            f"{' without --coop' if args.coop else f' (not {args.policy})'}",
+            file=sys.stderr,
+        )
+        return EXIT_BAD_INPUT
     if args.coop:  # both agents act (co-optimisation); the person by --human-policy
         from ..coop import parallel_env, rollout_coop
 
@@ -63,7 +70,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             return rollout_coop(coop_env, args.policy, args.human_policy, seed)
     else:
         env, label = make_env(args.spec, args.robot, args.out), args.policy
-        policy = make_policy(args.policy, env, seed=args.seed)
+        policy = make_policy(args.policy, env, seed=args.seed, trace=args.trace)
         player = env
         if args.record:  # every episode also written as DIR/episode-NNNN.npz (reads only: same episodes)
             from ..record import RecordEpisodes
@@ -71,7 +78,11 @@ def cmd_run(args: argparse.Namespace) -> int:
             player = RecordEpisodes(env, args.record, policy=args.policy)
 
         def play(seed: int) -> dict:
-            return rollout(player, policy, seed)
+            e = rollout(player, policy, seed)
+            if args.trace:  # the scripted policy's waypoint events (reading only: the same episode)
+                policy.end_episode()
+                e["trace"] = list(policy.trace)
+            return e
 
     weights = {t.name: t.weight for t in env.manifest.reward}
     episodes = []
@@ -104,6 +115,11 @@ def cmd_run(args: argparse.Namespace) -> int:
         return EXIT_OK
     human = f"  human-policy={args.human_policy}" if args.coop else ""
     print(f"{env.manifest.label}  policy={args.policy}{human}  episodes={len(episodes)}  seed={args.seed}")
+    if args.trace:
+        for k, e in enumerate(episodes):
+            print(f"trace of episode {k} (seed {e['seed']}):")
+            for event in e["trace"]:
+                print(f"  {event['line']}")
     rows = []
     for k, e in enumerate(episodes):
         top = sorted(e["terms"].items(), key=lambda kv: -abs(weights[kv[0]] * kv[1]))[:3]
@@ -162,9 +178,16 @@ def add_commands(sub) -> None:
     p = sub.add_parser("run", help="roll out a policy and report returns, success and the largest terms")
     add_spec_arguments(p)
     p.add_argument("--episodes", type=int, default=5)
-    p.add_argument("--out", help="artifact directory (default generated/<task>-<robot>)")
+    add_artifact_argument(p)
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.add_argument(
+        "--trace",
+        action="store_true",
+        help="with --policy scripted: print each waypoint event (reached within tolerance_m, stalled, where the "
+        "episode ended) with its goal (world, m), the distance left and what the robot and its tools touch "
+        "(with --json: each episode's 'trace' list)",
+    )
     p.add_argument(
         "--coop", action="store_true", help="co-optimisation: the person acts too (by --human-policy), shared reward"
     )

@@ -148,7 +148,12 @@ def add_commands(sub) -> None:
     add_library_argument(p)
     p.add_argument("spec", help="task spec file")
     p.add_argument("--robot", help="robot name (default: the spec's default robot)")
-    p.add_argument("--out", help="output directory (default: generated/<task>-<robot>)")
+    p.add_argument(
+        "--out",
+        "--out-dir",
+        dest="out",
+        help="output directory (default: generated/<task>-<robot>); --out-dir is the same",
+    )
     p.add_argument("--force", action="store_true", help="recompile even when the output is up to date")
     p.add_argument("--strict", action="store_true", help="also check every URDF with urdfdom, yourdfpy and pybullet")
     p.set_defaults(func=cmd_compile)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .common import EXIT_FAILED, add_spec_arguments
+from .common import EXIT_FAILED, add_artifact_argument, add_spec_arguments
 
 
 def cmd_view(args: argparse.Namespace) -> int:
@@ -61,5 +61,5 @@ def add_commands(sub) -> None:
     p.add_argument(
         "--gui", action="store_true", help="pybullet's own GUI window instead of the browser (needs a display)"
     )
-    p.add_argument("--out", help="artifact directory (default generated/<task>-<robot>)")
+    add_artifact_argument(p)
     p.set_defaults(func=cmd_view)

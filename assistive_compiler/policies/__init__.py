@@ -18,9 +18,10 @@ POLICY_HELP = (
 )
 
 
-def make_policy(name: str, env, seed: int = 0) -> Callable[[np.ndarray], np.ndarray]:
+def make_policy(name: str, env, seed: int = 0, trace: bool = False) -> Callable[[np.ndarray], np.ndarray]:
     """A callable ``obs -> action`` for ``env``. ``scripted`` needs a task with a ``scripted:``
-    section; a trained policy (``pretrained:...``, a run or policy folder) must have been trained
+    section (``trace``: it keeps a trace of its waypoint events, see
+    :class:`~assistive_compiler.policies.scripted.ScriptedPolicy`); a trained policy (``pretrained:...``, a run or policy folder) must have been trained
     for the env's task and robot."""
     if name == "random":
         space = env.action_space
@@ -31,7 +32,7 @@ def make_policy(name: str, env, seed: int = 0) -> Callable[[np.ndarray], np.ndar
     if name == "scripted":
         from .scripted import ScriptedPolicy
 
-        return ScriptedPolicy(env)
+        return ScriptedPolicy(env, trace=trace)
     from .pretrained import check_fits, load_trained
 
     policy, info = load_trained(name)

@@ -3,9 +3,10 @@
 Each step it reads the world (privileged: true target positions), asks pybullet's IK for the arm
 configuration that puts the moved point at the current waypoint with the tool's start
 orientation (or the waypoint's own), and returns the joint-delta action that heads there (clipped to [−1, 1]). It
-advances to the next waypoint within the waypoint's tolerance — or when it has stopped getting
-closer (no gain of 2 mm over 10 steps: an approach point the arm cannot quite reach should not
-end the episode) — and holds the last one, or goes on from ``repeat_from`` (to rub back and
+advances to the next waypoint within the waypoint's tolerance — or when it has stalled, stopped
+getting closer (by default no gain of more than 2 mm in 10 steps; each waypoint's ``stall_steps``
+and ``stall_progress_m``: an approach point the arm cannot quite reach should not end the
+episode) — and holds the last one, or goes on from ``repeat_from`` (to rub back and
 forth). A waypoint may sit off a surface-drawn target along its outward normal and along its limb,
 and may turn the tool towards that target's surface (``face_normal_within_rad``: the smallest
 rotation of the start orientation that brings the tool's pointing axis — end effector to moved
@@ -16,6 +17,10 @@ vertical, for a wrist that only yaws), and may be approached along a straight li
 the orientation IK aims at turns at most that far each step). A robot's own script may damp
 some arm joints in the IK (``ik_damping``, e.g. a slow shoulder). Works for any task and robot
 whose manifest has a ``scripted`` section.
+
+With ``trace=True`` it keeps a trace of its waypoint events (``run --trace``): each waypoint
+reached or given up as stalled, and where the episode ended, with the goal, the distance left and
+what the robot and its tools touched (see :meth:`ScriptedPolicy.end_episode`).
 """
 
 from __future__ import annotations
@@ -27,11 +32,9 @@ import pybullet as pb
 
 from ..artifact import Script
 from ..ik_options import ik_damping, ik_limits
-from ..references import LinkPoint
+from ..references import LinkPoint, TargetPoint
 from ..rotation import quat_about, quat_conj, quat_mul, quat_rotate, quat_towards, vec_angle
 
-STALL_STEPS = 10  # steps without getting STALL_GAIN_M closer before moving on to the next waypoint
-STALL_GAIN_M = 0.002
 # face_normal_level: a level tool's pointing axis is at least the normal's elevation from the inward
 # normal whatever its yaw, so past 45° it meets the surface side first anyway and is not turned.
 LEVEL_FACING_MAX_ELEVATION_RAD = math.radians(45)
@@ -54,6 +57,10 @@ class _Track:
         self.face_level = [w.face_normal_level for w in waypoints]
         self.steps_m = [w.step_m for w in waypoints]
         self.turn_steps = [w.turn_step_rad for w in waypoints]
+        # The stall rule per waypoint: moved on after stall_steps without stall_progress_m of progress.
+        self.stall = [(w.stall_steps, w.stall_progress_m) for w in waypoints]
+        self.labels = [w.to.target if isinstance(w.to, TargetPoint) else f"{w.to.body}.{w.to.link}" for w in waypoints]
+        self.arm = ""  # "left arm " / "right arm " on a robot acting with both arms (trace lines)
         self.repeat_from = script.repeat_from
         self.ee_link = env.link_index("robot", mount_link)
         self.ee_point = snap.point(LinkPoint(body="robot", link=mount_link))
@@ -69,7 +76,7 @@ class ScriptedPolicy:
     With a ``left`` section (a two-arm robot acting with both arms) the right arm follows the main
     waypoints and the left arm its own, each solved by its own IK call every step."""
 
-    def __init__(self, env):
+    def __init__(self, env, trace: bool = False):
         m = env.manifest
         if m.scripted is None:
             from ..errors import SpecError
@@ -86,8 +93,11 @@ class ScriptedPolicy:
                 _Track(env, m.scripted, links["right_tool_mount"], list(m.joint_groups["robot.right_arm"].joints)),
                 _Track(env, m.scripted.left, links["left_tool_mount"], list(m.joint_groups["robot.left_arm"].joints)),
             ]
+            self.tracks[0].arm, self.tracks[1].arm = "right arm ", "left arm "
         else:
             self.tracks = [_Track(env, m.scripted, links["tool_mount"], list(m.robot.arm_joints))]
+        #: With ``trace``: this episode's waypoint events so far, each a dict (see :meth:`_note`); None without.
+        self.trace: list[dict] | None = [] if trace else None
         robot, c = env.body_id("robot"), env.client
         movable = [
             j
@@ -140,6 +150,9 @@ class ScriptedPolicy:
             track.axis_in_point = np.asarray(quat_rotate(quat_conj(pt_orn), d))
             track.index = 0
             track.best, track.since_best = float("inf"), 0
+            track.noted = set()  # trace events noted for the current (held) waypoint
+        if self.trace is not None:
+            self.trace = []
             track.aimed_orn = None  # the orientation last handed to IK on a slow turn (turn_step_rad)
 
     @staticmethod
@@ -185,15 +198,21 @@ class ScriptedPolicy:
         for track in self.tracks:
             goal, tol = self._goal(track)
             error = float(np.linalg.norm(env.snap.position(track.move) - goal))
-            if error < track.best - STALL_GAIN_M:
+            stall_steps, progress = track.stall[track.index]
+            if error < track.best - progress:
                 track.best, track.since_best = error, 0
             else:
                 track.since_best += 1
             last = track.index == len(track.waypoints) - 1
-            if (not last or track.repeat_from is not None) and (error <= tol or track.since_best >= STALL_STEPS):
+            reached, stalled = error <= tol, track.since_best >= stall_steps
+            moves_on = (not last or track.repeat_from is not None) and (reached or stalled)
+            if self.trace is not None and (moves_on or (reached or stalled)):
+                self._note(track, "reached" if reached else "stalled", goal, moves_on)
+            if moves_on:
                 track.index = track.index + 1 if not last else track.repeat_from
                 track.best, track.since_best = float("inf"), 0
                 track.aimed_orn = None
+                track.noted = set()
                 goal, tol = self._goal(track)
             step = track.steps_m[track.index]
             if step is not None:  # a straight line from where the point is: IK aims at most step_m ahead
@@ -226,9 +245,125 @@ class ScriptedPolicy:
                 action[:2] = self._wheels(sol, rest)
         return action
 
+    def end_episode(self) -> None:
+        """With ``trace``: note where each arm stands when the episode ends (call it after the
+        episode's last step; the event is ``ended``)."""
+        if self.trace is not None:
+            for track in self.tracks:
+                self._note(track, "ended", self._goal(track)[0], False)
+
+    def _note(self, track: _Track, event: str, goal: np.ndarray, moves_on: bool) -> None:
+        """Add a trace event (``reached``, ``stalled`` or ``ended``) of ``track``'s current waypoint
+        with its goal (world, m), once per visit of a waypoint that is held, as a dict: ``step``,
+        ``arm``, ``waypoint`` (its index), ``to``, ``event``, ``goal_m``, ``point_m``, ``distance_m``,
+        ``tolerance_m``, ``contacts`` (what the robot and its tools touch: ``tool–body:link``),
+        ``moved_on`` and ``line`` (the event in words, one line)."""
+        if event != "ended" and not moves_on:  # the held last waypoint: each event once
+            if event in track.noted:
+                return
+            track.noted.add(event)
+        env, k = self.env, track.index
+        point = env.snap.position(track.move)
+        distance = float(np.linalg.norm(point - goal))
+        tol = track.waypoints[k][2]
+        stall_steps, progress = track.stall[k]
+        contacts = self._contacts()
+        touching = ", ".join(contacts) if contacts else "nothing"
+        where = f"waypoint {k} ({track.labels[k]})"
+        if event == "reached":
+            what = f"reached: {_cm(distance)} from its goal, within tolerance_m {_cm(tol)}"
+        elif event == "stalled":
+            why = (
+                f"held back by contact with {touching}"
+                if contacts
+                else "out of reach, nothing touching the robot or its tool"
+            )
+            what = (
+                f"stalled {_off(point, goal)}: {why} (no progress of more than {progress * 1000:g} mm "
+                f"in {stall_steps} steps)"
+            )
+        else:
+            what = f"was still the goal when the episode ended, {_off(point, goal)}"
+        then = ""
+        if moves_on:
+            last = k == len(track.waypoints) - 1
+            then = f"; on to waypoint {k + 1 if not last else track.repeat_from}"
+        elif event != "ended":
+            then = "; the last waypoint: held"
+        touches = f"; touching {touching}" if contacts and event != "stalled" else ""
+        line = (
+            f"step {env.steps}: {track.arm}{where} {what}{then}; goal ({_xyz(goal)}) m, "
+            f"point ({_xyz(point)}) m{touches}"
+        )
+        self.trace.append(
+            {
+                "step": int(env.steps),
+                "arm": track.arm.replace(" arm ", "") or None,
+                "waypoint": k,
+                "to": track.labels[k],
+                "event": event,
+                "goal_m": [float(x) for x in goal],
+                "point_m": [float(x) for x in point],
+                "distance_m": distance,
+                "tolerance_m": tol,
+                "contacts": contacts,
+                "moved_on": moves_on,
+                "line": line,
+            }
+        )
+
+    def _contacts(self) -> list[str]:
+        """What the robot and the tools it holds touch now, each once as ``own–other:link`` (the
+        other body by its spec name, with its link where it has several); particles left out."""
+        env, c = self.env, self.env.client
+        own = {env.body_id("robot")} | {env.body_id(t.body) for t in env.manifest.tools}
+        skip = {p.name for p in env.manifest.particles}
+        names = env.body_names()
+        out: list[str] = []
+        for a in sorted(own):
+            for cp in pb.getContactPoints(bodyA=a, physicsClientId=c):
+                b = cp[2]
+                other = names.get(b, str(b))
+                if b in own or other in skip:
+                    continue
+                if pb.getNumJoints(b, physicsClientId=c) > 0:
+                    link = (
+                        pb.getBodyInfo(b, physicsClientId=c)[0]
+                        if cp[4] < 0
+                        else pb.getJointInfo(b, cp[4], physicsClientId=c)[12]
+                    ).decode()
+                    other = f"{other}:{link}"
+                label = f"{env.link_owner(a, cp[3])}–{other}"
+                if label not in out:
+                    out.append(label)
+        return out
+
     def _wheels(self, sol, rest) -> np.ndarray:
         """Wheel actions (right, left) towards the base's planar change in the IK solution ``sol``
         from the joint positions ``rest``: forward along the heading and the turn, the sideways
         part dropped (the base cannot move sideways; the arm and later steps' IK make it up)."""
         dx, dy, dyaw = (sol[k] - rest[k] for k in self.drive_cols)
         return self.env.drive.wheels_towards(dx, dy, dyaw)
+
+
+def _cm(metres: float) -> str:
+    return f"{metres * 100:.1f} cm"
+
+
+def _xyz(v) -> str:
+    return ", ".join(f"{x:+.3f}" for x in v)
+
+
+def _off(point: np.ndarray, goal: np.ndarray) -> str:
+    """Where ``point`` is from ``goal`` in words: ``10.0 cm below its goal`` when one world axis
+    holds most of the gap, else ``10.0 cm from its goal`` with the gap per axis."""
+    d = point - goal
+    distance = float(np.linalg.norm(d))
+    if distance < 1e-9:
+        return "at its goal"
+    axis = int(np.argmax(np.abs(d)))
+    if abs(d[axis]) >= 0.8 * distance:
+        sign = "+" if d[axis] > 0 else "-"
+        side = ("above" if sign == "+" else "below") if axis == 2 else f"off towards {sign}{'xy'[axis]} of"
+        return f"{_cm(distance)} {side} its goal"
+    return f"{_cm(distance)} from its goal (point − goal: {_xyz(d)} m)"

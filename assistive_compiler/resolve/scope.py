@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..errors import SpecError
+from ..errors import SpecError, did_you_mean, one_of
 from ..library import Library, LoadedPart
 from ..references import JointGroup, LinkPoint, NodeSet, Point, TargetPoint
 from ..spec.load import LoadedSpec
@@ -277,4 +277,6 @@ def unknown_person_link(link: str, links) -> str:
                 f"unknown link '{link}' of person; the {part.replace('_', ' ')} is link {' or '.join(repr(n) for n in names)} "
                 f"(limb links are named after the joint at their top){on_it}{where}"
             )
-    return f"unknown link '{link}' of person; {expected(links, link)}{where}"
+    # The closest name among the links and the landmarks: both are written person.<name>.
+    guess = did_you_mean(link, [*links, *LANDMARKS])
+    return f"unknown link '{link}' of person; expected one of {one_of(links)}{guess}{where}"

@@ -146,6 +146,8 @@ def _script(s: Scope, script, base: tuple) -> Script | None:
                 step_m=(step_m or w.step_m) if w.step_m is not None else None,
                 face_normal_level=w.face_normal_level,
                 turn_step_rad=math.radians(w.turn_step_deg) if w.turn_step_deg is not None else None,
+                stall_steps=w.stall_steps,
+                stall_progress_m=w.stall_progress_m,
             )
         )
     move, where = (

@@ -105,7 +105,7 @@ def test_run_json_stays_pure_json_with_progress_on_stderr(tmp_path, capsys):
             "--episodes",
             "1",
             "--json",
-            "--out",
+            "--out-dir",
             str(tmp_path / "art"),
         ]
     )
@@ -159,3 +159,25 @@ def test_every_command_group_registers_its_commands():
         "describe",
     }
     assert all(callable(m.add_commands) for m in COMMAND_MODULES)
+
+
+def test_the_artifact_directory_is_out_dir_in_every_command_and_run_s_old_out_still_works(capsys):
+    """Issue 48, defect 7: --out is what a command writes (render's picture, compile's artifact);
+    the artifact directory a command compiles into on the way is --out-dir everywhere, and the
+    older spelling --out of run, view and compare still works, with a note."""
+    from assistive_compiler.cli import build_parser
+
+    parser = build_parser()
+    needs = {"render": ["--out", "x.png"], "compare": ["--robots", "jaco"]}
+    for command in ("run", "view", "compare", "render", "describe"):
+        args = parser.parse_args([command, "t.yaml", "--out-dir", "build/t", *needs.get(command, [])])
+        assert (args.out_dir if command in ("render", "describe") else args.out) == "build/t", command
+    assert parser.parse_args(["compile", "t.yaml", "--out-dir", "build/t"]).out == "build/t"
+    assert parser.parse_args(["compile", "t.yaml", "--out", "build/t"]).out == "build/t"
+    assert capsys.readouterr().err == ""
+    for command in ("run", "view", "compare"):
+        assert parser.parse_args([command, "t.yaml", "--out", "build/t", *needs.get(command, [])]).out == "build/t"
+        assert capsys.readouterr().err == (
+            f"assistive-compiler {command}: --out here is the older spelling of --out-dir (the artifact directory, "
+            "as in render, where --out is the picture); it still works\n"
+        )

@@ -150,7 +150,7 @@ def test_camera_option_is_parsed_and_misuse_is_explained(feeding, tmp_path):
 def _returns(command: str, spec: Path, robot: str, out: Path, tmp_path: Path) -> float:
     if command == "run":
         status, text, err = cli(
-            "run", str(spec), "--robot", robot, "--episodes", "1", "--json", "--quiet", "--out", str(out)
+            "run", str(spec), "--robot", robot, "--episodes", "1", "--json", "--quiet", "--out-dir", str(out)
         )
         assert status == 0, err
         return json.loads(text)["episodes"][0]["return"]

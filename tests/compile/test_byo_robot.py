@@ -123,3 +123,54 @@ def test_robot_control_defaults_apply_unless_the_task_sets_them(tmp_path):
     loose.write_text(text)  # Feeding without its control line: the robot's defaults apply
     robot = compile_task(loose, "kuka_iiwa", tmp_path / "b", library=library).manifest.robot
     assert (robot.position_gain, robot.max_force) == (0.04, 7.5)
+
+
+def test_a_search_failed_by_a_required_goal_names_it_and_the_remedy_says_required(tmp_path):
+    """Issue 48, defect 2: the goal marked required: true that discarded the samples is named, where
+    it is written, and the remedy offers dropping required."""
+    library = Library([DATA / "specs", specs_dir()])
+    bad = task(
+        tmp_path,
+        "  base_search:\n    attempts: 6\n    goals:\n"
+        "      - {point: mouth, oriented: true}\n"
+        "      - {point: mouth, offset_m: [0.0, 0.0, 2.0], required: true}\n",
+    )
+    with pytest.raises(SpecError) as info:
+        compile_task(bad, "kuka_iiwa", tmp_path / "out", library=library)
+    [problem] = info.value.problems
+    assert re.fullmatch(
+        r"robot 'kuka_iiwa' reaches target 'mouth' \(required: true at robot\.base_search\.goals\[1\]\) from none "
+        r"of 6 sampled base poses: \d left it out of reach \(the closest the end effector came was \d\.\d\d m away\); "
+        r"(\d missed the start pose; )?"
+        r"set robot\.per_robot\.kuka_iiwa\.base_offset_m or widen robot\.base_search \(x_range_m, y_range_m, "
+        r"yaw_noise_deg\), or drop required: true from robot\.base_search\.goals\[1\] \(a base pose that misses a "
+        r"required goal is discarded; a goal not required only ranks the poses\)",
+        problem.message,
+    ), problem.message
+
+
+def test_samples_lost_to_another_required_goal_are_counted_under_its_name(tmp_path):
+    """Some samples leave the start pose out of reach, the others miss a required goal: the latter
+    are no longer 'missed another goal' but counted under that goal."""
+    library = Library([DATA / "specs", specs_dir()])
+    bad = task(
+        tmp_path,
+        "  base_search:\n    attempts: 8\n    x_range_m: [-1.5, 0.0]\n    goals:\n"
+        "      - {point: mouth, offset_m: [0.0, 0.0, 2.0], required: true}\n",
+    )
+    with pytest.raises(SpecError) as info:
+        compile_task(bad, "kuka_iiwa", tmp_path / "out", library=library)
+    message = info.value.problems[0].message
+    assert "missed another goal" not in message
+    assert (
+        "robot.base_search.goals[0]" in message and "or drop required: true from robot.base_search.goals[0]" in message
+    )
+    start = re.search(
+        r"reaches the start pose from none of 8 sampled base poses: (\d+) left it out of reach.*; "
+        r"(\d+) missed target 'mouth' \(required: true at robot\.base_search\.goals\[0\]\);",
+        message,
+    )
+    goal = re.search(
+        r"reaches target 'mouth' \(required: true at robot\.base_search\.goals\[0\]\) from none of 8", message
+    )
+    assert start or goal, message

@@ -258,7 +258,7 @@ def test_cli_run_coop(artifact, capsys):
         "3",
         "--json",
         "--quiet",
-        "--out",
+        "--out-dir",
         str(artifact),
     ]
     assert main(base) == 0
@@ -318,7 +318,7 @@ def test_cli_coop_refuses_a_person_with_nothing_to_control(tmp_path, capsys):
     text = f"extends: {TASKS / 'feeding.yaml'}\nperson:\n  control:\n    policy_joints: []\n"
     path = tmp_path / "static.yaml"
     path.write_text(text)
-    assert main(["run", str(path), "--robot", "jaco", "--coop", "--out", str(tmp_path / "out")]) == 2
+    assert main(["run", str(path), "--robot", "jaco", "--coop", "--out-dir", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     assert "Traceback" not in err
     assert err.strip().startswith(

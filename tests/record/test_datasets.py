@@ -76,7 +76,7 @@ def test_dataset_matches_run_json(dataset, artifact):
             "5",
             "--seed",
             "0",
-            "--out",
+            "--out-dir",
             str(artifact),
             "--json",
             "--quiet",

@@ -168,7 +168,7 @@ def test_run_record_writes_the_episodes_it_reports(artifact, tmp_path):
             "2",
             "--seed",
             "3",
-            "--out",
+            "--out-dir",
             str(artifact),
             "--record",
             str(tmp_path / "rec"),

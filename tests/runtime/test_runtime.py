@@ -506,7 +506,7 @@ def test_cli_run_json(artifact, capsys):
             "2",
             "--quiet",
             "--json",
-            "--out",
+            "--out-dir",
             str(artifact),
         ]
     )

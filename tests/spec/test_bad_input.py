@@ -126,7 +126,7 @@ def test_a_urdf_that_is_not_urdf_is_located_at_the_urdf_key(tmp_path, content, m
 def test_run_scripted_without_a_scripted_section_says_so(tmp_path):
     spec = tmp_path / "task.yaml"
     spec.write_text("extends: shipped:tasks/feeding.yaml\nscripted: {$replace: null}\n")
-    status, _, err = cli("run", str(spec), "--episodes", "1", "--out", str(tmp_path / "out"), cwd=tmp_path)
+    status, _, err = cli("run", str(spec), "--episodes", "1", "--out-dir", str(tmp_path / "out"), cwd=tmp_path)
     assert status == 2 and "Traceback" not in err
     assert (
         "task.yaml:1:1: task 'feeding' has no scripted: section, so there is no scripted policy for it; "

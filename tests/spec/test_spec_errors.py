@@ -453,6 +453,22 @@ def test_unknown_person_link(tmp_path, capsys):
     )
 
 
+@pytest.mark.parametrize(("typo", "meant"), [("rigth_palm", "right_palm"), ("nsoe", "nose")])
+def test_a_misspelled_landmark_suggests_the_landmark(tmp_path, capsys, typo, meant):
+    """Landmarks are person points too: the best of the links and the landmarks wins (issue 48:
+    person.rigth_palm once suggested right_ankle, person.nsoe nothing)."""
+    text = EXTENDS + f"targets:\n  mouth:\n    link: person.{typo}\n"
+    path = write(tmp_path, text)
+    check(
+        capsys,
+        path,
+        f"{at(text, f'person.{typo}')}: unknown link '{typo}' of person; expected one of 'chest', 'head', 'head_x_link', "
+        "'head_y_link', 'left_ankle', 'left_ankle_x_link', 'left_ankle_y_link', 'left_elbow', 'left_elbow_link', "
+        f"'left_hip', 'left_hip_x_link', 'left_hip_y_link', ... (43 in all) (did you mean '{meant}'?); "
+        f"all 43 links of the person and their frames: docs/person.md{LANDMARKS_TAIL}",
+    )
+
+
 def test_a_body_part_by_its_everyday_name_names_the_link_that_is_it(tmp_path, capsys):
     """There is no right_hand link: the hand is right_wrist (limbs are named after their top joint),
     not the spelling-nearest 'right_ankle'."""

@@ -118,20 +118,43 @@ def search_base(rt: ResolvedTask, arms: list, goals, offset, rng, carry: Carried
             if own is not None and own.base_search is not None
             else ("robot", "base_search")
         )
+        # The task's own goals follow the start poses, in the order of base_search.goals.
+        starts = sum(1 for g in goals if g[5])
+
+        def path(k: int) -> str:  # where the spec writes one of its own goals
+            return f"{'.'.join(in_force)}.goals[{k - starts}]"
+
+        def marked(k: int) -> str:  # a goal the spec marks required
+            return f"{goals[k][3]} (required: true at {path(k)})"
+
+        others = [  # the samples that reached the worst goal but missed another (each is required)
+            (int(required_misses[k]), goals[k][3] if goals[k][5] else marked(k))
+            for k in range(len(goals))
+            if k != worst and required_misses[k]
+        ]
+        culprits = [path(k) for k in range(len(goals)) if not goals[k][5] and required_misses[k]]
+        drop = (
+            f", or drop required: true from {' and '.join(culprits)} (a base pose that misses a required goal is "
+            "discarded; a goal not required only ranks the poses)"
+            if culprits
+            else ""
+        )
+        what = marked(worst) if not goals[worst][5] else goals[worst][3]
         raise fail(
             rt,
             in_force,
-            f"robot '{rt.robot_name}' reaches {goals[worst][3]} from none of {search.attempts} sampled base poses: "
-            f"{_why(blocked, misses[worst], search.attempts)}; set robot.per_robot.{rt.robot_name}.base_offset_m "
-            f"or widen {'.'.join(in_force)} (x_range_m, y_range_m, yaw_noise_deg)",
+            f"robot '{rt.robot_name}' reaches {what} from none of {search.attempts} sampled base poses: "
+            f"{_why(blocked, misses[worst], search.attempts, others)}; set robot.per_robot.{rt.robot_name}.base_offset_m "
+            f"or widen {'.'.join(in_force)} (x_range_m, y_range_m, yaw_noise_deg){drop}",
         )
     found.sort(key=lambda f: (-f[1], -f[2]))
     return found[: search.keep]
 
 
-def _why(blocked: Counter, misses: list, attempts: int) -> str:
+def _why(blocked: Counter, misses: list, attempts: int, others: list[tuple[int, str]] = ()) -> str:
     """What stopped the samples: bases against a body, then the goal's IK misses by reason (out of
-    reach with the closest approach, a wrong orientation, or reached in collision)."""
+    reach with the closest approach, a wrong orientation, or reached in collision), then ``others``
+    (how many samples reached it but missed another required goal, and that goal in words)."""
     parts = []
     if blocked:
         parts.append(f"{sum(blocked.values())} put the robot (arm at rest) against {_names(blocked)}")
@@ -150,9 +173,10 @@ def _why(blocked: Counter, misses: list, attempts: int) -> str:
         parts.append(
             f"{kinds['collision']} reached it only in collision with {_names(Counter(m.body for m in misses if m is not None and m.kind == 'collision'))}"
         )
-    others = attempts - sum(blocked.values()) - len(misses)
-    if others > 0:
-        parts.append(f"{others} missed another goal")
+    parts.extend(f"{n} missed {goal}" for n, goal in others)
+    rest = attempts - sum(blocked.values()) - len(misses) - sum(n for n, _ in others)
+    if rest > 0:
+        parts.append(f"{rest} missed another goal")
     return "; ".join(parts) or "no sample was tried"
 
 

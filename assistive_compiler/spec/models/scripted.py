@@ -14,13 +14,41 @@ from pydantic import Discriminator, Field, Tag, model_validator
 
 from .common import Name, Ref, Strict, Vec3
 
+#: The scripted controller's stall rule by default: a waypoint it has not got ``STALL_PROGRESS_M``
+#: closer to in ``STALL_STEPS`` steps is given up (the next one starts).
+STALL_STEPS = 10
+STALL_PROGRESS_M = 0.002
+
 
 class Waypoint(Strict):
     """A goal for the scripted controller: a point near a target, reached within a tolerance."""
 
     to: Ref = Field(description="Target or link the goal is relative to, e.g. mouth.")
     offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Goal offset from that point, world frame, metres.")
-    tolerance_m: float = Field(0.02, ge=0, le=1, description="Distance at which the next waypoint starts, metres.")
+    tolerance_m: float = Field(
+        0.02,
+        ge=0,
+        le=1,
+        description="Distance at which the waypoint counts as reached and the next one starts, metres (0: never "
+        "reached). The controller also moves on when it stalls: when the moved point has not got more than "
+        f"stall_progress_m (default {STALL_PROGRESS_M * 1000:g} mm) closer to the goal in stall_steps (default "
+        f"{STALL_STEPS}) steps, e.g. a goal out of the arm's reach or behind a contact. The last waypoint is held "
+        "(unless repeat_from is given) however it stalls. run --trace prints each reached or stalled waypoint.",
+    )
+    stall_steps: int = Field(
+        STALL_STEPS,
+        ge=1,
+        le=100000,
+        description="Steps without progress (see stall_progress_m) after which the controller gives this waypoint "
+        "up and moves on to the next, e.g. more for a slow approach that must not be cut short.",
+    )
+    stall_progress_m: float = Field(
+        STALL_PROGRESS_M,
+        ge=0,
+        le=1,
+        description="Progress, metres: getting closer to the goal than the closest distance so far by more than this "
+        "restarts the stall_steps count.",
+    )
     normal_offset_m: float = Field(
         0.0,
         ge=-0.5,
