@@ -683,7 +683,7 @@ class Manifest(_Model):
     def label(self) -> str:
         """A name for logs and plot titles: the shipped task's id (``assistive_compiler/FeedingJaco-v1``),
         or ``<task> for <robot>`` for any other spec (whose id, ``assistive_compiler/Task-v1``, is shared)."""
-        from .registration import TASK_ID
+        from .gym_ids import TASK_ID
 
         return self.gym_id if self.gym_id != TASK_ID else f"{self.task} for {self.robot_name}"
 

@@ -50,7 +50,7 @@ def cmd_compile(args: argparse.Namespace) -> int:
         if failures:
             print("\n".join(failures), file=sys.stderr)
             return EXIT_FAILED
-    from ..registration import TASK_ID
+    from ..gym_ids import TASK_ID
 
     state = "up to date (cache hit)" if result.cache_hit else "compiled"
     print(
@@ -107,8 +107,8 @@ def cmd_schema(args: argparse.Namespace) -> int:
 
 
 def cmd_list(args: argparse.Namespace) -> int:
+    from ..gym_ids import shipped_tasks
     from ..paths import display
-    from ..registration import shipped_tasks
 
     tasks = shipped_tasks()
     if args.json:

@@ -54,7 +54,7 @@ IMPAIRMENT: TypeAdapter[Impairment] = TypeAdapter(Impairment)
 def gym_id(rt: ResolvedTask) -> str:
     """The Gymnasium id that makes this env: a shipped task's own (``assistive_compiler/FeedingJaco-v1``),
     else the id every other spec is made with, ``assistive_compiler/Task-v1`` (with ``spec=`` and ``robot=``)."""
-    from ..registration import TASK_ID, shipped_gym_id
+    from ..gym_ids import TASK_ID, shipped_gym_id
 
     return shipped_gym_id(rt.loaded.path, rt.spec.name, rt.robot_name) or TASK_ID
 
