@@ -65,7 +65,7 @@ def cmd_compile(args: argparse.Namespace) -> int:
 def task_schema() -> dict:
     """JSON Schema of a task spec, with the registered term and preference names as enums."""
     from ..spec.models import PREFERENCE_NAMES, TaskSpec
-    from ..terms.registry import terms
+    from ..terms.catalog import terms
 
     schema = TaskSpec.model_json_schema()
     defs = schema.get("$defs", {})
@@ -87,7 +87,7 @@ def cmd_schema(args: argparse.Namespace) -> int:
         print(json.dumps(training_schema(), indent=2, sort_keys=True))
         return EXIT_OK
     if args.terms:
-        from ..terms.registry import terms
+        from ..terms.catalog import terms
         from .output import print_table
 
         for category in ("observation", "reward", "preference"):

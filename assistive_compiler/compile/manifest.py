@@ -43,7 +43,8 @@ from ..resolve import ResolvedTask
 from ..resolve.bodies import surface_region
 from ..resolve.resolved import ResolvedMarkerSet, SurfaceTarget
 from ..spec.models import scalar_bounds
-from ..terms.registry import SizeContext, spec_form, terms
+from ..terms.catalog import terms
+from ..terms.registry import SizeContext, spec_form
 from ..urdf import urdf_info
 from .task import impairment_joints, policy_joints, present_furniture, rounded
 from .weld import gripper
