@@ -39,9 +39,10 @@ from ..artifact import (
 )
 from ..rotation import capsule_axes
 from .binding import BoundTerm
+from .bodies import PARK
 from .component import Episode, EpisodeComponent
 from .snapshot import Snapshot
-from .world import PARK, World
+from .world import World
 
 
 class EventTarget(Protocol):
