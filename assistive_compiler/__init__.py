@@ -7,7 +7,7 @@ tasks' Gymnasium ids and exposes :func:`make`. Heavy modules load when first use
 
 from __future__ import annotations
 
-__version__ = "0.1.0"
+from .version import __version__
 
 __all__ = ["__version__", "make", "compile_task", "load_spec", "parallel_env", "coop"]
 

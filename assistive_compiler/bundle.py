@@ -18,8 +18,8 @@ import tempfile
 from functools import cache
 from pathlib import Path
 
-from . import __version__
 from .errors import UsageError
+from .version import __version__
 
 PACKAGE_DIR = Path(__file__).resolve().parent
 FORMAT = 1

@@ -13,7 +13,7 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from assistive_compiler.compile.compiler import compile_task
-from assistive_compiler.registration import shipped_tasks
+from assistive_compiler.gym_ids import shipped_tasks
 from assistive_compiler.runtime.env import AssistiveEnv
 
 

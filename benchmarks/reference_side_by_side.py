@@ -32,7 +32,7 @@ import sys
 from pathlib import Path
 
 from assistive_compiler.cli.bench import reference_on_fork
-from assistive_compiler.registration import shipped_tasks
+from assistive_compiler.gym_ids import shipped_tasks
 
 RIGID_TASKS = ("feeding", "scratch_itch", "drinking", "bed_bathing", "arm_manipulation")
 """The reference's tasks that run on stock pybullet (its Dressing needs its fork)."""

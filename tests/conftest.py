@@ -145,7 +145,7 @@ def shared_cache(tmp_path_factory, monkeypatch) -> Callable[[str], FileLock]:
 def _shipped_envs() -> dict[str, tuple[Path, str]]:
     """(task spec, robot) of every shipped env, by Gymnasium id and by co-optimisation name."""
     from assistive_compiler.coop import coop_name
-    from assistive_compiler.registration import shipped_ids
+    from assistive_compiler.gym_ids import shipped_ids
 
     ids = shipped_ids()
     return ids | {coop_name(env_id): where for env_id, where in ids.items()}

@@ -96,7 +96,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--write", action="store_true", help=f"write {STORE.name} (else compare with it)")
     parser.add_argument("ids", nargs="*", help="only these ids (default all shipped)")
     args = parser.parse_args(argv)
-    from assistive_compiler.registration import shipped_ids
+    from assistive_compiler.gym_ids import shipped_ids
 
     ids = args.ids or sorted(shipped_ids())
     stored = json.loads(STORE.read_text()) if STORE.is_file() else {}

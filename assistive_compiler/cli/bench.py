@@ -283,6 +283,53 @@ def measure_steps_paired(
     return out
 
 
+BENCH_NOTES = (
+    "vs_reference: our env steps/s on the reference harness's episodes over the reference's on them, "
+    "its stored figure carried over to this machine's speed now by the machine probe (or a --reference-json "
+    "figure measured beside ours as it is); at the reference's solver: that ratio times the reference-settings "
+    "variant's speed over the shipped spec's on the paired episodes; "
+    "env/raw: the same episodes, physics timed inside env.step (stepSimulation + gravity compensation) vs the whole step; "
+    "reference_solver: the same episodes and actions on an artifact compiled with the reference's sim.solver, repeats "
+    "interleaved with the shipped ones (when reference_solver_is_shipped, the same figure as env_steps_per_s); random actions; "
+    "medians over repeats; physics_stages: each stage's share of stepSimulation by Bullet's profiler over one more "
+    "episode of the first repeat's seed (the profiler's cost inflates every stage alike: read the shares); "
+    "both agents acting: bench --coop; peak_rss_mb_one_env: the high-water mark (VmHWM) of a fresh process that "
+    "imports the package, builds one env and steps it 200 times (none where /proc/self/status is absent)"
+)
+"""How to read :func:`bench`'s figures (its ``notes``)."""
+
+
+def reference_rate(
+    env_name: str,
+    task: str,
+    robot: str,
+    probe_now: float,
+    reference_json: dict[str, float] | None,
+    reference_file: str | None,
+) -> tuple[float | None, float | None, float | None, str | None]:
+    """The reference's env steps/s to compare with, and where it comes from: (the stored figure,
+    this machine's speed over the reference session's, the figure now, its source). From a
+    ``--reference-json`` file measured beside ours (taken as it is), else the stored figure
+    carried over to this machine's speed now (:func:`reference_now`); Nones where there is none."""
+    if reference_json is not None:
+        reference = reference_json.get(env_name)
+        source = f"{reference_file}: measured beside ours with the reference harness" if reference is not None else None
+        return None, None, reference, source
+    carried = reference_now(task, robot, probe_now)
+    return carried if carried is not None else (None, None, None, None)
+
+
+def rate_at_reference_solver(
+    rates: dict[str, tuple[list[float], list[float], list[float]]], env_med: float, reference_has_task: bool
+) -> float | None:
+    """Env steps/s at the reference's solver settings: the median measured on the variant's artifact
+    (``rates["reference_solver"]``), or ``env_med`` (the shipped spec's) when the spec already uses
+    them; None when the reference has no such task."""
+    if "reference_solver" in rates:
+        return statistics.median(rates["reference_solver"][0])
+    return env_med if reference_has_task else None
+
+
 def bench(
     spec: str,
     robot: str | None,
@@ -330,16 +377,9 @@ def bench(
         m = env.manifest
         env_name = m.gym_id.rpartition("/")[2].removesuffix("-v1")
         probe_now = probe_steps_per_s()
-        stored = reference = speed = None
-        reference_figure = None
-        if reference_json is not None:
-            reference = reference_json.get(env_name)
-            if reference is not None:
-                reference_figure = f"{reference_file}: measured beside ours with the reference harness"
-        else:
-            carried = reference_now(m.task, m.robot_name, probe_now)
-            if carried is not None:
-                stored, speed, reference, reference_figure = carried
+        stored, speed, reference, reference_figure = reference_rate(
+            env_name, m.task, m.robot_name, probe_now, reference_json, reference_file
+        )
         # Only where there is a reference figure to divide by (Dressing's 400 steps alone take 10 s).
         harness_rate = measure_harness_protocol(env) if reference is not None else None
         env.close()
@@ -348,13 +388,7 @@ def bench(
     raw_med = statistics.median(raw_rates)
     reset_med, reset_p95 = _median_p95(reset_ms)
     ref_solver = reference_solver(m.task)
-    # At the reference's solver settings: measured on the variant's artifact, or the same figure when
-    # the spec already uses them (None: the reference has no such task).
-    at_ref = (
-        statistics.median(rates["reference_solver"][0])
-        if "reference_solver" in rates
-        else (env_med if ref_solver is not None else None)
-    )
+    at_ref = rate_at_reference_solver(rates, env_med, ref_solver is not None)
     return {
         "task": m.task,
         "robot": m.robot_name,
@@ -392,17 +426,7 @@ def bench(
         "peak_rss_mb_one_env": round(proc["peak_rss_mb"], 1) if proc["peak_rss_mb"] is not None else None,
         "steps_per_repeat": steps,
         "repeats": repeats,
-        "notes": "vs_reference: our env steps/s on the reference harness's episodes over the reference's on them, "
-        "its stored figure carried over to this machine's speed now by the machine probe (or a --reference-json "
-        "figure measured beside ours as it is); at the reference's solver: that ratio times the reference-settings "
-        "variant's speed over the shipped spec's on the paired episodes; "
-        "env/raw: the same episodes, physics timed inside env.step (stepSimulation + gravity compensation) vs the whole step; "
-        "reference_solver: the same episodes and actions on an artifact compiled with the reference's sim.solver, repeats "
-        "interleaved with the shipped ones (when reference_solver_is_shipped, the same figure as env_steps_per_s); random actions; "
-        "medians over repeats; physics_stages: each stage's share of stepSimulation by Bullet's profiler over one more "
-        "episode of the first repeat's seed (the profiler's cost inflates every stage alike: read the shares); "
-        "both agents acting: bench --coop; peak_rss_mb_one_env: the high-water mark (VmHWM) of a fresh process that "
-        "imports the package, builds one env and steps it 200 times (none where /proc/self/status is absent)",
+        "notes": BENCH_NOTES,
     }
 
 

@@ -72,7 +72,8 @@ def render_people(artifact_dir: Path, width: int = 360, height: int = 480) -> np
     import pybullet as pb
     from PIL import Image, ImageDraw
 
-    from ..runtime.world import PARK, World
+    from ..runtime.bodies import PARK
+    from ..runtime.world import World
 
     world = World(artifact_dir)
     m, c = world.m, world.client

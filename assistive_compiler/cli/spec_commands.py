@@ -50,7 +50,7 @@ def cmd_compile(args: argparse.Namespace) -> int:
         if failures:
             print("\n".join(failures), file=sys.stderr)
             return EXIT_FAILED
-    from ..registration import TASK_ID
+    from ..gym_ids import TASK_ID
 
     state = "up to date (cache hit)" if result.cache_hit else "compiled"
     print(
@@ -65,7 +65,7 @@ def cmd_compile(args: argparse.Namespace) -> int:
 def task_schema() -> dict:
     """JSON Schema of a task spec, with the registered term and preference names as enums."""
     from ..spec.models import PREFERENCE_NAMES, TaskSpec
-    from ..terms.registry import terms
+    from ..terms.catalog import terms
 
     schema = TaskSpec.model_json_schema()
     defs = schema.get("$defs", {})
@@ -87,7 +87,7 @@ def cmd_schema(args: argparse.Namespace) -> int:
         print(json.dumps(training_schema(), indent=2, sort_keys=True))
         return EXIT_OK
     if args.terms:
-        from ..terms.registry import terms
+        from ..terms.catalog import terms
         from .output import print_table
 
         for category in ("observation", "reward", "preference"):
@@ -107,8 +107,8 @@ def cmd_schema(args: argparse.Namespace) -> int:
 
 
 def cmd_list(args: argparse.Namespace) -> int:
+    from ..gym_ids import shipped_tasks
     from ..paths import display
-    from ..registration import shipped_tasks
 
     tasks = shipped_tasks()
     if args.json:

@@ -20,12 +20,12 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
-from .. import __version__
 from ..artifact import Manifest
 from ..library import Library
 from ..paths import templates_dir
 from ..resolve import ResolvedTask, resolve
 from ..spec.load import LoadedSpec, load_spec
+from ..version import __version__
 from .emit import emit_people, emit_props
 from .person import finish_person, merge_people
 from .placement import precompute

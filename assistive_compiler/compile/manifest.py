@@ -43,7 +43,8 @@ from ..resolve import ResolvedTask
 from ..resolve.bodies import surface_region
 from ..resolve.resolved import ResolvedMarkerSet, SurfaceTarget
 from ..spec.models import scalar_bounds
-from ..terms.registry import SizeContext, spec_form, terms
+from ..terms.catalog import terms
+from ..terms.registry import SizeContext, spec_form
 from ..urdf import urdf_info
 from .task import impairment_joints, policy_joints, present_furniture, rounded
 from .weld import gripper
@@ -54,7 +55,7 @@ IMPAIRMENT: TypeAdapter[Impairment] = TypeAdapter(Impairment)
 def gym_id(rt: ResolvedTask) -> str:
     """The Gymnasium id that makes this env: a shipped task's own (``assistive_compiler/FeedingJaco-v1``),
     else the id every other spec is made with, ``assistive_compiler/Task-v1`` (with ``spec=`` and ``robot=``)."""
-    from ..registration import TASK_ID, shipped_gym_id
+    from ..gym_ids import TASK_ID, shipped_gym_id
 
     return shipped_gym_id(rt.loaded.path, rt.spec.name, rt.robot_name) or TASK_ID
 

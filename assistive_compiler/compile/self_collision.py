@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
-from ..person.body import SELF_COLLISION_GROUPS
+from ..person.skeleton import SELF_COLLISION_GROUPS
 
 
 def person_self_collision(urdf_xml: str, keep: set[str]) -> tuple[set[str], list[tuple[str, str]]]:

@@ -118,7 +118,7 @@ def referenced_person_links(rt: ResolvedTask) -> set[str]:
 
 def seat_links() -> list[str]:
     """Links that rest on a seat: the pelvis and thighs (waist and hip joint children)."""
-    from ..person.body import JOINT_GROUPS, JOINT_NAMES, LINK_NAMES
+    from ..person.skeleton import JOINT_GROUPS, JOINT_NAMES, LINK_NAMES
 
     child = dict(zip(JOINT_NAMES, LINK_NAMES))
     joints = list(JOINT_GROUPS["waist"]) + [j for j in JOINT_NAMES if "_hip_" in j]

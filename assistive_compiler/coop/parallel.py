@@ -66,7 +66,7 @@ class AssistiveParallelEnv(ParallelEnv):
         #: The single-agent env underneath (the same world; its ``step`` is the static person's task).
         self.env = env
         m = env.manifest
-        from ..registration import TASK_ID
+        from ..gym_ids import TASK_ID
 
         self.metadata = {
             **type(self).metadata,

@@ -12,7 +12,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import did_you_mean
-from ..registration import NAMESPACE, cached_artifact_dir, shipped_ids
+from ..gym_ids import NAMESPACE, shipped_ids
+from ..registration import cached_artifact_dir
 from .parallel import AssistiveParallelEnv, coop_name, parallel_env
 
 __all__ = ["ids", "make", "spec_of"]

@@ -52,6 +52,58 @@ def _direction(xyz) -> str:
     return ", ".join(parts) or "at the origin"
 
 
+def _landmark_lines(urdfs: dict[str, str], shown: str) -> list[str]:
+    """The page's Landmarks section: each landmark's link, what it is and its offset (cm) per variant."""
+    marks = {v: landmark_offsets(urdfs[v]) for v in PAGE_VARIANTS}
+    lines = [
+        "",
+        "## Landmarks",
+        "",
+        "Named points placed from each variant's own shapes (`assistive_compiler/person/landmarks.py`),",
+        "used as `person.<landmark>` wherever a point is (a waypoint's `to`, a term's point), or as a",
+        "target's `link` (its `offset_m` then starts at the landmark). The joints are points already:",
+        "`person.right_elbow` is the elbow joint (the forearm's frame origin), `person.right_knee` the knee,",
+        "`person.right_shoulder` the shoulder, `person.right_wrist` the wrist.",
+        "",
+        f"| landmark | link | where | offset in the link frame (cm), {shown} |",
+        "|---|---|---|---|",
+    ]
+    for name, lm in LANDMARKS.items():
+        where = " / ".join(_xyz_cm(marks[v][name][1]) for v in PAGE_VARIANTS)
+        lines.append(f"| `person.{name}` | `{lm.link}` | {lm.description} | {where} |")
+    return lines
+
+
+def _joint_lines(joints: list[ET.Element]) -> list[str]:
+    """The page's Joints section: each joint's type, axis, parent and child links and limits (°)."""
+    lines = [
+        "",
+        "## Joints",
+        "",
+        "Limits are the model's (degrees; a fixed joint is held at its angle). The policy, impairments",
+        "and `joints_deg` move only the revolute ones.",
+        "",
+        "| joint | type | axis | parent → child | limits (°) |",
+        "|---|---|---|---|---|",
+    ]
+    for j in joints:
+        limit = j.find("limit")
+        axis_el = j.find("axis")
+        axis = _axis_name(vec3(axis_el.get("xyz"))) if axis_el is not None else "—"
+        if limit is not None and j.get("type") == "revolute":
+            limits = f"[{math.degrees(float(limit.get('lower'))):.0f}, {math.degrees(float(limit.get('upper'))):.0f}]"
+        elif j.get("type") == "fixed":
+            rpy = vec3(j.find("origin").get("rpy"))
+            limits = f"fixed at {math.degrees(max(rpy, key=abs)):.0f}" if any(rpy) else "fixed"
+        else:
+            limits = "—"
+        lines.append(
+            f"| `{j.get('name')}` | {j.get('type')} | {axis} | `{j.find('parent').get('link')}` → "
+            f"`{j.find('child').get('link')}` | {limits} |"
+        )
+    return lines
+
+
 def person_reference_markdown() -> str:
     """The page, as Markdown."""
     from ..library import Library
@@ -120,46 +172,5 @@ def person_reference_markdown() -> str:
             )
             nexts.append(f"`{child.get('name')}`: {where}")
         lines.append(f"| `{name}` | {moved_by} | {shape_text or 'none'} | {'<br>'.join(nexts) or '—'} |")
-    marks = {v: landmark_offsets(urdfs[v]) for v in PAGE_VARIANTS}
-    lines += [
-        "",
-        "## Landmarks",
-        "",
-        "Named points placed from each variant's own shapes (`assistive_compiler/person/landmarks.py`),",
-        "used as `person.<landmark>` wherever a point is (a waypoint's `to`, a term's point), or as a",
-        "target's `link` (its `offset_m` then starts at the landmark). The joints are points already:",
-        "`person.right_elbow` is the elbow joint (the forearm's frame origin), `person.right_knee` the knee,",
-        "`person.right_shoulder` the shoulder, `person.right_wrist` the wrist.",
-        "",
-        f"| landmark | link | where | offset in the link frame (cm), {shown} |",
-        "|---|---|---|---|",
-    ]
-    for name, lm in LANDMARKS.items():
-        where = " / ".join(_xyz_cm(marks[v][name][1]) for v in PAGE_VARIANTS)
-        lines.append(f"| `person.{name}` | `{lm.link}` | {lm.description} | {where} |")
-    lines += [
-        "",
-        "## Joints",
-        "",
-        "Limits are the model's (degrees; a fixed joint is held at its angle). The policy, impairments",
-        "and `joints_deg` move only the revolute ones.",
-        "",
-        "| joint | type | axis | parent → child | limits (°) |",
-        "|---|---|---|---|---|",
-    ]
-    for j in joints:
-        limit = j.find("limit")
-        axis_el = j.find("axis")
-        axis = _axis_name(vec3(axis_el.get("xyz"))) if axis_el is not None else "—"
-        if limit is not None and j.get("type") == "revolute":
-            limits = f"[{math.degrees(float(limit.get('lower'))):.0f}, {math.degrees(float(limit.get('upper'))):.0f}]"
-        elif j.get("type") == "fixed":
-            rpy = vec3(j.find("origin").get("rpy"))
-            limits = f"fixed at {math.degrees(max(rpy, key=abs)):.0f}" if any(rpy) else "fixed"
-        else:
-            limits = "—"
-        lines.append(
-            f"| `{j.get('name')}` | {j.get('type')} | {axis} | `{j.find('parent').get('link')}` → "
-            f"`{j.find('child').get('link')}` | {limits} |"
-        )
+    lines += _landmark_lines(urdfs, shown) + _joint_lines(joints)
     return "\n".join(lines) + "\n"

@@ -124,7 +124,7 @@ def robot_links(s: Scope) -> dict[str, str]:
 
 def joint_groups(s: Scope) -> dict[str, JointGroup]:
     """``robot.arm`` (the acting arms' joints), ``robot.<side>_arm`` and every ``person.<group>``."""
-    from ..person.body import JOINT_GROUPS
+    from ..person.skeleton import JOINT_GROUPS
 
     part = s.robot.part
     groups: dict[str, JointGroup] = {}

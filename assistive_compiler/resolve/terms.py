@@ -17,7 +17,8 @@ from pydantic import ValidationError
 
 from ..spec.models import PAPER_PREFERENCE_WEIGHTS, PREFERENCE_NAMES
 from ..spec.validation import problems_from_validation
-from ..terms.registry import Category, TermDef, ref_fields, spec_form, terms
+from ..terms.catalog import terms
+from ..terms.registry import Category, TermDef, ref_fields, spec_form
 from .located import expected
 from .resolved import ResolvedTerm
 from .scope import Scope

@@ -18,8 +18,9 @@ from ..references import (
     PointHandle,
     TargetPoint,
 )
+from ..terms.catalog import terms
 from ..terms.reads import SceneReads
-from ..terms.registry import BOUND_KINDS, Params, ref_fields, terms
+from ..terms.registry import BOUND_KINDS, Params, ref_fields
 from .snapshot import Snapshot
 
 

@@ -19,7 +19,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from ..artifact import PersonVariant
-    from .human import DrawnImpairment
+    from .impairment import DrawnImpairment
 
 
 @dataclass

@@ -12,7 +12,7 @@ so the order of the events is the order of the draws, and a seed gives one episo
 * ``furniture_noise``: a uniform offset of one piece of furniture (m, world frame),
 * ``floor_friction``: the floor's lateral friction coefficient.
 
-Each event is a function of the env, the episode and its own parameters (the manifest's event
+Each event is a function of the env (an :class:`EventTarget`), the episode and its own parameters (the manifest's event
 model); :func:`bind_events` binds them once, when the env is built.
 """
 
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from functools import partial
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 import pybullet as pb
@@ -31,6 +31,7 @@ from ..artifact import (
     Event,
     FloorFrictionEvent,
     FurnitureNoiseEvent,
+    Manifest,
     PersonVariantEvent,
     RobotStartEvent,
     SurfacePoint,
@@ -38,11 +39,24 @@ from ..artifact import (
 )
 from ..rotation import capsule_axes
 from .binding import BoundTerm
+from .bodies import PARK
 from .component import Episode, EpisodeComponent
-from .world import PARK, World
+from .snapshot import Snapshot
+from .world import World
 
-if TYPE_CHECKING:
-    from .env import AssistiveEnv
+
+class EventTarget(Protocol):
+    """What the events read and drive of an env (:class:`~.env.AssistiveEnv` is one): its
+    manifest, world and per-step snapshot, its components by name, and the robot's start command."""
+
+    manifest: Manifest
+    world: World
+    snap: Snapshot
+    components: dict[str, EpisodeComponent]
+
+    def command_start(self, joints: list[float]) -> None:
+        """The arm at ``joints`` (rad, action order), at rest, with position targets there."""
+
 
 #: An event bound to an env: applied to each reset's episode.
 BoundEvent = Callable[[Episode], None]
@@ -73,7 +87,7 @@ def draw_listed_point(points: Sequence[SurfacePoint], rng: np.random.Generator) 
 
 
 # -- the events ---------------------------------------------------------------------------------
-def person_variant(env: AssistiveEnv, episode: Episode, event: PersonVariantEvent) -> None:
+def person_variant(env: EventTarget, episode: Episode, event: PersonVariantEvent) -> None:
     """The episode's person body in place, the others parked asleep, person-attached targets at its offsets."""
     m, w, snap = env.manifest, env.world, env.snap
     variants = m.person.variants
@@ -96,7 +110,7 @@ def person_variant(env: AssistiveEnv, episode: Episode, event: PersonVariantEven
             snap.target_offsets[name] = np.asarray(offset, dtype=float)
 
 
-def surface_targets(env: AssistiveEnv, episode: Episode, event: SurfaceTargetsEvent) -> None:
+def surface_targets(env: EventTarget, episode: Episode, event: SurfaceTargetsEvent) -> None:
     """Each surface-drawn target at a new point of the person: on its limbs' capsules, then on listed points."""
     variant, snap = episode.variant, env.snap
     assert variant is not None, "surface targets are drawn after the person_variant event"
@@ -108,7 +122,7 @@ def surface_targets(env: AssistiveEnv, episode: Episode, event: SurfaceTargetsEv
         snap.place_target(name, p.link, np.asarray(p.offset), np.asarray(p.normal), np.asarray(p.axis))
 
 
-def robot_start(env: AssistiveEnv, episode: Episode, event: RobotStartEvent) -> None:
+def robot_start(env: EventTarget, episode: Episode, event: RobotStartEvent) -> None:
     """The robot at one of the variant's starts — base pose, arm (and followers, wheels) at rest
     with their motor targets there — the tools in the hand, carried furniture under the base."""
     m, w, c = env.manifest, env.world, env.world.client
@@ -131,20 +145,20 @@ def robot_start(env: AssistiveEnv, episode: Episode, event: RobotStartEvent) -> 
             w.set_base_frame(w.bodies[body.name], pos, orn)
 
 
-def furniture_noise(env: AssistiveEnv, episode: Episode, event: FurnitureNoiseEvent) -> None:
+def furniture_noise(env: EventTarget, episode: Episode, event: FurnitureNoiseEvent) -> None:
     """The body at its nominal position plus U(−half_width, half_width) per world axis (m)."""
     body, half = env.manifest.body(event.body), np.asarray(event.half_width)
     noise = episode.rng.uniform(-half, half)
     env.world.set_base_frame(env.world.bodies[body.name], tuple(np.asarray(body.position) + noise), body.orientation)
 
 
-def floor_friction(env: AssistiveEnv, episode: Episode, event: FloorFrictionEvent) -> None:
+def floor_friction(env: EventTarget, episode: Episode, event: FloorFrictionEvent) -> None:
     """The floor's lateral friction, U(low, high)."""
     friction = float(episode.rng.uniform(event.low, event.high))
     pb.changeDynamics(env.world.ground, -1, lateralFriction=friction, physicsClientId=env.world.client)
 
 
-def component_reset(env: AssistiveEnv, episode: Episode, event: ComponentResetEvent) -> None:
+def component_reset(env: EventTarget, episode: Episode, event: ComponentResetEvent) -> None:
     """Start the named component's episode."""
     env.components[event.component].reset(episode)
 
@@ -159,7 +173,7 @@ EVENTS: dict[str, Callable[..., None]] = {
 }
 
 
-def bind_events(env: AssistiveEnv, events: Sequence[Event]) -> list[BoundEvent]:
+def bind_events(env: EventTarget, events: Sequence[Event]) -> list[BoundEvent]:
     """The manifest's events bound to ``env``, in order."""
     return [partial(EVENTS[e.event], env, event=e) for e in events]
 

@@ -50,9 +50,10 @@ from ..artifact import Container, ParticleSet
 from ..references import PointHandle, TargetPoint
 from ..rotation import quat_matrix, vec_angle
 from ..terms.reads import ParticleEvents
+from .bodies import PARK, own_points
 from .component import EnvStep, Episode, EpisodeComponent
 from .snapshot import Snapshot
-from .world import PARK, World, own_points
+from .world import World
 
 _AXIS = np.array([0.0, 0.0, 1.0])  # a container's axis in its frame, towards its opening
 

@@ -21,7 +21,8 @@ import pybullet as pb
 from ..references import JointGroup, JointsHandle, NodeSet, NodesHandle, Point, PointHandle, TargetPoint
 from ..rotation import quat_conj, quat_matrix, quat_mul, quat_rotate  # noqa: F401  (re-exported)
 from ..terms.reads import ContactPoint, ParticleEvents, SceneReads
-from .world import BodyHandle, World, own_points
+from .bodies import BodyHandle, own_points
+from .world import World
 
 CLOSEST_SLACK_M = (
     0.05  # closest_distance first looks this far beyond its last answer (m); any value gives the same result

@@ -5,22 +5,18 @@ manifest, looks every referenced link and joint up by name once, attaches tools,
 particles and saves the initial state; :meth:`World.restore` brings that state back in well under
 a millisecond. It knows nothing about any particular task.
 
-Per-body gravity on stock pybullet: the world gravity is set to the value that needs the fewest
-compensated links, and every movable link of a body with a different gravity gets an external
-force m·(g_body − g_world) at its centre of mass before each physics step (forces are cleared by
-``stepSimulation``). The effect on those links is exactly the body's own gravity.
+Per-body gravity on stock pybullet (compensating forces before each physics step) is
+:class:`~.gravity.PerBodyGravity`'s part of the World; garments (cloth held by the robot) are
+:class:`~.garments.HeldGarments`'s; the handles of loaded bodies and :data:`~.bodies.PARK` are
+:mod:`.bodies`'.
 
 Person self-collision: a person body whose manifest lists self-collision pairs is loaded with
 ``URDF_USE_SELF_COLLISION`` and only those link pairs collide (:meth:`World._set_self_collision`);
 every other body loads as before. :attr:`World.after_physics_step`, when set, runs after each
 physics step of :meth:`step_physics` (the person's limit enforcement).
 
-Garments (cloth): an artifact with garments gets a deformable world (``RESET_USE_DEFORMABLE_WORLD``
-before anything is loaded; its gravity is the spec's, as a soft body feels only the world's). Each
-garment is a mass-spring soft body whose held nodes are pinned to a massless, collision-free anchor
-body; :meth:`follow_grips` teleports the anchors to the hand's held frame after every physics step
-and :meth:`reset_garments` puts the settled nodes back at reset (``restoreState`` does not cover
-soft-body nodes). The garment's body handle has the soft body's id and the anchor's pose.
+Garments: an artifact with garments gets a deformable world (``RESET_USE_DEFORMABLE_WORLD``
+before anything is loaded; its gravity is the spec's, as a soft body feels only the world's).
 
 Frames: pybullet reports a base's pose at its centre of mass; :meth:`base_frame` and
 :meth:`set_base_frame` convert to and from the URDF frame the manifest uses.
@@ -28,69 +24,21 @@ Frames: pybullet reports a base's pose at its centre of mass; :meth:`base_frame`
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable
 from pathlib import Path
 
-import numpy as np
 import pybullet as pb
 
 from ..artifact import Manifest
 from ..bullet import connect, use_contact_breaking_threshold
-from ..rotation import quat_matrix
+from .bodies import PARK, BodyHandle
+from .garments import HeldGarments
+from .gravity import PerBodyGravity
 
-PARK = (
-    0.0,
-    500.0,
-    50.0,
-)  # where inactive bodies (other person variants, removed particles) wait: far away, beyond the floor's edge, m
 FLOOR_HALF_M = 20.0  # the floor slab's half width, m: the scene sits near the origin
 
 
-@dataclass
-class BodyHandle:
-    """A loaded body: its pybullet id and name → index tables (base link is index -1)."""
-
-    name: str
-    id: int
-    links: dict[str, int]
-    joints: dict[str, int]
-    inertial_inv: tuple  # inverse of the base's local inertial frame (COM → URDF frame)
-    pose_id: int | None = None  # body whose base pose is this body's frame (a garment: its anchor; None: id itself)
-    #: A welded tool: the link of ``id`` (the robot) that is its base; −1: its own body's base.
-    base_link: int = -1
-    #: The links of ``id`` that are this body's when it shares its pybullet body with another (a
-    #: welded tool and the robot it is welded to: contacts and distances are filtered to them);
-    #: None: every link of ``id``.
-    link_set: frozenset[int] | None = None
-
-
-def own_points(points: Sequence, a: BodyHandle, b: BodyHandle | None = None) -> Sequence:
-    """Those of pybullet's contact or closest points between ``a.id`` (bodyA) and ``b.id`` (bodyB)
-    that lie on the links of ``a`` and ``b`` themselves (see :attr:`BodyHandle.link_set`); ``points``
-    itself when neither shares its pybullet body (the common case, on every step: no copy)."""
-    keep_a, keep_b = a.link_set, b.link_set if b is not None else None
-    if keep_a is None and keep_b is None:
-        return points
-    return [cp for cp in points if (keep_a is None or cp[3] in keep_a) and (keep_b is None or cp[4] in keep_b)]
-
-
-@dataclass
-class GarmentHandle:
-    """A loaded garment: the soft body, the anchor body its held nodes are pinned to, and where
-    the held frame rides (robot link index, pose in that link's URDF frame)."""
-
-    name: str
-    soft_id: int
-    anchor_id: int
-    link: int
-    grip: tuple  # (position, orientation) of the held frame in the link's URDF frame
-    nodes_in_held: np.ndarray  # (n, 3) settled node positions, held frame, m
-    faces: np.ndarray  # (m, 3) node indices of the mesh's triangles (renders draw the cloth from these)
-    rgba: tuple  # colour
-
-
-class World:
+class World(PerBodyGravity, HeldGarments):
     """All bodies of an artifact in one pybullet DIRECT client."""
 
     def __init__(self, artifact_dir: str | Path, manifest: Manifest | None = None):
@@ -345,134 +293,6 @@ class World:
                 )
             self.particles[ps.name] = ids
 
-    def _create_garments(self) -> None:
-        """Load each garment as a soft body with its held nodes pinned to an anchor body (see
-        :func:`assistive_compiler.garment.load_garment`); it waits parked until :meth:`reset_garments`.
-        The garment's body handle has the soft body's id (contacts) and the anchor's pose (its
-        ``held`` point)."""
-        from ..garment import load_garment, read_obj_faces
-
-        c = self.client
-        self.garments: list[GarmentHandle] = []
-        for k, g in enumerate(self.m.garments):
-            park = (PARK[0] + 20.0 + 5.0 * k, PARK[1], PARK[2])
-            sb, anchor = load_garment(
-                pb,
-                c,
-                self.dir / g.obj,
-                park,
-                (0, 0, 0, 1),
-                g.mass,
-                g.collision_margin,
-                g.elastic_stiffness,
-                g.damping_stiffness,
-                g.bending_stiffness,
-                g.friction,
-                g.anchored,
-                rgba=g.rgba,
-            )
-            self.garments.append(
-                GarmentHandle(
-                    g.name,
-                    sb,
-                    anchor,
-                    self.robot.links[g.parent_link],
-                    (g.grip_position, g.grip_orientation),
-                    np.asarray(g.nodes_in_held, dtype=float),
-                    read_obj_faces(self.dir / g.obj),
-                    tuple(g.rgba),
-                )
-            )
-            self.bodies[g.name] = BodyHandle(
-                g.name, sb, {"held": -1}, {}, ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)), pose_id=anchor
-            )
-            if g.collides_with is not None:  # contact with every other body (and the floor) off
-                keep = {
-                    b.name
-                    for b in self.m.bodies
-                    if (b.kind == "person" and "person" in g.collides_with) or b.name in g.collides_with
-                }
-                others = [self.ground] + [
-                    h.id for name, h in self.bodies.items() if name not in keep and name != g.name
-                ]
-                for bid in others:
-                    for link in range(-1, pb.getNumJoints(bid, physicsClientId=c)):
-                        pb.setCollisionFilterPair(sb, bid, -1, link, 0, physicsClientId=c)
-
-    def held_pose(self, g: GarmentHandle):
-        """World pose of a garment's held frame: its robot link's URDF frame times the grip."""
-        pos, orn = self.link_frame(self.robot, g.link)
-        return pb.multiplyTransforms(pos, orn, *g.grip)
-
-    def follow_grips(self) -> None:
-        """Teleport every garment's anchor to its held frame (the pinned nodes follow in the next step)."""
-        c = self.client
-        for g in self.garments:
-            pos, orn = self.held_pose(g)
-            pb.resetBasePositionAndOrientation(g.anchor_id, pos, orn, physicsClientId=c)
-
-    def reset_garments(self) -> None:
-        """Every garment back to its settled shape at its held frame, at rest (call after the robot
-        is placed). ``restoreState`` does not cover soft-body nodes: ``resetMeshData`` sets them and
-        ``resetBaseVelocity`` zeroes their velocities (well under a millisecond)."""
-        c = self.client
-        for g in self.garments:
-            pos, orn = self.held_pose(g)
-            pb.resetBasePositionAndOrientation(g.anchor_id, pos, orn, physicsClientId=c)
-            rot = quat_matrix(orn)
-            world = g.nodes_in_held @ rot.T + np.asarray(pos)
-            pb.resetMeshData(g.soft_id, vertices=world.tolist(), physicsClientId=c)
-            pb.resetBaseVelocity(g.soft_id, (0, 0, 0), (0, 0, 0), physicsClientId=c)
-
-    def garment_nodes(self, g: GarmentHandle) -> np.ndarray:
-        """(n, 3) node positions of a garment, world frame, m."""
-        return np.asarray(
-            pb.getMeshData(g.soft_id, -1, flags=pb.MESH_DATA_SIMULATION_MESH, physicsClientId=self.client)[1],
-            dtype=float,
-        )
-
-    def _set_gravity(self) -> None:
-        """Choose the world gravity needing the fewest compensated links; list those links."""
-        c = self.client
-        candidates: dict[float, list[tuple[int, int, float]]] = {}
-        welded = {att.body for att in self.m.tools if att.welded}  # they feel the robot's gravity (the compiler checks)
-        declared = {
-            b.name: (self.m.sim.gravity if b.gravity is None else b.gravity)
-            for b in self.m.bodies
-            if b.name not in welded
-        }
-        for ps in self.m.particles:
-            for k in range(len(self.particles[ps.name])):
-                declared[f"{ps.name}#{k}"] = self.m.sim.gravity
-        options = sorted(set(declared.values()) | ({self.m.sim.gravity} if self.m.garments else set()))
-        for g_world in options:
-            comp: list[tuple[int, int, float]] = []
-            for name, g in declared.items():
-                if g == g_world:
-                    continue
-                bid = self._body_id(name)
-                for link, mass in self._moving_links(bid):
-                    comp.append((bid, link, mass * (g - g_world)))
-            candidates[g_world] = comp
-        # A soft body feels only the world gravity: with a garment that is the spec's sim gravity.
-        self.world_gravity = (
-            self.m.sim.gravity if self.m.garments else min(options, key=lambda g: (len(candidates[g]), -abs(g)))
-        )
-        groups: dict[int, tuple[list[int], list[float]]] = {}
-        for bid, link, fz in candidates[self.world_gravity]:
-            links, forces = groups.setdefault(bid, ([], []))
-            links.append(link)
-            forces.append(fz)
-        #: Per body: (id, links, z-forces) applied before every physics step; ids in ``parked`` are skipped.
-        self.gravity_groups = [(bid, links, forces) for bid, (links, forces) in groups.items()]
-        self._gravity_plan = (
-            None  # gravity_groups and loads rearranged for the per-step loop (see _apply_gravity_compensation)
-        )
-        #: (body id, link) → a z-force (N, world frame) applied at the link's centre of mass with the gravity compensation.
-        self.loads: dict[tuple[int, int], float] = {}
-        self.parked: set[int] = set()
-        pb.setGravity(0, 0, self.world_gravity, physicsClientId=c)
-
     def _set_stepping(self) -> None:
         """One ``stepSimulation`` per physics step (each split into the spec's solver sub-steps).
 
@@ -484,31 +304,6 @@ class World:
         sim, c = self.m.sim, self.client
         pb.setTimeStep(sim.time_step, physicsClientId=c)
         pb.setPhysicsEngineParameter(numSubSteps=sim.sub_steps, physicsClientId=c)
-
-    def _body_id(self, name: str) -> int:
-        if "#" in name:
-            set_name, k = name.split("#")
-            return self.particles[set_name][int(k)]
-        return self.bodies[name].id
-
-    def _moving_links(self, bid: int) -> list[tuple[int, float]]:
-        """(link index, mass) of every link that can move (fixed-base chains of fixed joints can't)."""
-        c = self.client
-        fixed_base = pb.getDynamicsInfo(bid, -1, physicsClientId=c)[0] == 0 or self._is_fixed_base(bid)
-        out = [] if fixed_base else [(-1, pb.getDynamicsInfo(bid, -1, physicsClientId=c)[0])]
-        moves = {-1: not fixed_base}
-        for j in range(pb.getNumJoints(bid, physicsClientId=c)):
-            info = pb.getJointInfo(bid, j, physicsClientId=c)
-            moves[j] = moves[info[16]] or info[2] != pb.JOINT_FIXED
-            if moves[j]:
-                out.append((j, pb.getDynamicsInfo(bid, j, physicsClientId=c)[0]))
-        return out
-
-    def _is_fixed_base(self, bid: int) -> bool:
-        for b in self.m.bodies:
-            if self.bodies[b.name].id == bid and self.bodies[b.name].base_link == -1:
-                return b.fixed_base
-        return False
 
     # -- per step ------------------------------------------------------------------------------
     def step_physics(self) -> None:
@@ -523,53 +318,6 @@ class World:
                 self.follow_grips()
             if after is not None:
                 after()
-
-    def set_load(self, bid: int, link: int, fz: float) -> None:
-        """Push link ``link`` of body ``bid`` with ``fz`` (N, world z, at its centre of mass) before every
-        physics step until changed; 0 removes it. E.g. the weight of particles a container carries
-        outside the physics (:mod:`.particles`)."""
-        if fz:
-            self.loads[(bid, link)] = fz
-        else:
-            self.loads.pop((bid, link), None)
-        self._gravity_plan = None
-
-    def _apply_gravity_compensation(self) -> None:
-        c = self.client
-        apply, world = pb.applyExternalForce, pb.WORLD_FRAME
-        base_pose, link_states = pb.getBasePositionAndOrientation, pb.getLinkStates
-        parked = self.parked
-        plan = self._gravity_plan
-        if (
-            plan is None or plan[0] is not self.gravity_groups
-        ):  # per body: base force, child links, their forces (built on change)
-            per_body: dict[int, dict[int, float]] = {}
-            for (bid, link), fz in [
-                ((bid, index), f) for bid, links, forces in self.gravity_groups for index, f in zip(links, forces)
-            ] + list(self.loads.items()):
-                on_body = per_body.setdefault(bid, {})
-                on_body[link] = on_body.get(link, 0.0) + fz
-            plan = self._gravity_plan = (
-                self.gravity_groups,
-                [
-                    (
-                        bid,
-                        (0.0, 0.0, f[-1]) if -1 in f else None,
-                        [index for index in f if index >= 0],
-                        [(0.0, 0.0, f[index]) for index in f if index >= 0],
-                    )
-                    for bid, f in per_body.items()
-                ],
-            )
-        # Positional arguments: pybullet parses keywords slowly (0.5 µs per force here, up to 90 per env step).
-        for bid, base_force, children, child_forces in plan[1]:
-            if bid in parked:
-                continue
-            if base_force is not None:
-                apply(bid, -1, base_force, base_pose(bid, c)[0], world, c)
-            if children:
-                for link, force, state in zip(children, child_forces, link_states(bid, children, physicsClientId=c)):
-                    apply(bid, link, force, state[0], world, c)
 
     def set_asleep(self, handle: BodyHandle, asleep: bool) -> None:
         """Put a parked body to sleep, or wake it (and keep it from sleeping).

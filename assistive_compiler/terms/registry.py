@@ -10,7 +10,9 @@ references to (:mod:`assistive_compiler.references`). What a spec *writes* is th
 :func:`spec_form`: the same fields with those references as names, validated by the resolver
 (which then resolves each name to a reference model for the manifest).
 
-Importing this module (and the term modules) is cheap: numpy and pydantic only.
+The term modules register themselves here with :func:`term`; the catalog of every built-in term
+is :func:`assistive_compiler.terms.catalog.terms`. Importing this module (and the term modules)
+is cheap: numpy and pydantic only.
 """
 
 from __future__ import annotations
@@ -114,13 +116,6 @@ def term(
         return fn
 
     return decorate
-
-
-def terms(category: Category) -> dict[str, TermDef]:
-    """All registered terms of ``category`` (importing the built-in term modules first)."""
-    from . import observations, preferences, rewards  # noqa: F401  (registration side effects)
-
-    return REGISTRY[category]
 
 
 def ref_fields(params: type[Params]) -> dict[str, tuple[RefKind, str]]:

@@ -19,7 +19,7 @@ from assistive_compiler.errors import SpecError
 from assistive_compiler.paths import specs_dir
 from assistive_compiler.registration import cached_artifact_dir
 from assistive_compiler.runtime.env import AssistiveEnv
-from assistive_compiler.terms.registry import terms
+from assistive_compiler.terms.catalog import terms
 
 TASKS = specs_dir() / "tasks"
 FEEDING = TASKS / "feeding.yaml"

@@ -25,11 +25,8 @@ if str(REPO) not in sys.path:  # run from a checkout without the package install
 
 from assistive_compiler.compile.lint import lint_urdf  # noqa: E402
 from assistive_compiler.compile.merge import MergedFrame, merge_fixed_links  # noqa: E402
-from assistive_compiler.person.body import (  # noqa: E402
-    REVOLUTE_JOINTS,
-    body_measurements,
-    format_fixed_joints,
-)
+from assistive_compiler.person.body import body_measurements, format_fixed_joints  # noqa: E402
+from assistive_compiler.person.skeleton import REVOLUTE_JOINTS  # noqa: E402
 
 TEMPLATE = REPO / "templates" / "person" / "person.urdf.xacro"
 HEAD_CHAIN = ("neck", "head_x", "head_y", "head_z")

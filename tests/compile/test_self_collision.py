@@ -21,7 +21,7 @@ from helpers import person
 
 from assistive_compiler.compile.compiler import compile_task
 from assistive_compiler.compile.self_collision import person_self_collision
-from assistive_compiler.person.body import SELF_COLLISION_GROUPS, self_collision_pairs
+from assistive_compiler.person.skeleton import SELF_COLLISION_GROUPS, self_collision_pairs
 from assistive_compiler.runtime.env import AssistiveEnv
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "human"
@@ -113,7 +113,8 @@ def test_the_plan_is_exact_on_the_unmerged_body():
     links whose pair decision is the reference's (for the moving groups)."""
     from assistive_compiler.library import PERSON_TEMPLATE_RELPATH
     from assistive_compiler.paths import templates_dir
-    from assistive_compiler.person.body import REVOLUTE_JOINTS, body_measurements, format_fixed_joints
+    from assistive_compiler.person.body import body_measurements, format_fixed_joints
+    from assistive_compiler.person.skeleton import REVOLUTE_JOINTS
     from assistive_compiler.templates import expand_template
 
     movable = {"right_elbow", "head_x", "head_y", "head_z"}  # only the forearm of the right arm moves

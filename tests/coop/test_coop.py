@@ -23,8 +23,8 @@ import assistive_compiler
 from assistive_compiler import coop
 from assistive_compiler.coop import AssistiveParallelEnv, FixedPartner, rollout_coop
 from assistive_compiler.errors import SpecError
+from assistive_compiler.gym_ids import shipped_ids
 from assistive_compiler.paths import display
-from assistive_compiler.registration import shipped_ids
 from assistive_compiler.runtime.env import AssistiveEnv
 
 TASKS = Path(__file__).resolve().parents[2] / "specs" / "tasks"

@@ -19,7 +19,7 @@ from assistive_compiler.person.arm_limits import (
     mirror_pose,
     reference_input,
 )
-from assistive_compiler.person.body import JOINT_LIMITS_DEG
+from assistive_compiler.person.skeleton import JOINT_LIMITS_DEG
 
 D = np.radians
 SIDES = ("right", "left")

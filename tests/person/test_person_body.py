@@ -13,10 +13,10 @@ from pathlib import Path
 import pytest
 
 try:
-    from assistive_compiler.person import body
+    from assistive_compiler.person import body, skeleton
 except ModuleNotFoundError:  # running from a checkout without the package installed
     sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-    from assistive_compiler.person import body
+    from assistive_compiler.person import body, skeleton
 
 import pybullet as p
 import xacro
@@ -122,10 +122,10 @@ def test_joints(urdfs, client, sex):
     fixed = [info[1].decode() for info in infos if info[2] == p.JOINT_FIXED]
     assert revolute == REVOLUTE and fixed == ["stomach"]
     # Reference order (index 24 is the fixed stomach) and link naming.
-    assert names == list(body.JOINT_NAMES) and names[24] == "stomach"
-    assert [info[12].decode() for info in infos] == list(body.LINK_NAMES)
+    assert names == list(skeleton.JOINT_NAMES) and names[24] == "stomach"
+    assert [info[12].decode() for info in infos] == list(skeleton.LINK_NAMES)
     links = link_index(client, bid)
-    assert set(body.LANDMARKS) <= set(links)
+    assert set(skeleton.LANDMARKS) <= set(links)
     assert p.getBodyInfo(bid, physicsClientId=client)[0].decode() == "chest"
     # Axes and limits equal the reference's table.
     unit = {"x": (1, 0, 0), "y": (0, 1, 0), "z": (0, 0, 1)}
@@ -133,13 +133,13 @@ def test_joints(urdfs, client, sex):
         name = info[1].decode()
         if name == "stomach":
             continue
-        lo, hi = body.JOINT_LIMITS_DEG[name]
+        lo, hi = skeleton.JOINT_LIMITS_DEG[name]
         assert info[8] == pytest.approx(math.radians(lo)) and info[9] == pytest.approx(math.radians(hi))
-        assert info[13] == pytest.approx(unit[body.JOINT_AXES[name]])
+        assert info[13] == pytest.approx(unit[skeleton.JOINT_AXES[name]])
         assert info[10] > 0 and info[11] > 0  # effort, velocity
-    assert body.JOINT_AXES["right_shoulder_x"] == "y" and body.JOINT_AXES["right_shoulder_y"] == "x"
-    assert sum(len(g) for g in body.JOINT_GROUPS.values()) == 41
-    assert len(body.JOINT_GROUPS["right_arm"]) == 10 and body.JOINT_GROUPS["head"] == (
+    assert skeleton.JOINT_AXES["right_shoulder_x"] == "y" and skeleton.JOINT_AXES["right_shoulder_y"] == "x"
+    assert sum(len(g) for g in skeleton.JOINT_GROUPS.values()) == 41
+    assert len(skeleton.JOINT_GROUPS["right_arm"]) == 10 and skeleton.JOINT_GROUPS["head"] == (
         "neck",
         "head_x",
         "head_y",
@@ -299,7 +299,7 @@ def test_cloth_spheres_add_collision_shapes(tmp_path, client):
 
 
 def test_self_collision_groups():
-    groups = body.SELF_COLLISION_GROUPS
+    groups = skeleton.SELF_COLLISION_GROUPS
     assert set(groups) == {"right_arm", "left_arm", "right_leg", "left_leg"}
     assert groups["right_arm"].links == (
         "right_shoulder_x_link",
@@ -312,7 +312,7 @@ def test_self_collision_groups():
     )
     assert "chest" in groups["right_arm"].against and "right_pecs" not in groups["right_arm"].against
     assert "waist" not in groups["right_leg"].against and "left_ankle" in groups["right_leg"].against
-    known = {"chest", *body.LINK_NAMES}
+    known = {"chest", *skeleton.LINK_NAMES}
     assert all(set(g.links) <= known and set(g.against) <= known for g in groups.values())
-    pairs = body.self_collision_pairs()
+    pairs = skeleton.self_collision_pairs()
     assert ("chest", "neck") not in pairs and ("left_wrist", "right_wrist") in pairs

@@ -12,7 +12,7 @@ from episode_digests import STORE, first_difference, rollouts
 from gymnasium.utils.env_checker import check_env
 
 import assistive_compiler  # noqa: F401  (registers the ids)
-from assistive_compiler.registration import shipped_ids
+from assistive_compiler.gym_ids import shipped_ids
 
 IDS = sorted(shipped_ids())
 

@@ -10,7 +10,7 @@ from assistive_compiler.artifact import TermUse
 from assistive_compiler.references import LinkPoint, PointHandle, TargetPoint
 from assistive_compiler.runtime.binding import bind, bind_params
 from assistive_compiler.runtime.snapshot import Snapshot
-from assistive_compiler.terms.registry import terms
+from assistive_compiler.terms.catalog import terms
 
 
 def point(snap: Snapshot, body: str, link: str) -> PointHandle:

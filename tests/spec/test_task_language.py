@@ -20,7 +20,7 @@ from assistive_compiler.paths import specs_dir
 from assistive_compiler.references import TargetPoint
 from assistive_compiler.rotation import quat_angle, quat_rotate, vec_angle
 from assistive_compiler.runtime.env import AssistiveEnv
-from assistive_compiler.terms.registry import terms
+from assistive_compiler.terms.catalog import terms
 
 TASKS = specs_dir() / "tasks"
 

@@ -16,7 +16,7 @@ from helpers import at, compiled_env
 from assistive_compiler.cli import main
 from assistive_compiler.paths import display, specs_dir
 from assistive_compiler.references import LinkPoint
-from assistive_compiler.terms.registry import terms
+from assistive_compiler.terms.catalog import terms
 
 SPEC = specs_dir() / "tasks" / "arm_manipulation.yaml"
 FEEDING = specs_dir() / "tasks" / "feeding.yaml"

@@ -21,8 +21,8 @@ import pytest
 
 from assistive_compiler.references import LinkPoint, TargetPoint
 from assistive_compiler.runtime.snapshot import Snapshot
+from assistive_compiler.terms.catalog import terms
 from assistive_compiler.terms.reads import ParticleEvents
-from assistive_compiler.terms.registry import terms
 
 REPO = Path(__file__).resolve().parents[2]
 SPEC = REPO / "specs" / "tasks" / "feeding.yaml"

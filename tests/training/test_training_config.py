@@ -183,7 +183,7 @@ def test_evaluate_on_a_directory_that_is_not_a_run(capsys, tmp_path):
 
 
 def test_the_reach_example_is_not_a_registered_id():
-    from assistive_compiler.registration import shipped_ids
+    from assistive_compiler.gym_ids import shipped_ids
 
     assert not [i for i in shipped_ids() if "Reach" in i]
 

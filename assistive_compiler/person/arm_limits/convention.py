@@ -9,7 +9,7 @@ from typing import Literal, Protocol, runtime_checkable
 
 import numpy as np
 
-from ..body import JOINT_LIMITS_DEG
+from ..skeleton import JOINT_LIMITS_DEG
 
 Side = Literal["right", "left"]
 SIDES: tuple[Side, Side] = ("right", "left")

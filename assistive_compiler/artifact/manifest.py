@@ -1,0 +1,214 @@
+"""The manifest (``manifest.json``): the whole artifact description, how it is read and verified,
+its content hash, and the migration of the older format."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import Any
+
+from pydantic import Field, PrivateAttr, ValidationError, model_validator
+
+from ..errors import SpecError
+from ..gym_ids import TASK_ID
+from ..references import JointGroup
+from .events import Event, reset_events
+from .model import ArtifactModel
+from .person import Person
+from .programs import Script, Success, TermUse
+from .robot import Robot, ToolAttachment
+from .scene import Body, Camera, Garment, MarkerSet, ParticleSet, Sim, Target
+
+#: 2 (2026-11-28): the reset's draws are ``events``; floor friction and furniture noise moved there
+#: from ``sim.ground_friction`` and ``Body.position_noise`` (format 1 is read and migrated).
+FORMAT_VERSION = 2
+
+#: The agents of a co-optimised task, in order: the robot and the person. They are the manifest's
+#: observation groups, the PettingZoo agent ids (``coop``), the RLlib policy ids (``training``) and
+#: the parts of a shipped pair (``policies``).
+AGENTS = ("robot", "human")
+
+
+class Manifest(ArtifactModel):
+    """The whole artifact description."""
+
+    format_version: int = Field(FORMAT_VERSION, description="Artifact format version.")
+    task: str = Field(description="Task name.")
+    title: str = Field(description="Task title.")
+    robot_name: str = Field(description="Robot compiled for.")
+    gym_id: str = Field(
+        description="Gymnasium id that makes this (task, robot): a shipped task's own "
+        "(assistive_compiler/FeedingJaco-v1), else assistive_compiler/Task-v1 (with spec= and robot=)."
+    )
+    input_hash: str = Field(description="sha256 of every input (spec files, parts, templates, compiler source).")
+    content_hash: str = Field(
+        "",
+        description="sha256 of the output files (URDFs and the manifest minus this field and input_hash): "
+        "what was compiled, whichever compiler source compiled it.",
+    )
+    sources: list[str] = Field(description="Spec and part files this was compiled from.")
+    sim: Sim = Field(description="Physics settings: time step, frame skip, solver, gravity, episode length.")
+    bodies: list[Body] = Field(
+        description="Every URDF body the world loads (robot, furniture, tools, each person variant), placed."
+    )
+    person: Person = Field(description="The person: variants, holds, impairments, policy joints, limits.")
+    robot: Robot = Field(description="The robot: action joints and scaling, named links, start configurations.")
+    tools: list[ToolAttachment] = Field(description="Tools held by the robot: which link, where in it.")
+    targets: dict[str, Target] = Field(description="Named target points (a link and an offset), by name.")
+    particles: list[ParticleSet] = Field(description="Particle sets (food, water): size, mass, where they start.")
+    markers: list[MarkerSet] = Field(default_factory=list, description="Marker sets on the person.")
+    joint_groups: dict[str, JointGroup] = Field(
+        description="Joint groups by reference name (``robot.arm``, ``person.head``)."
+    )
+    observations: dict[str, list[TermUse]] = Field(description="Observation features per agent, in order.")
+    reward: list[TermUse] = Field(description="Reward terms including preference costs.")
+    success: Success = Field(description="The success criterion: which term, how aggregated, the threshold.")
+    garments: list[Garment] = Field(
+        default_factory=list, description="Soft-body garments (their presence makes the world a deformable one)."
+    )
+    scripted: Script | None = Field(
+        None, description="The scripted baseline's script for this robot (none: no baseline)."
+    )
+    camera: Camera = Field(default_factory=lambda: Camera(), description="The task's camera for this robot (renders).")
+    events: list[Event] = Field(
+        description="What ``reset()`` does, in order, with the episode's one random stream: the draws "
+        "(person variant, surface targets, robot start, furniture noise, floor friction) and the "
+        "components' episode starts (:func:`reset_events`)."
+    )
+    #: The manifest as its file holds it, when that was an older format (migrated on reading):
+    #: its content hash covers that form.
+    _as_written: dict[str, Any] | None = PrivateAttr(None)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _migrate(cls, data: Any) -> Any:
+        """Format 1 (before 2026-11-28) had no ``events``: build the ones its runtime applied."""
+        if isinstance(data, dict) and data.get("format_version") == 1:
+            data = _format_1_migrated(data)
+        return data
+
+    @property
+    def label(self) -> str:
+        """A name for logs and plot titles: the shipped task's id (``assistive_compiler/FeedingJaco-v1``),
+        or ``<task> for <robot>`` for any other spec (whose id, ``assistive_compiler/Task-v1``, is shared)."""
+        return self.gym_id if self.gym_id != TASK_ID else f"{self.task} for {self.robot_name}"
+
+    def body(self, name: str) -> Body:
+        for b in self.bodies:
+            if b.name == name:
+                return b
+        raise KeyError(name)
+
+    def to_json(self) -> str:
+        return json.dumps(self.model_dump(mode="json"), indent=1, sort_keys=True) + "\n"
+
+    def hash_of(self, artifact_dir: str | Path, *, with_input_hash: bool = False) -> str:
+        """sha256 of the body files under ``artifact_dir`` and this manifest (``content_hash`` and
+        ``input_hash`` empty): what ``content_hash`` records when the artifact is as compiled. The
+        same content compiled by another version of the compiler source has the same hash, so a
+        run can be resumed across a change that compiles its task to the same files.
+        ``with_input_hash``: the hash as artifacts written before 2026-11-28 recorded it (the
+        manifest with its input hash, which covers the compiler source)."""
+        return self._hash(self._body_bytes(artifact_dir), with_input_hash=with_input_hash)
+
+    def _body_bytes(self, artifact_dir: str | Path) -> bytes:
+        return b"".join(Path(artifact_dir, b.urdf).read_bytes() for b in sorted(self.bodies, key=lambda b: b.urdf))
+
+    def _hash(self, files: bytes, *, with_input_hash: bool, as_written: bool = False) -> str:
+        """``as_written``: of the manifest in the form its file holds (an older format's), not today's."""
+        blank = {"content_hash": ""} if with_input_hash else {"content_hash": "", "input_hash": ""}
+        if as_written and self._as_written is not None:
+            text = json.dumps(self._as_written | blank, indent=1, sort_keys=True) + "\n"
+        else:
+            text = self.model_copy(update=blank).to_json()
+        return hashlib.sha256(files + text.encode()).hexdigest()
+
+    def damage(self, artifact_dir: str | Path) -> str | None:
+        """What is wrong with the files of the artifact at ``artifact_dir`` (a missing, truncated or
+        edited URDF), or None when they are exactly as compiled."""
+        for b in self.bodies:
+            path = Path(artifact_dir, b.urdf)
+            if not path.is_file():
+                return f"{path}: missing"
+            try:
+                ET.parse(path)
+            except ET.ParseError as exc:
+                return f"{path}: not complete URDF XML ({exc}); truncated or edited?"
+        if not self.content_hash:
+            return None
+        files = self._body_bytes(artifact_dir)  # read once; the older hash only when the current one differs
+        if self.content_hash != self._hash(
+            files, with_input_hash=False, as_written=True
+        ) and self.content_hash != self._hash(files, with_input_hash=True, as_written=True):
+            return f"{artifact_dir}: files differ from what was compiled (the manifest's content hash does not match)"
+        return None
+
+    @classmethod
+    def read(cls, artifact_dir: str | Path, verify: bool = False) -> Manifest:
+        """The manifest of the artifact at ``artifact_dir``; with ``verify``, a :class:`SpecError`
+        naming what is damaged when its files are not as compiled (see :meth:`damage`)."""
+        path = Path(artifact_dir, "manifest.json")
+        if not path.is_file():
+            raise SpecError.at(
+                str(artifact_dir), "not a compiled artifact (no manifest.json); compile a spec into it first"
+            )
+        try:
+            text = path.read_text()
+            manifest = cls.model_validate_json(text)  # pydantic's own messages for malformed JSON
+            written = json.loads(text)
+            if manifest.format_version != written.get("format_version"):
+                manifest._as_written = written
+        except (ValueError, UnicodeDecodeError) as exc:
+            raise SpecError.at(
+                str(path), f"not a readable manifest ({_first_problem(exc)}); recompile with 'compile --force'"
+            ) from None
+        problem = manifest.damage(artifact_dir) if verify else None
+        if problem:
+            raise SpecError.at(
+                str(artifact_dir),
+                f"damaged artifact: {problem}; recompile it (assistive-compiler compile SPEC --out {artifact_dir} --force)",
+            )
+        return manifest
+
+
+def _first_problem(exc: Exception) -> str:
+    """One line naming what made a manifest unreadable: the first field pydantic refused, by its
+    dotted path, with pydantic's reason (and how many more there are); else the error's first line."""
+    if isinstance(exc, ValidationError) and exc.errors():
+        errors = exc.errors()
+        first = errors[0]
+        where = ".".join(str(part) for part in first["loc"]) or "the top level"
+        more = f", and {len(errors) - 1} more" if len(errors) > 1 else ""
+        return f"{where}: {first['msg']}{more}"
+    return str(exc).splitlines()[0]
+
+
+def _format_1_migrated(data: dict[str, Any]) -> dict[str, Any]:
+    """A format-1 manifest's data in format 2: the events its runtime applied at every reset, from
+    ``sim.ground_friction`` and the furniture's ``position_noise``, which move into them."""
+    sim = dict(data["sim"])
+    low, high = sim.pop("ground_friction")
+    bodies, noisy = [], []
+    for body in data["bodies"]:
+        body = dict(body)
+        noise = tuple(body.pop("position_noise", (0.0, 0.0, 0.0)))
+        if body["kind"] == "furniture" and any(noise):
+            noisy.append((body["name"], noise))
+        bodies.append(body)
+    variants = data["person"]["variants"]
+    events = reset_events(
+        surface_targets=any(v.get("surfaces") or v.get("surface_points") for v in variants),
+        markers=bool(data.get("markers")),
+        furniture_noise=noisy,
+        floor_friction=(low, high),
+        particles=bool(data["particles"]),
+        garments=bool(data.get("garments")),
+    )
+    return data | {
+        "format_version": FORMAT_VERSION,
+        "sim": sim,
+        "bodies": bodies,
+        "events": [e.model_dump(mode="json") for e in events],
+    }
