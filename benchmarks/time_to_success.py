@@ -57,7 +57,11 @@ def evaluated(run_dir: Path, steps: int, protocol: str, episodes: int, seed: int
     return figures
 
 
-def run_points(label: str, run_dir: Path, episodes: int, seed: int, every: int) -> list[dict]:
+def run_points(
+    label: str, run_dir: Path, episodes: int, seed: int, every: int, rate: float | None = None
+) -> list[dict]:
+    """The run's evaluated checkpoints; ``rate`` (env steps/s): place them at steps / rate hours
+    instead of the run's own clock (a run whose core was shared part of the time)."""
     from assistive_compiler.run_dir import RunDir
 
     run = RunDir(run_dir)
@@ -65,7 +69,8 @@ def run_points(label: str, run_dir: Path, episodes: int, seed: int, every: int) 
     steps_list = [s for i, s in enumerate(steps_list) if s > 0 and (i % every == 0 or s == steps_list[-1])]
     points = []
     for steps in steps_list:
-        row = {"run": label, "steps": steps, "hours": round(checkpoint_hours(run_dir, steps), 4)}
+        hours = steps / rate / 3600 if rate else checkpoint_hours(run_dir, steps)
+        row = {"run": label, "steps": steps, "hours": round(hours, 4)}
         for protocol in PROTOCOLS:
             row[protocol] = evaluated(run_dir, steps, protocol, episodes, seed)["success_rate"]
         print(
@@ -118,7 +123,14 @@ def plot(runs: dict[str, list[dict]], args: argparse.Namespace) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--run", action="append", required=True, metavar="LABEL=RUN_DIR")
+    p.add_argument(
+        "--run",
+        action="append",
+        required=True,
+        metavar="LABEL=RUN_DIR[@STEPS_PER_S]",
+        help="a run; with @STEPS_PER_S its checkpoints stand at steps / that rate (say so in LABEL) instead of "
+        "its own clock, for a run whose core was shared part of the time",
+    )
     p.add_argument("--title", required=True)
     p.add_argument("--out", type=Path, required=True, help="the plot (.png); a .csv of the points goes beside it")
     p.add_argument("--episodes", type=int, default=100)
@@ -137,8 +149,9 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(argv)
     runs: dict[str, list[dict]] = {}
     for item in args.run:
-        label, _, path = item.rpartition("=")
-        runs[label] = run_points(label, Path(path), args.episodes, args.seed, args.every)
+        label, _, where = item.rpartition("=")
+        path, _, rate = where.partition("@")
+        runs[label] = run_points(label, Path(path), args.episodes, args.seed, args.every, float(rate) if rate else None)
     plot(runs, args)
     with args.out.with_suffix(".csv").open("w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=["run", "steps", "hours", "mean", "sampled"])
