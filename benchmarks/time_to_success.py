@@ -66,7 +66,10 @@ def run_points(
 
     run = RunDir(run_dir)
     steps_list = sorted(run.complete_checkpoints())
-    steps_list = [s for i, s in enumerate(steps_list) if s > 0 and (i % every == 0 or s == steps_list[-1])]
+    cached = {int(f.name.split("-")[0][len("step_") :]) for f in (run_dir / "time_to_success").glob("step_*.json")}
+    steps_list = [
+        s for i, s in enumerate(steps_list) if s > 0 and (i % every == 0 or s == steps_list[-1] or s in cached)
+    ]
     points = []
     for steps in steps_list:
         hours = steps / rate / 3600 if rate else checkpoint_hours(run_dir, steps)
@@ -135,7 +138,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--out", type=Path, required=True, help="the plot (.png); a .csv of the points goes beside it")
     p.add_argument("--episodes", type=int, default=100)
     p.add_argument("--seed", type=int, default=1_000_000)
-    p.add_argument("--every", type=int, default=1, help="evaluate every k-th checkpoint (and the newest)")
+    p.add_argument(
+        "--every",
+        type=int,
+        default=1,
+        help="evaluate every k-th checkpoint (and the newest; those evaluated before are drawn too)",
+    )
     p.add_argument("--target", type=float, help="success to reach (e.g. the shipped policy's)")
     p.add_argument("--target-label")
     p.add_argument("--target-hours", type=float, help="the shipped run's wall time: a line at a fifth of it")

@@ -93,10 +93,10 @@ def add_commands(sub) -> None:
         help="learn a policy with PPO or SAC (SB3 on one machine; RLlib for --coop and Ray clusters)",
         description="Learn a policy for a task. Which config, by the clock (docs/results.md, 'The recipe by the "
         "clock'), one run per core (taskset -c N): sac_one_core (SAC, 2x64, learned by SBX/JAX: 2-3.5 times "
-        "sac_laptop's env steps per core-hour) where success is reaching and holding a pose (Feeding; the slow "
-        "envs Drinking and Dressing); ppo_paper_in_process (the paper's PPO, its 36 envs in one process) for "
+        "sac_laptop's env steps per core-hour) for Feeding and the slow envs (Drinking, Dressing); "
+        "ppo_paper_in_process (the paper's PPO, its 36 envs in one process) for "
         "Itch Scratching, whose success is a motion; ppo_one_core for the most env steps per hour and a working "
-        "policy soonest; sac_laptop (SB3, PyTorch) for what SBX does not do: --coop --engine sb3, "
+        "policy soonest (Arm Manipulation); sac_laptop (SB3, PyTorch) for the higher final figures and what SBX does not do: --coop --engine sb3, "
         "--demonstrations, the averaged actor, layer-normalised or conservative critics.",
     )
     add_library_argument(p)

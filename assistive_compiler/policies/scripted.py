@@ -151,9 +151,9 @@ class ScriptedPolicy:
             track.index = 0
             track.best, track.since_best = float("inf"), 0
             track.noted = set()  # trace events noted for the current (held) waypoint
+            track.aimed_orn = None  # the orientation last handed to IK on a slow turn (turn_step_rad)
         if self.trace is not None:
             self.trace = []
-            track.aimed_orn = None  # the orientation last handed to IK on a slow turn (turn_step_rad)
 
     @staticmethod
     def _facing(track: _Track, orn, inward: np.ndarray, within: float) -> list[float]:
