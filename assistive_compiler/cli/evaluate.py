@@ -40,7 +40,8 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         print(json.dumps(result, indent=1) if args.json else format_report(result))
         return EXIT_OK
     run = RunDir(source)
-    if not require_extra(*engine_modules(run.info().engine, run.info().library)):
+    info = run.info()
+    if not require_extra(*engine_modules(info.engine, info.library)):
         return EXIT_FAILED
     from ..training.evaluate import evaluate, save_evaluation
 

@@ -47,12 +47,10 @@ def cmd_train(args: argparse.Namespace) -> int:
         from ..spec.load import load_spec
 
         check_coop_spec(load_spec(args.spec))
-    if not require_extra(*engine_modules(engine)):
-        return EXIT_FAILED
     from ..training.config import load_training_config
 
     library = load_training_config(training_config_path(args.config)).library
-    if library != "sb3" and not require_extra(*engine_modules(engine, library)):
+    if not require_extra(*engine_modules(engine, library)):
         return EXIT_FAILED
     from ..training.train import train
 

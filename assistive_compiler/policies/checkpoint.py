@@ -82,11 +82,12 @@ class SB3Policy:
             str(checkpoint / "model.zip"), device="cpu", custom_objects={"replay_buffer_class": None}
         )
         # SBX's actor acts in NumPy (its own JAX call hands each action to XLA's thread: slow on a
-        # busy core), sampling from a generator seeded with ``seed``
+        # busy core), sampling from a generator seeded with ``seed``; ``numpy_policy`` is also its export
+        self.numpy_policy: MLPPolicy | None = None
         self.numpy_actor = None
         if library == "sbx":
-            actor = sbx_sac_actor(self.model, self.model.policy.actor.activation_fn.__name__)
-            self.numpy_actor = actor.sampling(seed) if stochastic else actor
+            self.numpy_policy = sbx_sac_actor(self.model, self.model.policy.actor.activation_fn.__name__)
+            self.numpy_actor = self.numpy_policy.sampling(seed) if stochastic else self.numpy_policy
         average = checkpoint / ACTOR_AVERAGE
         if average.is_file():  # trained with an averaged actor: the average acts
             import torch

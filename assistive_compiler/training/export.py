@@ -18,7 +18,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..policies.checkpoint import sbx_sac_actor
 from ..policies.mlp import MLPPolicy
 from ..run_dir import RunDir
 from .config import run_config
@@ -71,8 +70,8 @@ def mlp_from_sb3(loaded, algorithm: str, activation: str) -> MLPPolicy:
     mean through tanh; PPO's Gaussian mean, clipped), with PPO's observation normalisation if it used one."""
     model = loaded.model
     low, high = model.action_space.low, model.action_space.high
-    if algorithm == "sac" and type(model).__module__.startswith("sbx"):
-        return sbx_sac_actor(model, activation)
+    if loaded.numpy_policy is not None:  # SBX's SAC: its actor as the checkpoint already acts with it
+        return loaded.numpy_policy
     if algorithm == "sac":
         return _sac_actor(model.actor, activation, low, high)
     layers = _layers(_linears(model.policy.mlp_extractor.policy_net) + [model.policy.action_net])
@@ -106,6 +105,11 @@ def mlp_from_rllib(module, algorithm: str, activation: str) -> MLPPolicy:
     return MLPPolicy(
         layers, activation, head, space.low, space.high, log_std=(w[half:], b[half:]), log_std_bounds=(-20.0, 20.0)
     )
+
+
+def _jax_mean_action(model):
+    """An SBX model's deterministic action of one observation, computed by SBX itself."""
+    return lambda obs: model.predict(np.asarray(obs, dtype=np.float32), deterministic=True)[0]
 
 
 def check_same_actions(exported: MLPPolicy, original, observations: np.ndarray, atol: float = 1e-4) -> float:
@@ -185,7 +189,9 @@ def export_run(
 
         original = SB3Policy(checkpoint, config.algorithm, library=config.library)
         policy = mlp_from_sb3(original, config.algorithm, config.network.activation)
-        worst = check_same_actions(policy, original, rng.normal(0.0, 1.0, (32, policy.obs_dim)))
+        # an SBX checkpoint acts with the exported policy itself: compare with SBX's own (JAX) actions
+        acting = original if original.numpy_policy is None else _jax_mean_action(original.model)
+        worst = check_same_actions(policy, acting, rng.normal(0.0, 1.0, (32, policy.obs_dim)))
     else:
         from ..policies.checkpoint import SINGLE_MODULE, RLlibPolicy, SB3PairPolicy
 
