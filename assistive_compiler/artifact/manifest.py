@@ -9,11 +9,12 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any
 
-from pydantic import Field, PrivateAttr, ValidationError, model_validator
+from pydantic import Field, ValidationError, model_validator
 
 from ..errors import SpecError
 from ..gym_ids import TASK_ID
 from ..references import JointGroup
+from .canonical import canonical_json
 from .events import Event, reset_events
 from .model import ArtifactModel
 from .person import Person
@@ -24,6 +25,10 @@ from .scene import Body, Camera, Garment, MarkerSet, ParticleSet, Sim, Target
 #: 2 (2026-11-28): the reset's draws are ``events``; floor friction and furniture noise moved there
 #: from ``sim.ground_friction`` and ``Body.position_noise`` (format 1 is read and migrated).
 FORMAT_VERSION = 2
+
+#: The manifest's fields its content hash leaves out: the hashes themselves, and where the spec files
+#: lay, which depends on the working directory and the machine, not on what was compiled.
+NOT_HASHED = frozenset({"content_hash", "input_hash", "sources"})
 
 #: The agents of a co-optimised task, in order: the robot and the person. They are the manifest's
 #: observation groups, the PettingZoo agent ids (``coop``), the RLlib policy ids (``training``) and
@@ -45,10 +50,14 @@ class Manifest(ArtifactModel):
     input_hash: str = Field(description="sha256 of every input (spec files, parts, templates, compiler source).")
     content_hash: str = Field(
         "",
-        description="sha256 of the output files (URDFs and the manifest minus this field and input_hash): "
-        "what was compiled, whichever compiler source compiled it.",
+        description="sha256 of the output files: the URDFs and the manifest's canonical form (every field at "
+        "its default left out, and this field, input_hash and sources): what was compiled, whichever compiler "
+        "source compiled it and wherever its spec lay.",
     )
-    sources: list[str] = Field(description="Spec and part files this was compiled from.")
+    sources: list[str] = Field(
+        description="Spec files this was compiled from, as the command named them (not hashed: it depends on "
+        "the working directory)."
+    )
     sim: Sim = Field(description="Physics settings: time step, frame skip, solver, gravity, episode length.")
     bodies: list[Body] = Field(
         description="Every URDF body the world loads (robot, furniture, tools, each person variant), placed."
@@ -77,9 +86,6 @@ class Manifest(ArtifactModel):
         "(person variant, surface targets, robot start, furniture noise, floor friction) and the "
         "components' episode starts (:func:`reset_events`)."
     )
-    #: The manifest as its file holds it, when that was an older format (migrated on reading):
-    #: its content hash covers that form.
-    _as_written: dict[str, Any] | None = PrivateAttr(None)
 
     @model_validator(mode="before")
     @classmethod
@@ -104,26 +110,30 @@ class Manifest(ArtifactModel):
     def to_json(self) -> str:
         return json.dumps(self.model_dump(mode="json"), indent=1, sort_keys=True) + "\n"
 
-    def hash_of(self, artifact_dir: str | Path, *, with_input_hash: bool = False) -> str:
-        """sha256 of the body files under ``artifact_dir`` and this manifest (``content_hash`` and
-        ``input_hash`` empty): what ``content_hash`` records when the artifact is as compiled. The
-        same content compiled by another version of the compiler source has the same hash, so a
-        run can be resumed across a change that compiles its task to the same files.
-        ``with_input_hash``: the hash as artifacts written before 2026-11-28 recorded it (the
-        manifest with its input hash, which covers the compiler source)."""
-        return self._hash(self._body_bytes(artifact_dir), with_input_hash=with_input_hash)
+    def hash_of(self, artifact_dir: str | Path) -> str:
+        """sha256 of the body files under ``artifact_dir`` and this manifest in its canonical form
+        (:mod:`.canonical`): every field at its default left out, and with it the fields that say
+        nothing about what was compiled (:data:`NOT_HASHED`). What ``content_hash`` records when the
+        artifact is as compiled; the same content compiled by another version of the compiler
+        source, from another folder, or before a field with a default was added hashes the same."""
+        files = self._body_bytes(artifact_dir)
+        text = canonical_json(self, leave_out=NOT_HASHED)
+        return hashlib.sha256(files + b"\0" + text.encode()).hexdigest()
 
     def _body_bytes(self, artifact_dir: str | Path) -> bytes:
         return b"".join(Path(artifact_dir, b.urdf).read_bytes() for b in sorted(self.bodies, key=lambda b: b.urdf))
 
-    def _hash(self, files: bytes, *, with_input_hash: bool, as_written: bool = False) -> str:
-        """``as_written``: of the manifest in the form its file holds (an older format's), not today's."""
-        blank = {"content_hash": ""} if with_input_hash else {"content_hash": "", "input_hash": ""}
-        if as_written and self._as_written is not None:
-            text = json.dumps(self._as_written | blank, indent=1, sort_keys=True) + "\n"
-        else:
-            text = self.model_copy(update=blank).to_json()
-        return hashlib.sha256(files + text.encode()).hexdigest()
+    def _hashes_as_written(self, artifact_dir: str | Path, files: bytes) -> tuple[str, ...]:
+        """The content hashes that artifacts written before the canonical form (2026-12-07) recorded:
+        of the manifest as ``artifact_dir``'s file holds it, its JSON with ``content_hash`` empty, and
+        either ``input_hash`` empty (2026-11-28 on) or kept (before)."""
+        try:
+            written = json.loads(Path(artifact_dir, "manifest.json").read_text())
+        except (OSError, ValueError):
+            return ()
+        forms = (written | {"content_hash": "", "input_hash": ""}, written | {"content_hash": ""})
+        texts = (json.dumps(form, indent=1, sort_keys=True) + "\n" for form in forms)
+        return tuple(hashlib.sha256(files + text.encode()).hexdigest() for text in texts)
 
     def damage(self, artifact_dir: str | Path) -> str | None:
         """What is wrong with the files of the artifact at ``artifact_dir`` (a missing, truncated or
@@ -136,14 +146,11 @@ class Manifest(ArtifactModel):
                 ET.parse(path)
             except ET.ParseError as exc:
                 return f"{path}: not complete URDF XML ({exc}); truncated or edited?"
-        if not self.content_hash:
+        if not self.content_hash or self.content_hash == self.hash_of(artifact_dir):
             return None
-        files = self._body_bytes(artifact_dir)  # read once; the older hash only when the current one differs
-        if self.content_hash != self._hash(
-            files, with_input_hash=False, as_written=True
-        ) and self.content_hash != self._hash(files, with_input_hash=True, as_written=True):
-            return f"{artifact_dir}: files differ from what was compiled (the manifest's content hash does not match)"
-        return None
+        if self.content_hash in self._hashes_as_written(artifact_dir, self._body_bytes(artifact_dir)):
+            return None  # an artifact written under an earlier hashing rule, verified as its file holds it
+        return f"{artifact_dir}: files differ from what was compiled (the manifest's content hash does not match)"
 
     @classmethod
     def read(cls, artifact_dir: str | Path, verify: bool = False) -> Manifest:
@@ -157,9 +164,6 @@ class Manifest(ArtifactModel):
         try:
             text = path.read_text()
             manifest = cls.model_validate_json(text)  # pydantic's own messages for malformed JSON
-            written = json.loads(text)
-            if manifest.format_version != written.get("format_version"):
-                manifest._as_written = written
         except (ValueError, UnicodeDecodeError) as exc:
             raise SpecError.at(
                 str(path), f"not a readable manifest ({_first_problem(exc)}); recompile with 'compile --force'"

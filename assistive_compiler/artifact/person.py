@@ -3,9 +3,9 @@ robot starts), the holds and gains of its control, and the impairment choices (m
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal
+from typing import Annotated, Literal
 
-from pydantic import Field, SerializerFunctionWrapHandler, model_serializer
+from pydantic import Field
 
 from .model import ArtifactModel, Vec3
 from .robot import StartState
@@ -64,15 +64,6 @@ class PersonVariant(ArtifactModel):
     )
     starts: list[StartState] = Field(description="Robot starts for this variant; reset() draws one.")
 
-    @model_serializer(mode="wrap")
-    def _without_empty_additions(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
-        """``surface_points`` came after artifacts were first written: left out while empty, so an
-        artifact compiled before it still matches its content hash (runs keep their artifact)."""
-        data: dict[str, Any] = handler(self)
-        if not data.get("surface_points"):
-            data.pop("surface_points", None)
-        return data
-
 
 class _Impairment(ArtifactModel):
     """What every impairment choice has: the person joints it acts on and their limits."""
@@ -81,15 +72,6 @@ class _Impairment(ArtifactModel):
     limits: dict[str, tuple[float, float]] = Field(
         default_factory=dict, description="Each of those joints' pose-independent URDF limits, rad (lower, upper)."
     )
-
-    @model_serializer(mode="wrap")
-    def _without_empty(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
-        """No ``joints`` and ``limits`` keys when it names no joints (the form artifacts were first written in)."""
-        data: dict[str, Any] = handler(self)
-        for key in ("joints", "limits"):
-            if not data.get(key):
-                data.pop(key, None)
-        return data
 
 
 class NoImpairment(_Impairment):

@@ -3,9 +3,9 @@ criterion, and the scripted baseline's waypoints (world frame, m; rad)."""
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Literal
 
-from pydantic import Field, SerializerFunctionWrapHandler, model_serializer
+from pydantic import Field
 
 from ..references import LinkPoint, ParamValue, TargetPoint
 from .model import ArtifactModel, Vec3
@@ -58,22 +58,6 @@ class ScriptWaypoint(ArtifactModel):
     )
     stall_progress_m: float = Field(0.002, description="Progress that restarts the stall count, m.")
 
-    @model_serializer(mode="wrap")
-    def _without_unset_additions(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
-        """``step_m``, ``face_normal_level`` and ``turn_step_rad`` are left out when unset, and
-        ``stall_steps`` and ``stall_progress_m`` at their defaults (the form artifacts were first
-        written in)."""
-        data: dict[str, Any] = handler(self)
-        for key in ("step_m", "turn_step_rad"):
-            if data.get(key) is None:
-                data.pop(key, None)
-        if not data.get("face_normal_level"):
-            data.pop("face_normal_level", None)
-        for key in ("stall_steps", "stall_progress_m"):
-            if data.get(key) == type(self).model_fields[key].default:
-                data.pop(key, None)
-        return data
-
 
 class Script(ArtifactModel):
     """The scripted baseline's script for one arm: the point it moves through its waypoints."""
@@ -85,12 +69,3 @@ class Script(ArtifactModel):
     left: Script | None = Field(
         None, description="A two-arm robot's left arm's own script (this one is the right arm's)."
     )
-
-    @model_serializer(mode="wrap")
-    def _without_unset(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
-        """``ik_damping`` and ``left`` are left out when unset."""
-        data: dict[str, Any] = handler(self)
-        for key in ("ik_damping", "left"):
-            if data.get(key) is None:
-                data.pop(key, None)
-        return data

@@ -3,9 +3,7 @@ precomputed starts, and the tools it holds (world frame, m; rad)."""
 
 from __future__ import annotations
 
-from typing import Any
-
-from pydantic import Field, SerializerFunctionWrapHandler, model_serializer
+from pydantic import Field
 
 from .model import ArtifactModel, Quat, Vec3
 
@@ -94,14 +92,6 @@ class Robot(ArtifactModel):
     )
     drive: Drive | None = Field(None, description="The mobile base's drive (None: a fixed base).")
 
-    @model_serializer(mode="wrap")
-    def _drop_unset_mobility(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
-        data: dict[str, Any] = handler(self)
-        for key in ("action_multipliers", "followers", "drive"):
-            if data.get(key) is None:
-                data.pop(key, None)
-        return data
-
     @property
     def action_size(self) -> int:
         """Length of the robot's action: two wheel dimensions with a drive, then one per arm joint."""
@@ -122,11 +112,3 @@ class ToolAttachment(ArtifactModel):
         description="True: its links are links of the robot's URDF, on a fixed joint '<body>_grip' at this pose, and its "
         "body's urdf is the robot's; False: its own body, held at this pose by a fixed constraint of at most 500 N.",
     )
-
-    @model_serializer(mode="wrap")
-    def _drop_unwelded(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
-        """A held tool's manifest entry as before ``welded`` existed, so its artifact keeps its content hash."""
-        data: dict[str, Any] = handler(self)
-        if not data.get("welded"):
-            data.pop("welded", None)
-        return data

@@ -4,9 +4,9 @@ physics settings (world frame, m, s)."""
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Literal
 
-from pydantic import Field, SerializerFunctionWrapHandler, model_serializer
+from pydantic import Field
 
 from .model import ArtifactModel, Quat, Vec3
 
@@ -91,18 +91,6 @@ class ParticleRest(ArtifactModel):
     near_distance: float = Field(
         0.0, description="Gap between the container's link and near_body below which they are simulated, m."
     )
-
-    @model_serializer(mode="wrap")
-    def _without_unset_additions(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
-        """``carry_at_reset`` and ``near_body`` came after artifacts were first written: left out
-        while at their defaults, so an artifact compiled before them still matches its content hash."""
-        data: dict[str, Any] = handler(self)
-        if data.get("carry_at_reset", True):
-            data.pop("carry_at_reset", None)
-        if data.get("near_body") is None:
-            data.pop("near_body", None)
-            data.pop("near_distance", None)
-        return data
 
 
 class MarkerSet(ArtifactModel):

@@ -6,6 +6,7 @@ run directory describes itself, checkpoints resume, Ctrl-C leaves a resumable ch
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import shutil
 import signal
@@ -229,22 +230,39 @@ def test_resume_refuses_a_run_of_another_spec(reach_run, tmp_path, capsys):
 
 def test_resume_accepts_the_same_task_compiled_by_another_compiler_version(reach_run, tmp_path):
     """A run recorded before content hashes left the input hash out (which covers the compiler
-    source) resumes when today's compile of its spec gives the same files; an edited artifact does not."""
+    source; the hash then covered the manifest file's JSON) resumes when today's compile of its spec
+    gives the same files; an edited artifact does not."""
     copy = tmp_path / "older"
     shutil.copytree(reach_run, copy)
     run = RunDir(copy)
     today = Manifest.read(run.artifact).content_hash
-    older = Manifest.read(run.artifact).model_copy(update={"input_hash": "0" * 64})
-    older = older.model_copy(update={"content_hash": older.hash_of(run.artifact, with_input_hash=True)})
-    (run.artifact / "manifest.json").write_text(older.to_json())
+    data = json.loads((run.artifact / "manifest.json").read_text()) | {"input_hash": "0" * 64, "content_hash": ""}
+    bodies = sorted(data["bodies"], key=lambda b: b["urdf"])
+    files = b"".join((run.artifact / b["urdf"]).read_bytes() for b in bodies)
+    older_hash = hashlib.sha256(files + (json.dumps(data, indent=1, sort_keys=True) + "\n").encode()).hexdigest()
+    (run.artifact / "manifest.json").write_text(json.dumps(data | {"content_hash": older_hash}, indent=1) + "\n")
     info = json.loads((copy / "run.json").read_text())
-    (copy / "run.json").write_text(json.dumps({**info, "content_hash": older.content_hash}))
-    assert older.content_hash != today and Manifest.read(run.artifact, verify=True).content_hash == older.content_hash
-    assert check_resumable(run, today, "jaco", False, "sb3").content_hash == older.content_hash
+    (copy / "run.json").write_text(json.dumps({**info, "content_hash": older_hash}))
+    assert older_hash != today and Manifest.read(run.artifact, verify=True).content_hash == older_hash
+    assert check_resumable(run, today, "jaco", False, "sb3").content_hash == older_hash
     urdf = next(run.artifact.rglob("*.urdf"))
     urdf.write_text(urdf.read_text().replace("<robot ", "<robot  ", 1))
     with pytest.raises(SpecError, match="--resume: this run trained a different compiled task"):
         check_resumable(run, today, "jaco", False, "sb3")
+
+
+def test_a_run_written_before_the_canonical_content_hash_resumes(tmp_path):
+    """A real run directory written by the code before the canonical hash (tests/data/
+    run_before_hash_rule: reach for Jaco, ppo_quick, 800 steps) resumes with today's compile of its
+    spec and trains on from its checkpoint."""
+    copy = tmp_path / "before"
+    shutil.copytree(REPO / "tests" / "data" / "run_before_hash_rule", copy)
+    recorded = RunDir(copy).info().content_hash
+    args = ["train", str(REACH), "--robot", "jaco", "--config", "ppo_quick", "--out", str(copy)]
+    assert main([*args, "--resume", "--steps", "1600", "--quiet"]) == 0
+    newest = sorted(p.name for p in (copy / "checkpoints").iterdir())[-1]
+    assert newest == "step_0000001600", newest
+    assert RunDir(copy).info().content_hash == recorded  # the run keeps the task it was started on
 
 
 @pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
