@@ -144,7 +144,9 @@ LANDMARKS: dict[str, Landmark] = {
     "left_cheek": Landmark("head", "the face's left side, 50° round from the front", _cheek(1.0)),
     "top_of_head": Landmark("head", "the top of the cranium (the crown of the head)", _top_of_head),
     "forehead": Landmark("head", "the front of the cranium 25° above its centre (above the brows)", _forehead),
-    "right_ear": Landmark("head", "the cranium's right side 20° below its centre (about the nose's height)", _ear(-1.0)),
+    "right_ear": Landmark(
+        "head", "the cranium's right side 20° below its centre (about the nose's height)", _ear(-1.0)
+    ),
     "left_ear": Landmark("head", "the cranium's left side 20° below its centre (about the nose's height)", _ear(1.0)),
     "right_palm": Landmark(
         "right_wrist", "the right hand's surface toward the body (the palm's centre at the zero pose)", _palm(1.0)

@@ -15,7 +15,11 @@ first rather than with the tool lying across the limb; with ``face_normal_level`
 vertical, for a wrist that only yaws), and may be approached along a straight line
 (``step_m``: IK aims at most that far ahead of the moved point) and turned slowly (``turn_step_rad``:
 the orientation IK aims at turns at most that far each step). A robot's own script may damp
-some arm joints in the IK (``ik_damping``, e.g. a slow shoulder). Works for any task and robot
+some arm joints in the IK (``ik_damping``, e.g. a slow shoulder). A waypoint's offset and
+orientation may be in a point's link frame (``frame``: they turn with that link, R_world =
+R_frame·R with R = Rz·Ry·Rx of its rpy), its offset may differ per person variant
+(``offset_by_variant``), and its lane may follow a person link's surface (``surface``: the goal and
+each look-ahead put on the link's shapes, :mod:`.surface_lane`). Works for any task and robot
 whose manifest has a ``scripted`` section.
 
 With ``trace=True`` it keeps a trace of its waypoint events (``run --trace``): each waypoint

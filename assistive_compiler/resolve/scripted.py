@@ -4,7 +4,9 @@ Checks that ``per_robot`` keys name known robots, that every ``{segment: NAME}``
 of ``scripted.segments`` (and none stands inside a segment), that no segment is empty and that each
 segment the spec file itself defines is used, that every ``move`` and waypoint ``to`` is a known
 point, that surface offsets (``normal_offset_m``, ``axis_offset_m``, ``face_normal_within_deg``) are
-used only with targets drawn on a surface, that ``face_normal_level`` comes with
+used only with targets drawn on a surface (or, but for ``axis_offset_m``, with ``along_surface_of``),
+that a waypoint's ``frame`` is a known point, its ``offset_by_variant`` names person variants and
+its ``along_surface_of`` a person link with a collision shape (whose shapes per variant it carries), that ``face_normal_level`` comes with
 ``face_normal_within_deg`` and that a robot's ``ik_damping`` names its acting arm joints. Produces
 this robot's script (its own ``per_robot`` one if it has it, else the task's; a two-arm robot's
 ``left`` part under ``"left"``), segments spliced in, with points resolved and angles in radians; a
@@ -180,9 +182,7 @@ def _waypoint(s: Scope, w: Waypoint, at: tuple, step_m: float | None) -> ScriptW
         normal_offset_m=w.normal_offset_m,
         axis_offset_m=w.axis_offset_m,
         rpy_rad=tuple(math.radians(a) for a in w.rpy_deg) if w.rpy_deg is not None else None,
-        face_normal_within_rad=math.radians(w.face_normal_within_deg)
-        if w.face_normal_within_deg is not None
-        else None,
+        face_normal_within_rad=math.radians(w.face_normal_within_deg) if w.face_normal_within_deg is not None else None,
         step_m=own_step,
         face_normal_level=w.face_normal_level,
         turn_step_rad=math.radians(w.turn_step_deg) if w.turn_step_deg is not None else None,
