@@ -47,7 +47,7 @@ from .person import (
     Tremor,
     Weakness,
 )
-from .programs import Script, ScriptWaypoint, Success, TermUse
+from .programs import FollowedSurface, Script, ScriptWaypoint, Success, SurfaceShape, TermUse
 from .robot import BasePose, BaseSearch, Drive, Mounted, Robot, StartState, ToolAttachment
 from .scene import Body, Camera, Container, Garment, MarkerSet, ParticleRest, ParticleSet, Sim, Target
 
@@ -65,6 +65,7 @@ __all__ = [
     "Event",
     "FORMAT_VERSION",
     "FloorFrictionEvent",
+    "FollowedSurface",
     "FurnitureNoiseEvent",
     "Garment",
     "Impairment",
@@ -88,6 +89,7 @@ __all__ = [
     "StartState",
     "Success",
     "SurfacePoint",
+    "SurfaceShape",
     "SurfaceTargetsEvent",
     "Target",
     "TermUse",

@@ -35,16 +35,41 @@ class Success(ArtifactModel):
     )
 
 
+class SurfaceShape(ArtifactModel):
+    """One collision shape of a followed link, in its link frame: a capsule from ``start`` to
+    ``end`` with ``radius`` (a sphere when they are equal)."""
+
+    start: Vec3 = Field(description="One end of the axis (a sphere's centre), link frame, m.")
+    end: Vec3 = Field(description="The other end (a sphere's centre again), link frame, m.")
+    radius: float = Field(description="Radius, m.")
+
+
+class FollowedSurface(ArtifactModel):
+    """The surface a waypoint's lane follows (``along_surface_of``): a person link's shapes per variant."""
+
+    link: LinkPoint = Field(description="The person link followed.")
+    shapes: dict[str, list[SurfaceShape]] = Field(description="Its collision shapes by person variant name.")
+    step_m: float = Field(description="Look-ahead along the surface per step, m.")
+
+
 class ScriptWaypoint(ArtifactModel):
     """One waypoint of the scripted baseline: where the moved point goes next (world frame, m)."""
 
     to: TargetPoint | LinkPoint = Field(description="The point it heads for.")
-    offset_m: Vec3 = Field(description="Offset from that point, world frame, m.")
+    offset_m: Vec3 = Field(description="Offset from that point, m, along the axes of frame (world when none).")
+    frame: TargetPoint | LinkPoint | None = Field(
+        None,
+        description="The point whose link frame offset_m, offset_by_variant and rpy_rad are in (none: world).",
+    )
+    offset_by_variant: dict[str, Vec3] = Field(
+        default_factory=dict, description="Per person-variant offsets replacing offset_m, m (same frame)."
+    )
+    surface: FollowedSurface | None = Field(None, description="The surface the lane to this waypoint follows.")
     tolerance_m: float = Field(description="Reached within this distance, m (0: never; a last waypoint to hold).")
     normal_offset_m: float = Field(0.0, description="Offset along a surface target's outward normal, m.")
     axis_offset_m: float = Field(0.0, description="Offset along a surface target's limb axis, m.")
     rpy_rad: Vec3 | None = Field(
-        description="Orientation of the end effector to hold (roll, pitch, yaw, rad), or none."
+        description="Orientation of the moved point's link to hold (roll, pitch, yaw, rad; R = Rz·Ry·Rx, in frame), or none."
     )
     face_normal_within_rad: float | None = Field(
         description="Turn the tool towards the surface normal by at most this much, rad, or none."

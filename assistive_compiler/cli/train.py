@@ -14,9 +14,12 @@ from pathlib import Path
 from ..run_dir import engine_modules
 from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, add_library_argument, require_extra
 
-SHIPPED_CONFIGS = (
-    "ppo_one_core, sac_laptop, sac_low_entropy, sac_demos, ppo_paper, ppo_laptop, ppo_quick, ppo_rllib_reference"
-)
+
+def shipped_configs() -> str:
+    """The shipped training configs by name (specs/training/*.yaml), for the help text."""
+    from ..paths import specs_dir
+
+    return ", ".join(sorted(p.stem for p in (specs_dir() / "training").glob("*.yaml")))
 
 
 def training_config_path(name: str) -> str:
@@ -101,7 +104,7 @@ def add_commands(sub) -> None:
     p.add_argument("spec", help="task spec file")
     p.add_argument("--robot", help="robot name (default: the spec's default robot)")
     p.add_argument(
-        "--config", required=True, help=f"training config: a file, or a shipped one by name ({SHIPPED_CONFIGS})"
+        "--config", required=True, help=f"training config: a file, or a shipped one by name ({shipped_configs()})"
     )
     p.add_argument(
         "--coop", action="store_true", help="co-optimisation: train the robot and the person (policies robot and human)"

@@ -1,4 +1,4 @@
-"""Named landmarks on the person: points such as the mouth, the chin or a palm, each on one link,
+"""Named landmarks on the person: points such as the mouth, the top of the head or a palm, each on one link,
 placed from that link's collision shapes so that it scales with every person variant.
 
 A spec uses one wherever it uses a point, as ``person.<landmark>`` (a waypoint's ``to``, a term's
@@ -77,6 +77,31 @@ def _cheek(sign: float) -> Callable[[LinkShapes], Vec3]:
     return offset
 
 
+def _cranium(shapes: LinkShapes) -> tuple[Vec3, float]:
+    """The head's larger sphere (the cranium; the smaller is the face and jaw)."""
+    return max(shapes.spheres, key=lambda s: s[1])
+
+
+def _top_of_head(s: LinkShapes) -> Vec3:
+    (cx, cy, cz), r = _cranium(s)
+    return (cx, cy, cz + r)
+
+
+def _forehead(s: LinkShapes) -> Vec3:
+    (cx, cy, cz), r = _cranium(s)
+    a = math.radians(25)  # up from the cranium's front, above the brows
+    return (cx, cy - r * math.cos(a), cz + r * math.sin(a))
+
+
+def _ear(sign: float) -> Callable[[LinkShapes], Vec3]:
+    def offset(s: LinkShapes) -> Vec3:
+        (cx, cy, cz), r = _cranium(s)
+        a = math.radians(20)  # down from the cranium's side, about the nose's height
+        return (cx + sign * r * math.cos(a), cy, cz - r * math.sin(a))
+
+    return offset
+
+
 def _hand(s: LinkShapes) -> tuple[Vec3, float]:
     return max(s.spheres, key=lambda sphere: sphere[1])
 
@@ -117,6 +142,12 @@ LANDMARKS: dict[str, Landmark] = {
     "nose": Landmark("head", "the front of the face 0.6 jaw radii above the mouth", _nose),
     "right_cheek": Landmark("head", "the face's right side, 50° round from the front", _cheek(-1.0)),
     "left_cheek": Landmark("head", "the face's left side, 50° round from the front", _cheek(1.0)),
+    "top_of_head": Landmark("head", "the top of the cranium (the crown of the head)", _top_of_head),
+    "forehead": Landmark("head", "the front of the cranium 25° above its centre (above the brows)", _forehead),
+    "right_ear": Landmark(
+        "head", "the cranium's right side 20° below its centre (about the nose's height)", _ear(-1.0)
+    ),
+    "left_ear": Landmark("head", "the cranium's left side 20° below its centre (about the nose's height)", _ear(1.0)),
     "right_palm": Landmark(
         "right_wrist", "the right hand's surface toward the body (the palm's centre at the zero pose)", _palm(1.0)
     ),

@@ -15,7 +15,11 @@ first rather than with the tool lying across the limb; with ``face_normal_level`
 vertical, for a wrist that only yaws), and may be approached along a straight line
 (``step_m``: IK aims at most that far ahead of the moved point) and turned slowly (``turn_step_rad``:
 the orientation IK aims at turns at most that far each step). A robot's own script may damp
-some arm joints in the IK (``ik_damping``, e.g. a slow shoulder). Works for any task and robot
+some arm joints in the IK (``ik_damping``, e.g. a slow shoulder). A waypoint's offset and
+orientation may be in a point's link frame (``frame``: they turn with that link, R_world =
+R_frame·R with R = Rz·Ry·Rx of its rpy), its offset may differ per person variant
+(``offset_by_variant``), and its lane may follow a person link's surface (``surface``: the goal and
+each look-ahead put on the link's shapes, :mod:`.surface_lane`). Works for any task and robot
 whose manifest has a ``scripted`` section.
 
 With ``trace=True`` it keeps a trace of its waypoint events (``run --trace``): each waypoint
@@ -34,6 +38,7 @@ from ..artifact import Script
 from ..ik_options import ik_damping, ik_limits
 from ..references import LinkPoint, TargetPoint
 from ..rotation import quat_about, quat_conj, quat_mul, quat_rotate, quat_towards, vec_angle
+from .surface_lane import onto_surface, shapes_of
 
 # face_normal_level: a level tool's pointing axis is at least the normal's elevation from the inward
 # normal whatever its yaw, so past 45° it meets the surface side first anyway and is not turned.
@@ -53,6 +58,15 @@ class _Track:
             for w in waypoints
         ]
         self.orientations = [pb.getQuaternionFromEuler(w.rpy_rad) if w.rpy_rad else None for w in waypoints]
+        # Offsets and orientations in a point's link frame (None: world), per-variant offsets, followed surfaces.
+        self.frames = [snap.point(w.frame) if w.frame is not None else None for w in waypoints]
+        self.variant_offsets = [{v: np.asarray(o) for v, o in w.offset_by_variant.items()} for w in waypoints]
+        self.surfaces = [
+            (snap.point(w.surface.link), {v: shapes_of(sh) for v, sh in w.surface.shapes.items()}, w.surface.step_m)
+            if w.surface is not None
+            else None
+            for w in waypoints
+        ]
         self.face_normal = [w.face_normal_within_rad for w in waypoints]
         self.face_level = [w.face_normal_level for w in waypoints]
         self.steps_m = [w.step_m for w in waypoints]
@@ -129,10 +143,29 @@ class ScriptedPolicy:
         self.arm_offset = 2 if env.drive else 0
 
     def _goal(self, track: _Track) -> tuple[np.ndarray, float]:
-        """The track's current waypoint position (world, m) and tolerance."""
-        to, offset, tol, along_normal, along_axis = track.waypoints[track.index]
+        """The track's current waypoint position (world, m) and tolerance: ``to`` plus the offset
+        (this variant's, along the frame's axes), then off a surface target along its normal and
+        limb, or put on the followed surface."""
+        k = track.index
+        to, offset, tol, along_normal, along_axis = track.waypoints[k]
         snap = self.env.snap
+        if track.variant_offsets[k]:
+            offset = track.variant_offsets[k].get(self.env.person_variant, offset)
+        if track.frames[k] is not None:
+            offset = quat_rotate(snap.orientation(track.frames[k]), offset)
+        if track.surfaces[k] is not None:
+            return self._on_surface(track, snap.position(to) + offset + along_axis * snap.axis(to))[0], tol
         return snap.position(to) + offset + along_normal * snap.normal(to) + along_axis * snap.axis(to), tol
+
+    def _on_surface(self, track: _Track, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``p`` (world) put on the current waypoint's followed surface, ``normal_offset_m`` off it,
+        and the surface's outward normal there (world, unit)."""
+        link, shapes, _ = track.surfaces[track.index]
+        snap = self.env.snap
+        pos, orn = snap.position(link), snap.orientation(link)
+        q, normal = onto_surface(shapes[self.env.person_variant], quat_rotate(quat_conj(orn), p - pos))
+        q = q + track.waypoints[track.index][3] * normal
+        return pos + quat_rotate(orn, q), quat_rotate(orn, normal)
 
     def _start_episode(self) -> None:
         snap = self.env.snap
@@ -214,21 +247,24 @@ class ScriptedPolicy:
                 track.aimed_orn = None
                 track.noted = set()
                 goal, tol = self._goal(track)
-            step = track.steps_m[track.index]
+            surface = track.surfaces[track.index]
+            step = surface[2] if surface is not None else track.steps_m[track.index]
             if step is not None:  # a straight line from where the point is: IK aims at most step_m ahead
                 here = env.snap.position(track.move)
                 ahead = goal - here
                 distance = float(np.linalg.norm(ahead))
                 if distance > step:
                     goal = here + ahead * (step / distance)
+            inward = -env.snap.normal(track.waypoints[track.index][0])
+            if surface is not None:  # the look-ahead put on the followed surface
+                goal, outward = self._on_surface(track, goal)
+                inward = -outward
             # End-effector pose that puts the moved point at the goal with the kept orientation.
             inv_pos, inv_orn = pb.invertTransform(*track.point_in_ee)
-            orn = track.orientations[track.index] or track.keep_orn
+            orn = self._orientation(track)
             if track.face_normal[track.index] is not None:
                 turn = self._yawing if track.face_level[track.index] else self._facing
-                orn = turn(
-                    track, orn, -env.snap.normal(track.waypoints[track.index][0]), track.face_normal[track.index]
-                )
+                orn = turn(track, orn, inward, track.face_normal[track.index])
             turn_step = track.turn_steps[track.index]
             if turn_step is not None:  # a slow turn: the orientation handed to IK moves at most turn_step_rad a step,
                 # from the tool's own orientation when the waypoint began (not from the lagging tool's, which a contact can stop)
@@ -244,6 +280,17 @@ class ScriptedPolicy:
             if self.drive_cols and track is self.tracks[0]:
                 action[:2] = self._wheels(sol, rest)
         return action
+
+    def _orientation(self, track: _Track) -> list[float]:
+        """The orientation the current waypoint asks of the moved point's link (world): its rpy in
+        its frame (R_world = R_frame·R), or the tool's start orientation."""
+        own = track.orientations[track.index]
+        if own is None:
+            return list(track.keep_orn)
+        frame = track.frames[track.index]
+        if frame is None:
+            return list(own)
+        return quat_mul(self.env.snap.orientation(frame), np.asarray(own)).tolist()
 
     def end_episode(self) -> None:
         """With ``trace``: note where each arm stands when the episode ends (call it after the

@@ -83,4 +83,19 @@ def test_an_unknown_person_point_lists_the_landmarks(tmp_path):
     with pytest.raises(SpecError) as info:
         resolve(load_spec(spec), "jaco")
     assert "unknown link 'lips' of person; " in str(info.value)
-    assert "landmarks: mouth, chin, nose, right_cheek, left_cheek, right_palm, left_palm" in str(info.value)
+    assert "landmarks: mouth, chin, nose, right_cheek, left_cheek, top_of_head, forehead, right_ear" in str(info.value)
+
+
+def test_head_landmarks_follow_each_variants_cranium():
+    """The top of the head, the forehead and the ears sit on each variant's own cranium (the head's
+    larger sphere: male_50th r 9.5 cm at z 10.4, female_50th r 8.8 cm at z 9.6)."""
+    for variant, (centre_z, r) in {"male_50th": (0.104, 0.095), "female_50th": (0.096, 0.088)}.items():
+        got = offsets(variant)
+        assert all(got[name][0] == "head" for name in ("top_of_head", "forehead", "right_ear", "left_ear"))
+        assert np.allclose(got["top_of_head"][1], (0.0, 0.0, centre_z + r), atol=2e-4), variant
+        for name in ("forehead", "right_ear", "left_ear"):  # on the cranium's surface
+            assert abs(np.linalg.norm(np.subtract(got[name][1], (0, 0, centre_z))) - r) < 2e-4, (variant, name)
+        forehead, right, left = got["forehead"][1], got["right_ear"][1], got["left_ear"][1]
+        assert forehead[1] < -0.07 and forehead[2] > got["nose"][1][2]  # in front, above the nose
+        assert right[0] < -0.08 < 0.08 < left[0] and right[1:] == left[1:]  # the sides, mirrored
+    assert offsets("female_50th")["top_of_head"][1][2] < offsets("male_50th")["top_of_head"][1][2]

@@ -74,7 +74,8 @@ def feeding_location(needle: str, offset: int = 0) -> str:
 
 
 LANDMARKS_TAIL = (
-    "; landmarks: mouth, chin, nose, right_cheek, left_cheek, right_palm, left_palm, right_fingertips, left_fingertips, "
+    "; landmarks: mouth, chin, nose, right_cheek, left_cheek, top_of_head, forehead, right_ear, left_ear, right_palm, "
+    "left_palm, right_fingertips, left_fingertips, "
     "right_heel, left_heel, right_toes, left_toes"
 )
 

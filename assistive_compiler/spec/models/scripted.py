@@ -18,13 +18,42 @@ from .common import Name, Ref, Strict, Vec3
 #: closer to in ``STALL_STEPS`` steps is given up (the next one starts).
 STALL_STEPS = 10
 STALL_PROGRESS_M = 0.002
+#: The look-ahead along a followed surface (``along_surface_of``) when a waypoint gives no ``step_m``, metres.
+SURFACE_STEP_M = 0.03
 
 
 class Waypoint(Strict):
     """A goal for the scripted controller: a point near a target, reached within a tolerance."""
 
     to: Ref = Field(description="Target or link the goal is relative to, e.g. mouth.")
-    offset_m: Vec3 = Field((0.0, 0.0, 0.0), description="Goal offset from that point, world frame, metres.")
+    frame: Ref = Field(
+        "world",
+        description="The frame offset_m, offset_by_variant and rpy_deg are given in: world (the default: x, y, z "
+        "of the world), or a point, i.e. a target (e.g. mouth), a person landmark (e.g. person.top_of_head) or a link "
+        "(e.g. person.head): that point's link frame, turning with the link, so a lane written in the head's frame "
+        "follows the head as it turns (a target's or landmark's frame is the frame of the link it is on; "
+        "docs/person.md: +x the person's left, -y their front, +z up at the zero pose). The offset still starts at "
+        "'to'; only its axes are the frame's.",
+    )
+    offset_m: Vec3 = Field(
+        (0.0, 0.0, 0.0),
+        description="Goal offset from 'to', metres, along the axes of 'frame' (world unless frame names a point).",
+    )
+    offset_by_variant: dict[Name, Vec3] = Field(
+        default_factory=dict,
+        description="Per person-variant offsets replacing offset_m for that variant (same frame as offset_m), "
+        "e.g. {female_50th: [0, 0, 0.088]} for a smaller head; a variant not listed uses offset_m.",
+    )
+    along_surface_of: Ref | None = Field(
+        None,
+        description="A person link with a collision shape (e.g. person.head) to follow: the goal is the point of "
+        "that link's surface nearest to 'to' plus the offset, moved normal_offset_m along the surface's outward "
+        "normal there (each person variant's own shapes), and on the way to it every look-ahead of step_m "
+        f"(default {SURFACE_STEP_M:g} m here) is put on the surface the same way, so the moved point slides along the surface "
+        "between the previous waypoint and this one (over a sphere, along a great circle) instead of cutting "
+        "through it. face_normal_within_deg then turns the tool towards the surface's inward normal at each "
+        "look-ahead. None: a straight line (or one IK jump).",
+    )
     tolerance_m: float = Field(
         0.02,
         ge=0,
@@ -53,7 +82,8 @@ class Waypoint(Strict):
         0.0,
         ge=-0.5,
         le=0.5,
-        description="Offset along the target's outward surface normal (targets drawn on a surface), metres.",
+        description="Offset along the outward surface normal, metres: of the target (targets drawn on a surface), "
+        "or of the surface followed (along_surface_of); negative presses into it.",
     )
     axis_offset_m: float = Field(
         0.0,
@@ -63,16 +93,18 @@ class Waypoint(Strict):
     )
     rpy_deg: Vec3 | None = Field(
         None,
-        description="Orientation of the moved point's link at this waypoint (roll, pitch, yaw; world, degrees), e.g. "
-        "to tilt a cup; None keeps the tool's start orientation.",
+        description="Orientation of the moved point's link at this waypoint, degrees: roll, pitch, yaw about fixed "
+        "axes x, then y, then z, i.e. R = Rz(yaw)·Ry(pitch)·Rx(roll) (pybullet's Euler convention), relative to "
+        "'frame' (world by default; in a link's frame the orientation turns with the link: R_world = R_frame·R), "
+        "e.g. to tilt a cup; None keeps the tool's start orientation.",
     )
     face_normal_within_deg: float | None = Field(
         None,
         ge=0,
         le=180,
         description="Turn the tool, by the smallest rotation from its start orientation, until its "
-        "pointing axis (from the end effector to the moved point) lies within this angle of the target's inward surface "
-        "normal (targets drawn on a surface), so the tool meets the surface tip first instead of lying across the limb; "
+        "pointing axis (from the end effector to the moved point) lies within this angle of the inward surface "
+        "normal (of a target drawn on a surface, or of the surface followed: along_surface_of), so the tool meets the surface tip first instead of lying across the limb; "
         "degrees. None keeps the start orientation (or rpy_deg's).",
     )
     face_normal_level: bool = Field(
