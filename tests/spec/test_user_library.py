@@ -102,6 +102,29 @@ def test_python_make_finds_the_same_parts(tmp_path, monkeypatch):
     env.close()
 
 
+def test_python_make_and_gym_make_share_one_artifact(tmp_path, monkeypatch):
+    """``assistive_compiler.make(spec)`` compiles into the artifact cache, the folder
+    ``gym.make("assistive_compiler/Task-v1", spec=...)`` uses, not into ``./generated`` of the
+    working directory: one spec, one artifact (issue 48, defect 6)."""
+    import gymnasium as gym
+
+    import assistive_compiler
+
+    project = write_project(tmp_path)
+    spec = project / "specs" / "tasks" / "long_scratch.yaml"
+    monkeypatch.setenv("ASSISTIVE_COMPILER_CACHE", str(tmp_path / "cache"))
+    monkeypatch.chdir(tmp_path)
+    env = assistive_compiler.make(spec, "jaco")
+    by_id = gym.make("assistive_compiler/Task-v1", spec=str(spec), robot="jaco")
+    try:
+        assert env.artifact_dir == by_id.unwrapped.artifact_dir
+        assert env.artifact_dir.parent == tmp_path / "cache" and not (tmp_path / "generated").exists()
+        assert env.manifest.content_hash == by_id.unwrapped.manifest.content_hash
+    finally:
+        env.close()
+        by_id.close()
+
+
 def test_a_part_name_in_two_libraries_is_an_error_naming_both_files(tmp_path):
     project = write_project(tmp_path)
     mine = project / "specs" / "tools" / "scratcher.yaml"
