@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import SpecError
 from ..pictures import check_picture_path, episode_frames, write_picture
 from ..rotation import quat_matrix
-from .common import EXIT_OK, add_library_argument, add_spec_arguments, make_env
+from .common import EXIT_OK, SPEC_HELP, add_library_argument, add_spec_arguments, make_env
 
 
 def control_hz(manifest) -> float:
@@ -152,7 +152,7 @@ def add_commands(sub) -> None:
 
     p = sub.add_parser("render-person", help="draw the person variants a spec declares, side by side (PNG)")
     add_library_argument(p)
-    p.add_argument("spec", help="task spec file")
+    p.add_argument("spec", help=SPEC_HELP)
     p.add_argument("--robot", help="robot to compile the task for (default: the spec's default)")
     p.add_argument("--out", required=True, help="output .png")
     p.add_argument("--out-dir", dest="out_dir", help="artifact directory")

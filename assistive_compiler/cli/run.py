@@ -166,12 +166,6 @@ def cmd_demo(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _default_feeding() -> Path:
-    from ..paths import display, specs_dir
-
-    return Path(display(specs_dir() / "tasks" / "feeding.yaml"))
-
-
 def add_commands(sub) -> None:
     from ..policies import HUMAN_POLICIES
 
@@ -209,7 +203,7 @@ def add_commands(sub) -> None:
 
     p = sub.add_parser("demo", help="the main job: compile Feeding for Jaco, run the scripted policy, write a picture")
     add_library_argument(p)
-    p.add_argument("--spec", default=str(_default_feeding()), help="task spec (default: the shipped feeding.yaml)")
+    p.add_argument("--spec", default="feeding", help="task spec (default: the shipped task feeding)")
     p.add_argument("--robot", default="jaco")
     p.add_argument("--episodes", type=int, default=3)
     p.add_argument("--seed", type=int, default=0)

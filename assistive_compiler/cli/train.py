@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 from ..run_dir import engine_modules
-from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, add_library_argument, require_extra
+from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, SPEC_HELP, add_library_argument, require_extra
 
 SHIPPED_CONFIGS = (
     "ppo_one_core, sac_laptop, sac_low_entropy, sac_demos, ppo_paper, ppo_laptop, ppo_quick, ppo_rllib_reference"
@@ -98,7 +98,7 @@ def add_commands(sub) -> None:
         "--demonstrations, the averaged actor, layer-normalised or conservative critics.",
     )
     add_library_argument(p)
-    p.add_argument("spec", help="task spec file")
+    p.add_argument("spec", help=SPEC_HELP)
     p.add_argument("--robot", help="robot name (default: the spec's default robot)")
     p.add_argument(
         "--config", required=True, help=f"training config: a file, or a shipped one by name ({SHIPPED_CONFIGS})"
