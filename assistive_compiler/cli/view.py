@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .common import EXIT_FAILED, add_artifact_argument, add_spec_arguments
+from .common import EXIT_BAD_INPUT, EXIT_FAILED, add_artifact_argument, add_spec_arguments
 
 
 def cmd_view(args: argparse.Namespace) -> int:
@@ -25,10 +25,20 @@ def cmd_view(args: argparse.Namespace) -> int:
     def ready(url: str) -> None:
         print(f"viewing {args.spec} at {url}  (Ctrl-C to stop)", flush=True)
 
+    if args.coop and args.replay:
+        print("view: --coop plays an episode with the person acting; a --replay shows a recorded one", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    human_policy = None
+    if args.coop:
+        from .run import _check_human_policy, _default_human_policy
+
+        human_policy = args.human_policy or _default_human_policy(args.policy or "scripted")
+        _check_human_policy(human_policy)
     status = view(
         args.spec,
         args.robot,
         policy=args.policy,
+        human_policy=human_policy,
         replay=args.replay,
         seed=args.seed,
         out=args.out,
@@ -62,4 +72,7 @@ def add_commands(sub) -> None:
         "--gui", action="store_true", help="pybullet's own GUI window instead of the browser (needs a display)"
     )
     add_artifact_argument(p)
+    from .render import add_coop_arguments
+
+    add_coop_arguments(p)
     p.set_defaults(func=cmd_view)
