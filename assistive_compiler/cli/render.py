@@ -15,7 +15,8 @@ import numpy as np
 from ..errors import SpecError
 from ..pictures import check_picture_path, episode_frames, write_picture
 from ..rotation import quat_matrix
-from .common import EXIT_OK, SPEC_HELP, add_library_argument, add_spec_arguments, make_env
+from .common import EXIT_BAD_INPUT, EXIT_OK, SPEC_HELP, add_library_argument, add_spec_arguments, make_env
+from .run import TRACE_HELP, trace_fits, trace_lines
 
 
 def control_hz(manifest) -> float:
@@ -46,6 +47,8 @@ def parse_camera(text: str | None) -> dict | None:
 
 
 def cmd_render(args: argparse.Namespace) -> int:
+    if not trace_fits("render", args):
+        return EXIT_BAD_INPUT
 
     out = Path(args.out)
     check_picture_path(out)
@@ -54,14 +57,22 @@ def cmd_render(args: argparse.Namespace) -> int:
         args.spec, args.robot, args.out_dir, render_mode="rgb_array", render_size=(args.width, args.height), camera=view
     )
     env.show_frames = args.frames
-    target, act = _player(args, env)
+    if args.trace:  # the scripted policy noting its waypoint events (reading only: the same episode)
+        from ..policies import make_policy
+
+        target, act = env, make_policy("scripted", env, seed=args.seed, trace=True)
+    else:
+        target, act = _player(args, env)
     frames, summary = episode_frames(target, act, args.seed, args.every)
     fps = args.fps or control_hz(env.manifest) / args.every
+    trace = trace_lines(act, args.seed) if args.trace else []  # where the episode ended: read before closing
     env.close()
     write_picture(frames, out, fps=fps)
     print(
         f"wrote {args.out} ({len(frames)} frames at {fps:g} fps; return {summary['return']:.1f}, success {'yes' if summary['success'] else 'no'})"
     )
+    if trace:
+        print("\n".join(trace))
     return EXIT_OK
 
 
@@ -183,6 +194,7 @@ def add_commands(sub) -> None:
         help="draw the end effector's, tools' and targets' frames (x red, y green, z blue, 6 cm) with their names",
     )
     add_coop_arguments(p)
+    p.add_argument("--trace", action="store_true", help=TRACE_HELP + ", after the picture")
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("render-person", help="draw the person variants a spec declares, side by side (PNG)")

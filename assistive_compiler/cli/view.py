@@ -25,8 +25,12 @@ def cmd_view(args: argparse.Namespace) -> int:
     def ready(url: str) -> None:
         print(f"viewing {args.spec} at {url}  (Ctrl-C to stop)", flush=True)
 
-    if args.coop and args.replay:
-        print("view: --coop plays an episode with the person acting; a --replay shows a recorded one", file=sys.stderr)
+    from .run import trace_fits
+
+    if not trace_fits("view", args):
+        return EXIT_BAD_INPUT
+    if (args.coop or args.trace) and args.replay:
+        print("view: --coop and --trace play an episode; a --replay shows a recorded one", file=sys.stderr)
         return EXIT_BAD_INPUT
     human_policy = None
     if args.coop:
@@ -39,6 +43,7 @@ def cmd_view(args: argparse.Namespace) -> int:
         args.robot,
         policy=args.policy,
         human_policy=human_policy,
+        trace=args.trace,
         replay=args.replay,
         seed=args.seed,
         out=args.out,
@@ -75,4 +80,7 @@ def add_commands(sub) -> None:
     from .render import add_coop_arguments
 
     add_coop_arguments(p)
+    from .run import TRACE_HELP
+
+    p.add_argument("--trace", action="store_true", help=TRACE_HELP + ", for each episode it plays")
     p.set_defaults(func=cmd_view)

@@ -29,11 +29,13 @@ class EpisodePlayer:
     """Plays one episode of an env with a named policy and returns its recording (headless). A
     co-optimised pair, or any policy with a ``human_policy``, plays both agents (the person acts)."""
 
-    def __init__(self, env, policy_name: str, seed: int, human_policy: str | None = None):
-        from ..policies import make_player
+    def __init__(self, env, policy_name: str, seed: int, human_policy: str | None = None, trace: bool = False):
+        from ..policies import make_player, make_policy
 
-        self.env, self.policy_name, self.pair = env, policy_name, None
-        if human_policy is not None:
+        self.env, self.policy_name, self.pair, self.trace = env, policy_name, None, trace
+        if trace:  # the scripted policy notes its waypoint events; play() prints them
+            self.policy = make_policy(policy_name, env, seed=seed, trace=True)
+        elif human_policy is not None:
             from ..coop.policies import pair_policy
 
             self.pair = pair_policy(env, policy_name, human_policy, seed)
@@ -50,9 +52,14 @@ class EpisodePlayer:
 
         options = {"person_variant": variant} if variant else None
         if self.pair is None:
-            return record_episode(
+            recording = record_episode(
                 self.env, self.policy, seed, self._dir.name, policy_name=self.policy_name, options=options
             )
+            if self.trace:
+                self.policy.end_episode()
+                lines = [f"  {event['line']}" for event in self.policy.trace]
+                print("\n".join([f"trace of the episode (seed {seed}):", *lines]), flush=True)
+            return recording
         from ..policies.pair import both_agents
 
         recorder = RecordEpisodes(self.env, self._dir.name, policy=self.policy_name)
