@@ -26,15 +26,21 @@ def compile_task(spec_path, robot=None, out_dir=None, **kwargs):
     return _compile(spec_path, robot, out_dir, **kwargs)
 
 
-def make(spec, robot=None, library=None, **kwargs):
+def make(spec, robot=None, library=None, out_dir=None, **kwargs):
     """A Gymnasium env for the task spec at ``spec`` (a path) and ``robot``.
+
+    It compiles into the artifact cache, the folder ``gym.make("assistive_compiler/Task-v1",
+    spec=spec, robot=robot)`` uses (``$ASSISTIVE_COMPILER_CACHE``), so one spec has one artifact
+    whichever way it is made; ``out_dir`` compiles into a folder of your choice instead.
 
     Parts and templates are found in ``library`` (a list of directories laid out like ``specs/``),
     then ``$ASSISTIVE_COMPILER_LIBRARY``, then the spec's own library (``<root>`` of a spec at
     ``<root>/tasks/<name>.yaml``), then the shipped parts; see :mod:`assistive_compiler.library`."""
+    from .registration import cached_artifact_dir
     from .runtime.env import AssistiveEnv
 
-    return AssistiveEnv.from_spec(spec, robot=robot, library=library, **kwargs)
+    out = out_dir if out_dir is not None else cached_artifact_dir(spec, robot)
+    return AssistiveEnv.from_spec(spec, robot=robot, out_dir=out, library=library, **kwargs)
 
 
 def parallel_env(spec, robot=None, render_mode=None, out_dir=None, **kwargs):

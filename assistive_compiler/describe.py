@@ -17,12 +17,19 @@ from .rotation import quat_matrix
 AXES = "xyz"
 
 
+AXIS_NAMED_WITHIN_DEG = 0.5
+"""A frame axis is named (``+x``) only within this angle of a world axis; further off, its
+components show the turn (a head turned 4.6° reads ``(1.00, -0.08, 0.00)``, not ``+x``)."""
+
+_NAMED_COS = float(np.cos(np.radians(AXIS_NAMED_WITHIN_DEG)))
+
+
 def axis_direction(vector) -> str:
-    """A unit vector in words: ``+x``, ``-z`` when it lies within ~18° of a world axis, else its
-    components (``(0.71, 0.00, -0.71)``)."""
+    """A unit vector in words: ``+x``, ``-z`` when it lies within :data:`AXIS_NAMED_WITHIN_DEG`
+    (0.5°) of a world axis, else its components (``(0.71, 0.00, -0.71)``)."""
     v = np.asarray(vector, dtype=float)
     k = int(np.argmax(np.abs(v)))
-    if abs(v[k]) >= 0.95:
+    if abs(v[k]) >= _NAMED_COS:
         return f"{'+' if v[k] > 0 else '-'}{AXES[k]}"
     return "(" + ", ".join(f"{c:.2f}" for c in v) + ")"
 

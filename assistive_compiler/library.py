@@ -312,6 +312,12 @@ class Library:
         return {kind: self.names(kind) for kind in KINDS}
 
 
+def is_shipped(path: Path) -> bool:
+    """Whether ``path`` is one of the shipped specs (inside the package, or the checkout's
+    ``specs/``): a file to copy into a library, never to edit."""
+    return Path(path).resolve().is_relative_to(specs_dir().resolve())
+
+
 def env_library_dirs() -> list[Path]:
     """The directories named by ``$ASSISTIVE_COMPILER_LIBRARY`` (empty entries skipped)."""
     return [Path(p) for p in os.environ.get(LIBRARY_ENV, "").split(os.pathsep) if p.strip()]

@@ -31,7 +31,9 @@ def cached_artifact_dir(spec: str | Path, robot: str | None) -> Path:
     of the same file name do not take turns recompiling one folder."""
     import hashlib
 
-    path = Path(spec).resolve()
+    from .spec.load import spec_path
+
+    path = spec_path(spec).resolve()  # a shipped task's name or shipped:tasks/<file> too
     label = robot or "default"
     if path.parent == (specs_dir() / "tasks").resolve():
         return cache_dir() / f"{path.stem}-{label}"

@@ -32,7 +32,7 @@ from collections.abc import Callable, Sequence
 
 from ..errors import SpecError, UsageError
 from . import bench, collect, compare, describe, evaluate, render, results, run, spec_commands, table, train, view
-from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, print_problems, use_library_dirs
+from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, print_problems, spec_from_gym_id, use_library_dirs
 
 COMMAND_MODULES = (spec_commands, run, render, describe, bench, compare, view, collect, train, evaluate, table, results)
 
@@ -53,6 +53,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     func: Callable[[argparse.Namespace], int] = args.func
     try:
         use_library_dirs(getattr(args, "library", []))
+        spec_from_gym_id(args)
         return func(args)
     except SpecError as exc:
         print_problems(exc)

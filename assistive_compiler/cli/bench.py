@@ -533,7 +533,12 @@ def add_commands(sub) -> None:
         help="speed figures taken in one run: steps/s vs raw physics and the reference, resets, compile, import, RSS",
     )
     add_library_argument(p)
-    p.add_argument("specs", nargs="+", metavar="spec", help="task spec file(s); several print one row each")
+    p.add_argument(
+        "specs",
+        nargs="+",
+        metavar="spec",
+        help="task spec file(s) or shipped task names (feeding); several print one row each",
+    )
     p.add_argument(
         "--robot",
         action="append",

@@ -54,12 +54,37 @@ def use_library_dirs(dirs: list[str]) -> None:
         os.environ[LIBRARY_ENV] = os.pathsep.join([str(Path(d).resolve()) for d in dirs] + current)
 
 
+SPEC_HELP = (
+    "task spec: a file, a shipped task's name (feeding; `list` shows them), shipped:tasks/<name>.yaml, "
+    "or a Gymnasium id (FeedingJaco-v1: the task and its robot)"
+)
+
+
+def spec_from_gym_id(args: argparse.Namespace) -> None:
+    """A Gymnasium id given as the spec (``assistive_compiler/FeedingJaco-v1`` or ``FeedingJaco-v1``)
+    names the shipped task's file and its robot: ``args.spec`` becomes ``shipped:tasks/<file>``
+    and ``args.robot`` its robot (a different ``--robot`` is a usage error)."""
+    from ..errors import UsageError
+    from ..gym_ids import NAMESPACE, shipped_ids
+
+    spec = getattr(args, "spec", None)
+    if not isinstance(spec, str) or not spec.endswith("-v1") or Path(spec).exists():
+        return
+    found = shipped_ids().get(spec if spec.startswith(f"{NAMESPACE}/") else f"{NAMESPACE}/{spec}")
+    if found is None:
+        return
+    path, robot = found
+    if getattr(args, "robot", None) not in (None, robot):
+        raise UsageError(f"{spec} is the task for robot '{robot}', but --robot is '{args.robot}'; give one of them")
+    args.spec, args.robot = f"shipped:tasks/{path.name}", robot
+
+
 def add_spec_arguments(p: argparse.ArgumentParser, policy: bool = True) -> None:
     """``spec``, ``--robot``, ``--policy`` (optional), ``--seed`` and ``--library``: what a rollout command needs."""
     from ..policies import POLICY_HELP
 
     add_library_argument(p)
-    p.add_argument("spec", help="task spec file")
+    p.add_argument("spec", help=SPEC_HELP)
     p.add_argument("--robot", help="robot (default: the spec's default)")
     if policy:
         p.add_argument("--policy", default="scripted", help=f"policy to roll out: {POLICY_HELP} (default scripted)")

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..artifact import BaseSearch, Mounted
 from ..episode import rollout
-from .common import EXIT_OK, add_artifact_argument, add_library_argument
+from .common import EXIT_OK, SPEC_HELP, add_artifact_argument, add_library_argument
 
 COLUMNS = ("robot", "placement", "goals_reached", "jlwki", "compile_s", "success", "return")
 #: ``--policy pretrained``: each robot plays its own shipped policy, ``pretrained:<task>-<robot>``.
@@ -149,7 +149,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
 def add_commands(sub) -> None:
     p = sub.add_parser("compare", help="compile a task for several robots and compare placement and scripted results")
     add_library_argument(p)
-    p.add_argument("spec", help="task spec file")
+    p.add_argument("spec", help=SPEC_HELP)
     p.add_argument("--robots", required=True, help="comma-separated robot names, e.g. pr2,jaco,baxter,sawyer,panda")
     p.add_argument("--episodes", type=int, default=10, help="episodes per robot")
     p.add_argument(

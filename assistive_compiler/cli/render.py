@@ -15,7 +15,8 @@ import numpy as np
 from ..errors import SpecError
 from ..pictures import check_picture_path, episode_frames, write_picture
 from ..rotation import quat_matrix
-from .common import EXIT_OK, add_library_argument, add_spec_arguments, make_env
+from .common import EXIT_BAD_INPUT, EXIT_OK, SPEC_HELP, add_library_argument, add_spec_arguments, make_env
+from .run import TRACE_HELP, trace_fits, trace_lines
 
 
 def control_hz(manifest) -> float:
@@ -46,7 +47,8 @@ def parse_camera(text: str | None) -> dict | None:
 
 
 def cmd_render(args: argparse.Namespace) -> int:
-    from ..policies import make_player
+    if not trace_fits("render", args):
+        return EXIT_BAD_INPUT
 
     out = Path(args.out)
     check_picture_path(out)
@@ -55,15 +57,58 @@ def cmd_render(args: argparse.Namespace) -> int:
         args.spec, args.robot, args.out_dir, render_mode="rgb_array", render_size=(args.width, args.height), camera=view
     )
     env.show_frames = args.frames
-    target, act = make_player(args.policy, env, seed=args.seed)  # a co-optimised pair: the person acts too
+    if args.trace:  # the scripted policy noting its waypoint events (reading only: the same episode)
+        from ..policies import make_policy
+
+        target, act = env, make_policy("scripted", env, seed=args.seed, trace=True)
+    else:
+        target, act = _player(args, env)
     frames, summary = episode_frames(target, act, args.seed, args.every)
     fps = args.fps or control_hz(env.manifest) / args.every
+    trace = trace_lines(act, args.seed) if args.trace else []  # where the episode ended: read before closing
     env.close()
     write_picture(frames, out, fps=fps)
     print(
         f"wrote {args.out} ({len(frames)} frames at {fps:g} fps; return {summary['return']:.1f}, success {'yes' if summary['success'] else 'no'})"
     )
+    if trace:
+        print("\n".join(trace))
     return EXIT_OK
+
+
+def _player(args: argparse.Namespace, env):
+    """``(target, act)`` that plays ``--policy``: under ``--coop`` the person acts too, by
+    ``--human-policy`` (default: a co-optimised pair's own person, else random); a co-optimised
+    pair plays both agents either way."""
+    from ..policies import make_player
+
+    if not args.coop:
+        return make_player(args.policy, env, seed=args.seed)
+    from ..coop.policies import pair_policy
+    from ..policies.pair import both_agents
+    from .run import _check_human_policy, _default_human_policy
+
+    args.human_policy = args.human_policy or _default_human_policy(args.policy)
+    _check_human_policy(args.human_policy)
+    return both_agents(env, pair_policy(env, args.policy, args.human_policy, args.seed))
+
+
+def add_coop_arguments(p: argparse.ArgumentParser) -> None:
+    """``--coop`` and ``--human-policy``, as ``run`` has them: the person acts too."""
+    from ..policies import HUMAN_POLICIES
+
+    p.add_argument(
+        "--coop",
+        action="store_true",
+        help="co-optimisation: the person acts too, by --human-policy (a co-optimised pair plays both agents anyway)",
+    )
+    p.add_argument(
+        "--human-policy",
+        dest="human_policy",
+        default=None,
+        help=f"with --coop: {', '.join(HUMAN_POLICIES)}, or a co-optimised pair (pretrained:<task>-<robot>-coop...); "
+        "default: the pair's own person when --policy is one, else random",
+    )
 
 
 def render_people(artifact_dir: Path, width: int = 360, height: int = 480) -> np.ndarray:
@@ -148,11 +193,13 @@ def add_commands(sub) -> None:
         action="store_true",
         help="draw the end effector's, tools' and targets' frames (x red, y green, z blue, 6 cm) with their names",
     )
+    add_coop_arguments(p)
+    p.add_argument("--trace", action="store_true", help=TRACE_HELP + ", after the picture")
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("render-person", help="draw the person variants a spec declares, side by side (PNG)")
     add_library_argument(p)
-    p.add_argument("spec", help="task spec file")
+    p.add_argument("spec", help=SPEC_HELP)
     p.add_argument("--robot", help="robot to compile the task for (default: the spec's default)")
     p.add_argument("--out", required=True, help="output .png")
     p.add_argument("--out-dir", dest="out_dir", help="artifact directory")

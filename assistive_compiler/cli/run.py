@@ -44,6 +44,31 @@ def _check_human_policy(name: str) -> None:
         load_trained(name)
 
 
+TRACE_HELP = (
+    "with --policy scripted: print each waypoint event (reached within tolerance_m, stalled, where the "
+    "episode ended) with its goal (world, m), the distance left and what the robot and its tools touch"
+)
+
+
+def trace_fits(command: str, args: argparse.Namespace) -> bool:
+    """Whether ``--trace`` (if given) can follow the policy: the scripted one, robot alone; says why not."""
+    policy = getattr(args, "policy", None) or "scripted"
+    if args.trace and (policy != "scripted" or args.coop):
+        print(
+            f"{command}: --trace follows the scripted policy's waypoints; it needs --policy scripted"
+            f"{' without --coop' if args.coop else f' (not {policy})'}",
+            file=sys.stderr,
+        )
+        return False
+    return True
+
+
+def trace_lines(policy, seed: int | None) -> list[str]:
+    """The scripted ``policy``'s trace of the episode just played (seed ``seed``), as printed."""
+    policy.end_episode()
+    return [f"trace of the episode (seed {seed}):", *(f"  {event['line']}" for event in policy.trace)]
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     from ..policies import make_policy
     from .output import print_table, progress
@@ -51,12 +76,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.coop and args.record:
         print("run: --record writes single-agent episodes; it cannot be combined with --coop", file=sys.stderr)
         return EXIT_BAD_INPUT
-    if args.trace and (args.policy != "scripted" or args.coop):
-        print(
-            f"run: --trace follows the scripted policy's waypoints; it needs --policy scripted"
-            f"{' without --coop' if args.coop else f' (not {args.policy})'}",
-            file=sys.stderr,
-        )
+    if not trace_fits("run", args):
         return EXIT_BAD_INPUT
     if args.coop:  # both agents act (co-optimisation); the person by --human-policy
         from ..coop import parallel_env, rollout_coop
@@ -166,12 +186,6 @@ def cmd_demo(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _default_feeding() -> Path:
-    from ..paths import display, specs_dir
-
-    return Path(display(specs_dir() / "tasks" / "feeding.yaml"))
-
-
 def add_commands(sub) -> None:
     from ..policies import HUMAN_POLICIES
 
@@ -181,13 +195,7 @@ def add_commands(sub) -> None:
     add_artifact_argument(p)
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
-    p.add_argument(
-        "--trace",
-        action="store_true",
-        help="with --policy scripted: print each waypoint event (reached within tolerance_m, stalled, where the "
-        "episode ended) with its goal (world, m), the distance left and what the robot and its tools touch "
-        "(with --json: each episode's 'trace' list)",
-    )
+    p.add_argument("--trace", action="store_true", help=TRACE_HELP + " (with --json: each episode's 'trace' list)")
     p.add_argument(
         "--coop", action="store_true", help="co-optimisation: the person acts too (by --human-policy), shared reward"
     )
@@ -209,7 +217,7 @@ def add_commands(sub) -> None:
 
     p = sub.add_parser("demo", help="the main job: compile Feeding for Jaco, run the scripted policy, write a picture")
     add_library_argument(p)
-    p.add_argument("--spec", default=str(_default_feeding()), help="task spec (default: the shipped feeding.yaml)")
+    p.add_argument("--spec", default="feeding", help="task spec (default: the shipped task feeding)")
     p.add_argument("--robot", default="jaco")
     p.add_argument("--episodes", type=int, default=3)
     p.add_argument("--seed", type=int, default=0)

@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 from ..errors import SpecError
-from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, add_library_argument, print_problems
+from .common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, SPEC_HELP, add_library_argument, print_problems
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
@@ -107,15 +107,24 @@ def cmd_schema(args: argparse.Namespace) -> int:
 
 
 def cmd_list(args: argparse.Namespace) -> int:
+    """The shipped tasks by the names that work from any directory (``run feeding``, the ids);
+    the folder holding their files is said once, for copying or ``extends: shipped:tasks/...``."""
     from ..gym_ids import shipped_tasks
-    from ..paths import display
+    from ..paths import specs_dir
 
     tasks = shipped_tasks()
     if args.json:
         print(
             json.dumps(
                 [
-                    {"task": t.name, "title": t.title, "spec": display(t.spec), "robots": t.robots, "ids": t.ids}
+                    {
+                        "task": t.name,
+                        "title": t.title,
+                        "spec": f"shipped:tasks/{t.spec.name}",
+                        "file": str(t.spec),
+                        "robots": t.robots,
+                        "ids": t.ids,
+                    }
                     for t in tasks
                 ],
                 indent=2,
@@ -126,27 +135,32 @@ def cmd_list(args: argparse.Namespace) -> int:
 
     robots = sorted({r for t in tasks for r in t.robots})
     print(
-        f"{len(tasks)} tasks x {len(robots)} robots ({', '.join(robots)}); Gymnasium ids (gymnasium.make after import assistive_compiler):"
+        f"{len(tasks)} tasks x {len(robots)} robots ({', '.join(robots)}). Name a task by its name from any directory "
+        f"(assistive-compiler run {tasks[0].name} --robot {tasks[0].robots[0]}), in a spec as shipped:tasks/<name>.yaml "
+        "(extends:), or by its Gymnasium id (gymnasium.make after import assistive_compiler, or on the command line):"
     )
     rows, ends = [], []
     for t in tasks:
         for k, (robot, env_id) in enumerate(zip(t.robots, t.ids)):
-            rows.append([f"{t.title} ({t.name})" if k == 0 else "", display(t.spec) if k == 0 else "", robot, env_id])
+            rows.append([f"{t.title}" if k == 0 else "", t.name if k == 0 else "", robot, env_id])
         ends.append(len(rows) - 1)
-    columns = ["task", "spec", "robot", "Gymnasium id"]
+    columns = ["task", "name", "robot", "Gymnasium id"]
     print_table(columns, rows, left=columns, section_after=ends[:-1])
+    print(f"(the spec files, to read or copy: {specs_dir() / 'tasks'})")
     return EXIT_OK
 
 
 def add_commands(sub) -> None:
     p = sub.add_parser("validate", help="check task specs; print PATH:LINE:COL: problem for each mistake")
     add_library_argument(p)
-    p.add_argument("paths", nargs="+", help="task spec files")
+    p.add_argument(
+        "paths", nargs="+", help="task spec files, or shipped task names (feeding) or shipped:tasks/<name>.yaml"
+    )
     p.set_defaults(func=cmd_validate)
 
     p = sub.add_parser("compile", help="compile a task spec for a robot into URDFs and a manifest")
     add_library_argument(p)
-    p.add_argument("spec", help="task spec file")
+    p.add_argument("spec", help=SPEC_HELP)
     p.add_argument("--robot", help="robot name (default: the spec's default robot)")
     p.add_argument(
         "--out",

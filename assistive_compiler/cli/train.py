@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 from ..run_dir import engine_modules
-from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, add_library_argument, require_extra
+from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, SPEC_HELP, add_library_argument, require_extra
 
 
 def shipped_configs() -> str:
@@ -101,7 +101,7 @@ def add_commands(sub) -> None:
         "--demonstrations, the averaged actor, layer-normalised or conservative critics.",
     )
     add_library_argument(p)
-    p.add_argument("spec", help="task spec file")
+    p.add_argument("spec", help=SPEC_HELP)
     p.add_argument("--robot", help="robot name (default: the spec's default robot)")
     p.add_argument(
         "--config", required=True, help=f"training config: a file, or a shipped one by name ({shipped_configs()})"

@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .common import EXIT_FAILED, add_artifact_argument, add_spec_arguments
+from .common import EXIT_BAD_INPUT, EXIT_FAILED, add_artifact_argument, add_spec_arguments
 
 
 def cmd_view(args: argparse.Namespace) -> int:
@@ -25,10 +25,25 @@ def cmd_view(args: argparse.Namespace) -> int:
     def ready(url: str) -> None:
         print(f"viewing {args.spec} at {url}  (Ctrl-C to stop)", flush=True)
 
+    from .run import trace_fits
+
+    if not trace_fits("view", args):
+        return EXIT_BAD_INPUT
+    if (args.coop or args.trace) and args.replay:
+        print("view: --coop and --trace play an episode; a --replay shows a recorded one", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    human_policy = None
+    if args.coop:
+        from .run import _check_human_policy, _default_human_policy
+
+        human_policy = args.human_policy or _default_human_policy(args.policy or "scripted")
+        _check_human_policy(human_policy)
     status = view(
         args.spec,
         args.robot,
         policy=args.policy,
+        human_policy=human_policy,
+        trace=args.trace,
         replay=args.replay,
         seed=args.seed,
         out=args.out,
@@ -62,4 +77,10 @@ def add_commands(sub) -> None:
         "--gui", action="store_true", help="pybullet's own GUI window instead of the browser (needs a display)"
     )
     add_artifact_argument(p)
+    from .render import add_coop_arguments
+
+    add_coop_arguments(p)
+    from .run import TRACE_HELP
+
+    p.add_argument("--trace", action="store_true", help=TRACE_HELP + ", for each episode it plays")
     p.set_defaults(func=cmd_view)

@@ -19,7 +19,7 @@ the limp arm squeezes the scooper against the bed; held by the constraint the sc
 17 mm into it (max penetration 17 mm against 3.5 mm welded), and the scripted policy succeeds on 15
 of 20 seeds against 6 welded. The spoon's food and the cup's water rest in theirs (and against a
 link deep in the arm's chain Feeding's step was slower, 0.93×). A tool also stays free when its
-gravity differs from the robot's (a link feels its body's gravity), when a link or joint name of
+gravity differs from the robot's (a link feels its body's gravity) or its friction is set, when a link or joint name of
 it is also the robot's, and in a task with a garment (below).
 
 **Fixed links merged.** A robot's URDF keeps many links on fixed joints that the simulation pays
@@ -95,6 +95,8 @@ def _weldable(manifest: Manifest, att: ToolAttachment, robot: ET.Element, tool: 
         if movable and body.gravity != 0.0:
             return False
     if manifest.body(att.body).gravity != manifest.body("robot").gravity:
+        return False
+    if manifest.body(att.body).friction is not None:  # its own friction: a link of the robot would have the robot's
         return False
     names = {e.get("name") for e in robot if e.tag in ("link", "joint")}
     return not names & {e.get("name") for e in tool if e.tag in ("link", "joint")} and f"{att.body}_grip" not in names

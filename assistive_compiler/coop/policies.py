@@ -58,6 +58,26 @@ def agent_policy(env, agent: str, policy: Any, seed: int = 0) -> Policy:
     )
 
 
+def pair_policy(env, robot_policy: Any, human_policy: Any, seed: int = 0):
+    """``(robot_obs, human_obs) -> (robot_action, human_action)``: ``robot_policy`` and
+    ``human_policy`` (as :func:`agent_policy` takes them) in the single-agent ``env`` (an
+    :class:`~assistive_compiler.runtime.env.AssistiveEnv`), the form a co-optimised pair has, so
+    that the single-agent tools (``render``, ``view``'s recording; :func:`~assistive_compiler.policies.pair.both_agents`)
+    play both agents."""
+    from types import SimpleNamespace
+
+    from ..errors import UsageError
+
+    if env.human_action_space is None:
+        raise UsageError(
+            "--coop: the person of this task has no policy joints (person.control.policy_joints), so it cannot act"
+        )
+    spaces = {"robot": env.action_space, "human": env.human_action_space}
+    agents = SimpleNamespace(env=env, action_space=spaces.__getitem__)
+    robot, human = agent_policy(agents, "robot", robot_policy, seed), agent_policy(agents, "human", human_policy, seed)
+    return lambda robot_obs, human_obs: (robot(robot_obs), human(human_obs))
+
+
 def _is_trained(source: str) -> bool:
     from pathlib import Path
 

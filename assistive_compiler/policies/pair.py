@@ -17,7 +17,7 @@ class BothAgents:
         return getattr(self.env, name)
 
     def robot_action(self, obs):
-        a_robot, self.human_action = self.policy(obs, self.env.observe_human())
+        a_robot, self.human_action = self.policy(obs, self.env.unwrapped.observe_human())
         return a_robot
 
     def step(self, a_robot):

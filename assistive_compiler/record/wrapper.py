@@ -51,6 +51,17 @@ class RecordEpisodes(gym.Wrapper):
 
     def step(self, action):
         obs, reward, terminated, truncated, info = self.env.step(action)
+        self._record(obs, action, reward, terminated, truncated, info)
+        return obs, reward, terminated, truncated, info
+
+    def step_agents(self, robot_action, human_action):
+        """One step of both agents (the env's ``step_agents``: co-optimisation), recorded as
+        :meth:`step` records the robot's; returns what ``step_agents`` does."""
+        obs, human_obs, reward, terminated, truncated, info = self.env.unwrapped.step_agents(robot_action, human_action)
+        self._record(obs, robot_action, reward, terminated, truncated, info)
+        return obs, human_obs, reward, terminated, truncated, info
+
+    def _record(self, obs, action, reward, terminated, truncated, info) -> None:
         if self._rows is not None:
             rows = self._rows
             rows["observations"].append(np.asarray(obs, dtype=np.float32))
@@ -63,7 +74,6 @@ class RecordEpisodes(gym.Wrapper):
             self._add_state()
             if terminated or truncated:
                 self._flush(complete=True)
-        return obs, reward, terminated, truncated, info
 
     def close(self):
         self._flush(complete=False)

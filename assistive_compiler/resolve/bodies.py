@@ -15,6 +15,7 @@ import math
 from typing import Literal
 
 from ..errors import did_you_mean, one_of
+from ..library import is_shipped
 from ..person.surface import SURFACE_TARGET_SPACING_M, Region, link_surface
 from ..references import LinkPoint, TargetPoint
 from .located import expected
@@ -242,7 +243,8 @@ def check_garments(s: Scope) -> None:
             grips = list(s.robot.part.grips)
             s.problem(
                 base + ("grip",),
-                f"robot '{s.robot_name}' has no grip '{g.held.grip}' to hold garment '{name}' (add it under grips: in {s.robot.shown}); its grips are {one_of(grips)}{did_you_mean(g.held.grip, grips)}",
+                f"robot '{s.robot_name}' has no grip '{g.held.grip}' to hold garment '{name}'; its grips are {one_of(grips)}{did_you_mean(g.held.grip, grips)}"
+                + ("" if is_shipped(s.robot.path) else f" (or add it under grips: in {s.robot.shown})"),
             )
         for i, body in enumerate(g.collides_with or []):
             if s.body(body, ("garments", name, "collides_with", i), allow_particles=False) == name:

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from ..errors import did_you_mean, one_of
-from ..library import LoadedPart
+from ..library import LoadedPart, is_shipped
 from ..references import JointGroup
 from ..spec.models import TaskSpec
 from .located import expected
@@ -160,15 +160,54 @@ def check_mount(s: Scope) -> None:
     if spec.robot.mount_base == "search":
         _check_searched_mount(s, mount)
     for name, use in spec.tools.items():
-        grip = use.grip or use.part
-        if grip not in s.robot.part.grips:
-            grips = list(s.robot.part.grips)
-            where = ("tools", name, "grip" if use.grip else "part")
+        _check_grip(s, name, use.part, use.grip)
+
+
+def _check_grip(s: Scope, name: str, part: str, grip: str | None) -> None:
+    """A grip for tool ``name``: the robot's ``grip``, or the robot's or the tool part's for this
+    robot (not both). The remedy never sends the user to edit a shipped file: a shipped robot gets
+    its grip from the tool part in the user's library."""
+    tool = s.tools.get(name)
+    if tool is None:  # an unknown tool part: already a problem
+        return
+    robot = s.robot.part
+    grips = list(robot.grips)
+    if grip is not None:
+        if grip not in robot.grips:
             s.problem(
-                where,
-                f"robot '{s.robot_name}' has no grip '{grip}' for tool '{name}' (add it under grips: in {s.robot.shown}, "
-                f"or set tools.{name}.grip to one of its grips: {one_of(grips)}){did_you_mean(grip, grips)}",
+                ("tools", name, "grip"),
+                f"robot '{s.robot_name}' has no grip '{grip}' for tool '{name}'; its grips: {one_of(grips)}"
+                f"{did_you_mean(grip, grips)} (or remove tools.{name}.grip and give the tool part its own grip for "
+                f"{s.robot_name}: grips: {{{s.robot_name}: ...}} in {tool.shown})",
             )
+        return
+    own = tool.part.grips.get(s.robot_name)
+    if part in robot.grips and own is not None:
+        s.problem(
+            ("tools", name, "part"),
+            f"tool '{name}': robot '{s.robot_name}' holds '{part}' by two grips, grips.{part} in {s.robot.shown} "
+            f"and grips.{s.robot_name} in {tool.shown}; remove one",
+        )
+    elif part not in robot.grips and own is None:
+        s.problem(("tools", name, "part"), _no_grip(s, name, tool, grips))
+
+
+def _no_grip(s: Scope, name: str, tool: LoadedPart, grips: list[str]) -> str:
+    """What to do about a tool no grip holds: give the tool part a grip for this robot (in the
+    user's library; a shipped tool copied there first), or reuse one of the robot's grips."""
+    robot, part = s.robot_name, tool.part.name
+    example = f"grips: {{{robot}: {{position_m: [x, y, z], rpy_rad: [r, p, y]}}}}"
+    frame = f"the tool frame in {robot}'s tool-mount frame"
+    if is_shipped(tool.path):
+        give = f"copy {tool.shown} into your library as tools/<new name>.yaml and add {example} ({frame})"
+    else:
+        give = f"add {example} to {tool.shown} ({frame})"
+    if not is_shipped(s.robot.path):
+        give += f", or a grip '{part}' under grips: in {s.robot.shown}"
+    return (
+        f"robot '{robot}' has no grip for tool '{name}' (part '{part}'): {give}; or set tools.{name}.grip to one of "
+        f"{robot}'s grips: {one_of(grips)}{did_you_mean(part, grips)}"
+    )
 
 
 def check_arm_rest(s: Scope) -> None:

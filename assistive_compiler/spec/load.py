@@ -141,6 +141,43 @@ def _parent_path(path: Path, ref: str) -> Path:
     return (path.parent / ref).resolve()
 
 
+def shipped_task_names() -> list[str]:
+    """The shipped tasks' names (``feeding``, ...): what names a shipped task from any directory."""
+    return sorted(p.stem for p in (specs_dir() / "tasks").glob("*.yaml"))
+
+
+def spec_path(ref: str | Path) -> Path:
+    """The task spec file ``ref`` names, from any directory and from an installed wheel: a path (an
+    existing file wins); ``shipped:tasks/feeding.yaml`` (a file under the shipped ``specs/``;
+    ``shipped:feeding`` for short); or a shipped task's bare name, ``feeding``. Anything else is
+    returned as given (loading it says the file is not found, and how to name a shipped task)."""
+    text = str(ref)
+    if text.startswith(SHIPPED_PREFIX):
+        rel = text[len(SHIPPED_PREFIX) :]
+        if "/" not in rel and not rel.endswith((".yaml", ".yml")):
+            rel = f"tasks/{rel}.yaml"
+        return specs_dir() / rel
+    path = Path(ref)
+    if path.exists() or "/" in text or path.suffix:
+        return path
+    shipped = specs_dir() / "tasks" / f"{text}.yaml"
+    return shipped if shipped.is_file() else path
+
+
+def _not_found(ref: str | Path) -> SpecError:
+    """``file not found``; for a name (not a path), how a shipped task is named and the likely one."""
+    text, names = str(ref), shipped_task_names()
+    stem = Path(text.removeprefix(SHIPPED_PREFIX)).stem
+    where = display(spec_path(ref) if text.startswith(SHIPPED_PREFIX) else Path(text))
+    if not text.startswith(SHIPPED_PREFIX) and ("/" in text or Path(text).suffix):
+        return SpecError.at(where, "file not found")  # a path, not a name
+    return SpecError.at(
+        where,
+        f"file not found; a shipped task is named by its name ({', '.join(names)}) or as shipped:tasks/<name>.yaml, "
+        f"from any directory{did_you_mean(stem, names)}",
+    )
+
+
 def _load_tree(path: Path, chain: tuple[Path, ...]) -> tuple[dict, SourceMap, tuple[Path, ...]]:
     data, smap = load_located(path, display_path=display(path))
     files = (path,)
@@ -168,8 +205,12 @@ def _load_tree(path: Path, chain: tuple[Path, ...]) -> tuple[dict, SourceMap, tu
 
 
 def load_spec(path: str | Path) -> LoadedSpec:
-    """Load and validate the task spec at ``path``; raises :class:`SpecError` with located problems."""
-    path = Path(path).resolve() if Path(path).exists() else Path(path)
+    """Load and validate the task spec at ``path`` (or a shipped task's name, see :func:`spec_path`);
+    raises :class:`SpecError` with located problems."""
+    found = spec_path(path)
+    if not found.exists():
+        raise _not_found(path)
+    path = found.resolve()
     data, smap, files = _load_tree(path, ())
     try:
         spec = TaskSpec.model_validate(data)

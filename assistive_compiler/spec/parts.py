@@ -177,6 +177,21 @@ class ToolPart(Strict):
     reference_link: Name = Field(description="Semantic link meant when a spec names the tool alone (e.g. tip).")
     mass_kg: float = Field(gt=0, description="Total mass, kg.")
     container: Container | None = Field(None, description="The open volume the tool holds things in (a cup), if any.")
+    grips: dict[Name, ToolGrip] = Field(
+        default_factory=dict,
+        description="How each robot holds this tool, by robot name (the tool frame in the robot's tool-mount frame): "
+        "a tool in your own library brings its grips for the robots it is used with, shipped ones included. A robot "
+        "part's own grip of this tool's name (grips: in the robot's file) is used where it has one; giving both is "
+        "an error.",
+    )
+    friction: float | None = Field(
+        None,
+        ge=0,
+        le=5,
+        description="Lateral (Coulomb) friction coefficient of every link of the tool, set in pybullet when it is "
+        "loaded (None: pybullet's default, 0.5). A tool whose friction is set stays a free body held at its grip, "
+        "never welded into the robot. A task's tools.<name>.friction overrides it.",
+    )
 
 
 class FurniturePart(Strict):
@@ -274,3 +289,12 @@ class PersonPart(Strict):
         if self.height_m is not None:
             return body_for_height(self.sex, self.height_m, self.mass_kg, self.radius_scale)
         return body_measurements(self.sex, self.mass_kg, self.height_scale, self.radius_scale)
+
+
+def tool_grip(robot: RobotPart, tool: ToolPart, grip: str | None = None) -> ToolGrip | None:
+    """How ``robot`` holds ``tool``: the robot's grip named ``grip`` when the task names one, else
+    the robot's grip named like the tool part, else the tool part's grip for this robot (None:
+    no grip; giving both the robot's and the tool's is a resolve error)."""
+    if grip is not None:
+        return robot.grips.get(grip)
+    return robot.grips.get(tool.name, tool.grips.get(robot.name))

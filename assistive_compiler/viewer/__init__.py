@@ -19,10 +19,14 @@ def episode_for_view(
     replay: str | None = None,
     seed: int = 0,
     out: str | None = None,
+    human_policy: str | None = None,
+    trace: bool = False,
 ):
     """(artifact dir, recording, player): the compiled task, the episode to show — ``replay`` (a
     recording of this very artifact) or one played headless by ``policy`` (default scripted) from
-    ``seed`` — and the player that plays more (None for a replay)."""
+    ``seed``, the person acting by ``human_policy`` where given (a co-optimised pair plays both
+    agents anyway) — and the player that plays more (None for a replay). ``trace``: the scripted
+    policy prints its waypoint events after each episode it plays (``run --trace``'s lines)."""
     from ..compile.compiler import compile_task
     from ..errors import SpecError
     from ..record import RecordingError, load_recording
@@ -45,7 +49,7 @@ def episode_for_view(
     from ..runtime.env import AssistiveEnv
     from .app import EpisodePlayer
 
-    player = EpisodePlayer(AssistiveEnv.from_compiled(result), policy or "scripted", seed)
+    player = EpisodePlayer(AssistiveEnv.from_compiled(result), policy or "scripted", seed, human_policy, trace)
     return result.out_dir, player.play(seed), player
 
 
@@ -61,10 +65,12 @@ def view(
     gui: bool = False,
     speed: float = 1.0,
     on_ready=None,
+    human_policy: str | None = None,
+    trace: bool = False,
 ) -> int:
     """Show an episode of ``spec`` for ``robot`` until Ctrl-C: in the browser (``host:port``) or,
     with ``gui``, in pybullet's GUI. Returns the exit status."""
-    artifact_dir, recording, player = episode_for_view(spec, robot, policy, replay, seed, out)
+    artifact_dir, recording, player = episode_for_view(spec, robot, policy, replay, seed, out, human_policy, trace)
     if gui:
         from .bullet_gui import replay_in_gui
 

@@ -26,23 +26,51 @@ PALETTE = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e
 
 
 class EpisodePlayer:
-    """Plays one episode of an env with a named policy and returns its recording (headless)."""
+    """Plays one episode of an env with a named policy and returns its recording (headless). A
+    co-optimised pair, or any policy with a ``human_policy``, plays both agents (the person acts)."""
 
-    def __init__(self, env, policy_name: str, seed: int):
-        from ..policies import make_policy
+    def __init__(self, env, policy_name: str, seed: int, human_policy: str | None = None, trace: bool = False):
+        from ..policies import make_player, make_policy
 
-        self.env, self.policy_name = env, policy_name
-        self.policy = make_policy(policy_name, env, seed=seed)
+        self.env, self.policy_name, self.pair, self.trace = env, policy_name, None, trace
+        if trace:  # the scripted policy notes its waypoint events; play() prints them
+            self.policy = make_policy(policy_name, env, seed=seed, trace=True)
+        elif human_policy is not None:
+            from ..coop.policies import pair_policy
+
+            self.pair = pair_policy(env, policy_name, human_policy, seed)
+            self.policy_name = f"{policy_name}, human {human_policy}"
+        else:
+            target, self.policy = make_player(policy_name, env, seed=seed)
+            if target is not env:  # a co-optimised pair: both agents act
+                self.pair = target.policy
         self._dir = tempfile.TemporaryDirectory(prefix="assistive-view-")
         self.variants = [v.name for v in env.manifest.person.variants]
 
     def play(self, seed: int, variant: str | None = None) -> Recording:
-        from ..record import record_episode
+        from ..record import RecordEpisodes, record_episode
 
         options = {"person_variant": variant} if variant else None
-        return record_episode(
-            self.env, self.policy, seed, self._dir.name, policy_name=self.policy_name, options=options
-        )
+        if self.pair is None:
+            recording = record_episode(
+                self.env, self.policy, seed, self._dir.name, policy_name=self.policy_name, options=options
+            )
+            if self.trace:
+                self.policy.end_episode()
+                lines = [f"  {event['line']}" for event in self.policy.trace]
+                print("\n".join([f"trace of the episode (seed {seed}):", *lines]), flush=True)
+            return recording
+        from ..policies.pair import both_agents
+
+        recorder = RecordEpisodes(self.env, self._dir.name, policy=self.policy_name)
+        target, act = both_agents(recorder, self.pair)  # steps recorder.step_agents: the person acts
+        obs, _ = target.reset(seed=seed, options=options)
+        done = False
+        while not done:
+            obs, _, terminated, truncated, _ = target.step(act(obs))
+            done = terminated or truncated
+        assert recorder.last_recording is not None
+        return recorder.last_recording
 
 
 class ViewerApp:

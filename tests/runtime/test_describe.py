@@ -15,8 +15,41 @@ from assistive_compiler.runtime.env import AssistiveEnv
 
 
 def test_axis_direction_in_words():
-    assert axis_direction([0, 0, -1]) == "-z" and axis_direction([0.99, 0.1, 0]) == "+x"
+    assert axis_direction([0, 0, -1]) == "-z" and axis_direction([0.99999, 0.004, 0]) == "+x"
     assert axis_direction([0.7071, 0, -0.7071]) == "(0.71, 0.00, -0.71)"
+    # 5.7° off +x is not +x any more (issue 48, defect 1: it was, up to ~18°)
+    assert axis_direction([0.995, -0.0998, 0]) == "(0.99, -0.10, 0.00)"
+
+
+def test_describe_shows_a_slightly_turned_head_turned(artifact):
+    """A head turned a few degrees (the new user's −4.6°/−9.2°/−9.7°) is described with its axes'
+    components, as pybullet has them, not as the named axes +x +y +z (issue 48, defect 1)."""
+    from assistive_compiler.describe import describe_scene, describe_text
+
+    env = AssistiveEnv(artifact)
+    try:
+        env.reset(seed=0)
+        person = env.person_body
+        body = env.body_id(person)
+        for joint, deg in (("neck", 0.0), ("head_x", -4.6), ("head_y", -9.2), ("head_z", -9.7)):
+            pb.resetJointState(body, env.joint_index(person, joint), np.radians(deg), physicsClientId=env.client)
+        env.snap.refresh()
+        scene = describe_scene(env)
+        head = next(
+            link for b in scene["bodies"] if b["name"] == person for link in b["links"] if link["name"] == "head"
+        )
+        state = pb.getLinkState(
+            body, env.link_index(person, "head"), computeForwardKinematics=1, physicsClientId=env.client
+        )
+        rot = np.array(pb.getMatrixFromQuaternion(state[5])).reshape(3, 3)
+        assert [head["axes"][a] for a in "xyz"] == [
+            "(" + ", ".join(f"{c:.2f}" for c in rot[:, k]) + ")" for k in range(3)
+        ]
+        assert "+x" not in head["axes"].values() and "+z" not in head["axes"].values()
+        line = next(row for row in describe_text(scene).splitlines() if row.strip().startswith("head "))
+        assert "+x" not in line and head["axes"]["x"] in line
+    finally:
+        env.close()
 
 
 def test_describe_reports_the_scene_as_pybullet_has_it(artifact, capsys):

@@ -9,7 +9,7 @@ import shutil
 from pathlib import Path
 
 import pytest
-from helpers import cli
+from helpers import at, cli
 
 from assistive_compiler.errors import SpecError
 from assistive_compiler.library import LIBRARY_ENV, Library
@@ -102,6 +102,29 @@ def test_python_make_finds_the_same_parts(tmp_path, monkeypatch):
     env.close()
 
 
+def test_python_make_and_gym_make_share_one_artifact(tmp_path, monkeypatch):
+    """``assistive_compiler.make(spec)`` compiles into the artifact cache, the folder
+    ``gym.make("assistive_compiler/Task-v1", spec=...)`` uses, not into ``./generated`` of the
+    working directory: one spec, one artifact (issue 48, defect 6)."""
+    import gymnasium as gym
+
+    import assistive_compiler
+
+    project = write_project(tmp_path)
+    spec = project / "specs" / "tasks" / "long_scratch.yaml"
+    monkeypatch.setenv("ASSISTIVE_COMPILER_CACHE", str(tmp_path / "cache"))
+    monkeypatch.chdir(tmp_path)
+    env = assistive_compiler.make(spec, "jaco")
+    by_id = gym.make("assistive_compiler/Task-v1", spec=str(spec), robot="jaco")
+    try:
+        assert env.artifact_dir == by_id.unwrapped.artifact_dir
+        assert env.artifact_dir.parent == tmp_path / "cache" and not (tmp_path / "generated").exists()
+        assert env.manifest.content_hash == by_id.unwrapped.manifest.content_hash
+    finally:
+        env.close()
+        by_id.close()
+
+
 def test_a_part_name_in_two_libraries_is_an_error_naming_both_files(tmp_path):
     project = write_project(tmp_path)
     mine = project / "specs" / "tools" / "scratcher.yaml"
@@ -137,6 +160,62 @@ def test_a_tool_grip_that_the_robot_lacks_is_located(tmp_path):
         validate_all_robots(load_spec(spec))
     assert "robot 'jaco' has no grip 'scratchr' for tool 'scratcher'" in str(info.value)
     assert "(did you mean 'scratcher'?)" in str(info.value)
+
+
+def test_a_tool_without_a_grip_is_told_to_bring_one_not_to_edit_the_shipped_robot(tmp_path):
+    """A user's tool that no grip holds: the message names the user's own tool file and the grip
+    to add there, never the shipped robot's file (issue 48, defect 4)."""
+    project = write_project(tmp_path)
+    spec = project / "specs" / "tasks" / "long_scratch.yaml"
+    text = spec.read_text().replace("part: long_scratcher, grip: scratcher", "part: long_scratcher")
+    spec.write_text(text)
+    status, _, err = cli("validate", str(spec), cwd=tmp_path)
+    tool = "myproject/specs/tools/long_scratcher.yaml"
+    assert status == 2 and err.splitlines()[0] == (
+        f"myproject/specs/tasks/long_scratch.yaml:{at(text, 'long_scratcher')}: robot 'jaco' has no grip for tool "
+        f"'scratcher' (part 'long_scratcher'): add grips: {{jaco: {{position_m: [x, y, z], rpy_rad: [r, p, y]}}}} to "
+        f"{tool} (the tool frame in jaco's tool-mount frame); or set tools.scratcher.grip to one of jaco's grips: "
+        "'cup', 'garment', 'scooper', 'scratcher', 'spoon', 'wiper' (did you mean 'scratcher'?)"
+    ), err
+    assert "robots/jaco.yaml" not in err and str(specs_dir()) not in err
+
+
+GRIPS = """grips:   # how the shipped robots hold it (their scratcher's grips)
+  jaco: {position_m: [0.0, 0.0, 0.03], rpy_rad: [0.0, -1.5707963267948966, 0.0]}
+  panda: {position_m: [0.0, 0.0, 0.0], rpy_rad: [0.0, -1.5707963267948966, 0.0]}
+friction: 1.3
+"""
+
+
+def test_a_user_tool_brings_its_grips_and_friction_for_a_shipped_robot(tmp_path):
+    """The tool part in the user's library gives the grip a shipped robot holds it by and its
+    contact friction; the task may override the friction (issue 48, What to build 5)."""
+    import pybullet as pb
+
+    from assistive_compiler.compile.compiler import compile_task
+    from assistive_compiler.runtime.env import AssistiveEnv
+
+    project = write_project(tmp_path)
+    part = project / "specs" / "tools" / "long_scratcher.yaml"
+    part.write_text(part.read_text() + GRIPS)
+    spec = project / "specs" / "tasks" / "long_scratch.yaml"
+    spec.write_text(spec.read_text().replace("part: long_scratcher, grip: scratcher", "part: long_scratcher"))
+    status, out, err = cli("validate", str(spec), cwd=tmp_path)
+    assert status == 0 and "ok (task 'long_scratch', robots: jaco, panda)" in out, err
+    result = compile_task(spec, "jaco", tmp_path / "out")
+    (att,) = result.manifest.tools
+    assert att.position == (0.0, 0.0, 0.03) and not att.welded  # its own friction: a free body at its grip
+    assert result.manifest.body("scratcher").friction == 1.3
+    env = AssistiveEnv(result.out_dir)
+    try:
+        env.reset(seed=0)
+        body = env.body_id("scratcher")
+        for link in [-1, *env.links("scratcher").values()]:
+            assert pb.getDynamicsInfo(body, link, physicsClientId=env.client)[1] == 1.3
+    finally:
+        env.close()
+    spec.write_text(spec.read_text().replace("part: long_scratcher}", "part: long_scratcher, friction: 0.8}"))
+    assert compile_task(spec, "panda", tmp_path / "panda").manifest.body("scratcher").friction == 0.8
 
 
 TEMPLATE = "templates/tools/long_scratcher.urdf.xacro"

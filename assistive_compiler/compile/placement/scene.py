@@ -17,6 +17,7 @@ from typing import Any
 from ...artifact import Body, ToolAttachment
 from ...resolve import ResolvedTask
 from ...rotation import quat_from_rpy, quat_from_rpy_deg
+from ...spec.parts import tool_grip
 from ..emit import EmittedScene
 from ..task import mounted_on, present_furniture, rounded, seat_links
 from .base_search import Carried
@@ -176,9 +177,13 @@ def _load_tools(rt: ResolvedTask, pc: PlacementClient, emitted: EmittedScene, ou
     bodies: list[Body] = []
     for name, use in rt.tool_uses.items():
         tpart = rt.tools[name].part
-        grip = robot_part.grips[use.grip or tpart.name]
+        grip = tool_grip(robot_part, tpart, use.grip)  # checked in resolve: there is one
+        assert grip is not None
+        friction = use.friction if use.friction is not None else tpart.friction
         _, hand = robot_part.arm_for(use.hand)
         ids[name] = pc.load(emitted.written[name], (0, 0, -10), (0, 0, 0, 1), True)
+        if friction is not None:  # as the runtime has it (Body.friction), for the particles settled in it
+            pc.set_friction(ids[name], friction)
         attachments.append(
             ToolAttachment(
                 body=name,
@@ -197,6 +202,7 @@ def _load_tools(rt: ResolvedTask, pc: PlacementClient, emitted: EmittedScene, ou
                 orientation=(0.0, 0.0, 0.0, 1.0),
                 fixed_base=False,
                 gravity=use.gravity_mps2,
+                friction=friction,
             )
         )
     return ids, attachments, bodies

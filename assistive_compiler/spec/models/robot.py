@@ -157,7 +157,16 @@ class ToolUse(Strict):
     grip: Name | None = Field(
         None,
         description="Which of the robot part's grips (grips: in specs/robots/<robot>.yaml) holds this tool; default "
-        "the tool's part name. A new tool shaped like a shipped one can reuse its grip (e.g. grip: scratcher).",
+        "the robot's grip named like the tool part, else the tool part's own grip for the robot (grips: <robot>: in "
+        "specs/tools/<part>.yaml: how a tool in your library is held by a shipped robot). A new tool shaped like a "
+        "shipped one can reuse its grip (e.g. grip: scratcher).",
+    )
+    friction: float | None = Field(
+        None,
+        ge=0,
+        le=5,
+        description="Lateral friction coefficient of every link of the tool in this task (None: the tool part's "
+        "friction, else pybullet's default 0.5). A tool whose friction is set stays a free body, never welded.",
     )
     one_arm_same_as: Name | None = Field(
         None,
