@@ -14,9 +14,7 @@ the commit)::
 
 from __future__ import annotations
 
-import argparse
 import hashlib
-import json
 import sys
 from pathlib import Path
 
@@ -92,25 +90,19 @@ def _at(values: list[str], field: str, step: int) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--write", action="store_true", help=f"write {STORE.name} (else compare with it)")
-    parser.add_argument("ids", nargs="*", help="only these ids (default all shipped)")
-    args = parser.parse_args(argv)
     from assistive_compiler.gym_ids import shipped_ids
 
-    ids = args.ids or sorted(shipped_ids())
-    stored = json.loads(STORE.read_text()) if STORE.is_file() else {}
-    changed = 0
-    for env_id in ids:
-        got = digests(env_id)
-        where = first_difference(stored[env_id], got) if env_id in stored else "not stored"
-        print(f"{env_id}: {where or 'same'}", flush=True)
-        changed += where is not None
-        stored[env_id] = got
-    if args.write:
-        STORE.write_text(json.dumps(dict(sorted(stored.items())), indent=1) + "\n")
-        print(f"wrote {STORE}")
-    return 1 if changed and not args.write else 0
+    from .stored_record import compare_or_write
+
+    return compare_or_write(
+        STORE,
+        __doc__.split("\n\n")[0],
+        "only these ids (default all shipped)",
+        lambda: sorted(shipped_ids()),
+        digests,
+        first_difference,
+        argv,
+    )
 
 
 if __name__ == "__main__":

@@ -18,8 +18,6 @@ Regenerate the record after a change that is meant to change episodes (with the 
 
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -79,29 +77,29 @@ def episodes(recorded: dict[str, list]) -> list[dict]:
     return [{"return": r, "success": s} for r, s in zip(recorded["returns"], recorded["successes"], strict=True)]
 
 
+def played_outcomes(name: str) -> dict[str, list]:
+    """The outcomes of the shipped policy ``name`` on all its regression seeds, played now."""
+    regression = Regression(name)
+    try:
+        return outcomes(regression.play(0, regression.episodes))
+    finally:
+        regression.close()
+
+
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--write", action="store_true", help=f"write {STORE.name} (else compare with it)")
-    parser.add_argument("names", nargs="*", help="only these shipped policies (default all)")
-    args = parser.parse_args(argv)
     from assistive_compiler.policies.pretrained import shipped_names
 
-    stored = json.loads(STORE.read_text()) if STORE.is_file() else {}
-    changed = 0
-    for name in args.names or shipped_names():
-        regression = Regression(name)
-        try:
-            got = outcomes(regression.play(0, regression.episodes))
-        finally:
-            regression.close()
-        same = stored.get(name) == got
-        print(f"{name}: {'same' if same else 'changed' if name in stored else 'not stored'}", flush=True)
-        changed += not same
-        stored[name] = got
-    if args.write:
-        STORE.write_text(json.dumps(dict(sorted(stored.items())), indent=1) + "\n")
-        print(f"wrote {STORE}")
-    return 1 if changed and not args.write else 0
+    from .stored_record import compare_or_write
+
+    return compare_or_write(
+        STORE,
+        __doc__.split("\n\n")[0],
+        "only these shipped policies (default all)",
+        shipped_names,
+        played_outcomes,
+        lambda recorded, played: None if recorded == played else "changed",
+        argv,
+    )
 
 
 if __name__ == "__main__":

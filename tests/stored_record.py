@@ -1,0 +1,41 @@
+"""The command line of a record stored in ``tests/data`` (``python -m tests.<record> [--write]
+[NAMES...]``): play each name on the current code, say per name whether it matches the record (or
+where it first differs), and with ``--write`` store what was played. Exit status 1 when something
+differs and nothing was written."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Any
+
+
+def compare_or_write(
+    store: Path,
+    description: str,
+    names_help: str,
+    default_names: Callable[[], Iterable[str]],
+    play: Callable[[str], Any],
+    difference: Callable[[Any, Any], str | None],
+    argv: list[str] | None = None,
+) -> int:
+    """Compare ``play(name)`` with ``store``'s entry for each name (``difference(stored, played)``:
+    None when they match, else where they differ), or write them with ``--write``."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--write", action="store_true", help=f"write {store.name} (else compare with it)")
+    parser.add_argument("names", nargs="*", help=names_help)
+    args = parser.parse_args(argv)
+    stored = json.loads(store.read_text()) if store.is_file() else {}
+    changed = 0
+    for name in args.names or default_names():
+        played = play(name)
+        where = difference(stored[name], played) if name in stored else "not stored"
+        print(f"{name}: {where or 'same'}", flush=True)
+        changed += where is not None
+        stored[name] = played
+    if args.write:
+        store.write_text(json.dumps(dict(sorted(stored.items())), indent=1) + "\n")
+        print(f"wrote {store}")
+    return 1 if changed and not args.write else 0
