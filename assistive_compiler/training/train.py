@@ -17,8 +17,8 @@ from pathlib import Path
 from ..errors import UsageError
 from ..paths import display
 from ..run_dir import RunDir
+from .bookkeeping.resume import check_resumable, new_run_info
 from .config import TrainingConfig, load_training_config, run_config
-from .resume import check_resumable, new_run_info
 
 ENGINES = ("auto", "sb3", "rllib")
 
@@ -81,7 +81,7 @@ def train(
 ) -> dict:
     """Train a policy for ``spec`` and ``robot`` as ``config_path`` says; returns the run's summary.
     ``demonstrations``: a Minari dataset id of the same task to start a new SAC run from
-    (:mod:`.demonstrations`)."""
+    (:mod:`.learners.demonstrations`)."""
     engine = choose_engine(engine, coop, address)
     if demonstrations is not None and resume:
         raise UsageError(
@@ -103,12 +103,12 @@ def train(
             "learns with sbx (sac.library): use a config with library: sb3 (e.g. sac_laptop)"
         )
     if engine == "rllib":
-        from .rllib import check_supported
+        from .engines.rllib import check_supported
 
         check_supported(config)  # settings only SB3 builds are refused before anything is compiled or written
     result, robot = compile_for_run(spec, robot, coop)
     if engine == "rllib":
-        from .rllib import init_ray
+        from .engines.rllib import init_ray
 
         init_ray(address, config.envs)  # an unreachable cluster fails here, before the run directory is written
     manifest = result.manifest
@@ -130,7 +130,7 @@ def train(
     # read and checked before the run directory is written; a resumed run reads them again for its actor's updates
     d = config.demonstrations
     if d is not None and (not resume or d.steers_actor_updates):
-        from .demonstrations import load_demonstrations
+        from .learners.demonstrations import load_demonstrations
 
         if d.dataset is None:
             raise UsageError(
@@ -142,7 +142,7 @@ def train(
         run.create(new_run_info(spec, manifest, robot, coop, engine, config), result.out_dir)
     weights = reward_weights(manifest)
     if not quiet:
-        from .progress import print_reward_table
+        from .bookkeeping.progress import print_reward_table
 
         print(
             f"{manifest.label}{' + human (co-optimisation)' if coop else ''}: {engine} {config.algorithm.upper()}, {config.envs} envs, "
@@ -152,13 +152,13 @@ def train(
         print_reward_table(weights, manifest.task)
     with stop_on_signals() as stop:
         if engine == "sb3":
-            from . import sb3
+            from .engines import sb3
 
             figures = sb3.train(
                 run, config, weights, resume=resume, quiet=quiet, stop=stop, demonstrations=demo_data, coop=coop
             )
         else:
-            from . import rllib
+            from .engines import rllib
 
             figures = rllib.train(
                 run, config, weights, coop=coop, resume=resume, address=address, quiet=quiet, stop=stop
@@ -204,7 +204,7 @@ def stop_on_signals():
 
 def finish(run: RunDir, manifest, engine: str, config: TrainingConfig, figures: dict) -> dict:
     """Write the learning-curve figure and ``summary.json``; returns the summary."""
-    from .curves import plot_curves, read_curve
+    from .bookkeeping.curves import plot_curves, read_curve
 
     curve = read_curve(run.curve_csv)
     tail = curve[-5:]
