@@ -371,13 +371,14 @@ def test_a_learned_temperature_starts_where_the_config_says(sac_run, tmp_path, e
     """sac.initial_ent_coef: the α that ent_coef 'auto' starts from (SB3's and RLlib's default 1.0)."""
     from assistive_compiler.training.config import load_training_config
     from assistive_compiler.training.engines import sb3
+    from assistive_compiler.training.learners.choice import new_model
 
     path = tmp_path / "sac.yaml"
     path.write_text(SAC_TINY.replace("batch_size: 32}", f"batch_size: 32, initial_ent_coef: {alpha}}}"))
     config = load_training_config(path)
     if engine == "sb3":
         venv = sb3.make_vec_env(RunDir(sac_run).artifact, 1, 0)
-        model = sb3._new_model(venv, config, RunDir(tmp_path / "run"))
+        model = new_model(venv, config, RunDir(tmp_path / "run"))
         venv.close()
         assert float(model.log_ent_coef.exp()) == pytest.approx(alpha)
     else:
