@@ -126,18 +126,8 @@ def train(
         raise UsageError(
             f"{display(run.path)}: the run directory already holds a run; pass --resume to continue it, or choose another --out"
         )
-    demo_data = None
     # read and checked before the run directory is written; a resumed run reads them again for its actor's updates
-    d = config.demonstrations
-    if d is not None and (not resume or d.steers_actor_updates):
-        from .learners.demonstrations import load_demonstrations
-
-        if d.dataset is None:
-            raise UsageError(
-                f"{display(Path(config_path))}: this config starts from demonstrations; "
-                "name the dataset with --demonstrations DATASET (a `collect` dataset of this task)"
-            )
-        demo_data = load_demonstrations(d, manifest.content_hash)
+    demo_data = read_demonstrations(config, config_path, manifest.content_hash, resume)
     if not resume:
         run.create(new_run_info(spec, manifest, robot, coop, engine, config), result.out_dir)
     weights = reward_weights(manifest)
@@ -164,6 +154,24 @@ def train(
                 run, config, weights, coop=coop, resume=resume, address=address, quiet=quiet, stop=stop
             )
     return finish(run, manifest, engine, config, figures)
+
+
+def read_demonstrations(config: TrainingConfig, config_path: str, content_hash: str, resume: bool):
+    """The demonstrations a config with a ``demonstrations`` block starts from (a new run) or keeps
+    cloning in its actor's updates (a resumed one), read and checked against the run's compiled
+    task (``content_hash``); None where the run does not read them."""
+    demo_data = None
+    d = config.demonstrations
+    if d is not None and (not resume or d.steers_actor_updates):
+        from .learners.demonstrations import load_demonstrations
+
+        if d.dataset is None:
+            raise UsageError(
+                f"{display(Path(config_path))}: this config starts from demonstrations; "
+                "name the dataset with --demonstrations DATASET (a `collect` dataset of this task)"
+            )
+        demo_data = load_demonstrations(d, content_hash)
+    return demo_data
 
 
 class StopRequest:
