@@ -30,7 +30,7 @@ PROTOCOLS = {"mean": False, "sampled": True}
 
 def checkpoint_hours(run_dir: Path, steps: int) -> float:
     """Wall-clock hours of training at ``steps`` env steps, interpolated on the run's curve."""
-    from assistive_compiler.training.curves import read_curve
+    from assistive_compiler.training.bookkeeping.curves import read_curve
 
     rows = read_curve(run_dir / "curve.csv")
     if not rows:
@@ -45,7 +45,7 @@ def checkpoint_hours(run_dir: Path, steps: int) -> float:
 
 def evaluated(run_dir: Path, steps: int, protocol: str, episodes: int, seed: int) -> dict:
     """The cached (or new) evaluation of the checkpoint at ``steps`` under ``protocol``."""
-    from assistive_compiler.training.evaluate import evaluate
+    from assistive_compiler.training.trained.evaluate import evaluate
 
     cache = run_dir / "time_to_success" / f"step_{steps}-{protocol}-{episodes}x{seed}.json"
     if cache.is_file():

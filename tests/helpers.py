@@ -59,7 +59,7 @@ def assert_exported_pair_acts_as(checkpoint_pair, exported, artifact: Path, seed
     1e-6 action difference.)"""
     import numpy as np
 
-    from assistive_compiler.training.evaluate import play_episodes
+    from assistive_compiler.training.trained.evaluate import play_episodes
 
     seen: dict[str, list] = {"robot": [], "human": []}
 

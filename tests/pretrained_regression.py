@@ -38,7 +38,7 @@ class Regression:
         from assistive_compiler.policies.pretrained import load_trained, shipped_info
         from assistive_compiler.registration import cached_artifact_dir
         from assistive_compiler.runtime.env import AssistiveEnv
-        from assistive_compiler.training.evaluate import trained_task_spec
+        from assistive_compiler.training.trained.evaluate import trained_task_spec
 
         self.name = name
         self.info = info = shipped_info(name)
@@ -56,7 +56,7 @@ class Regression:
     def play(self, start: int, count: int) -> list[dict]:
         """The episodes of regression seeds ``start`` .. ``start + count - 1`` (0: the first)."""
         if self.info["coop"]:
-            from assistive_compiler.training.evaluate import play_episodes
+            from assistive_compiler.training.trained.evaluate import play_episodes
 
             return play_episodes(self.env.artifact_dir, self.pair, True, count, self.seed + start)
         from assistive_compiler.episode import rollout

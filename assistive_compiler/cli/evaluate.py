@@ -18,7 +18,7 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     from ..policies.mlp import POLICY_FILE
     from ..policies.pretrained import PREFIX
     from ..run_dir import RunDir
-    from ..training.evaluate import evaluate_exported, format_report
+    from ..training.trained.evaluate import evaluate_exported, format_report
 
     source = args.policy or args.run_dir
     if source is None:
@@ -43,7 +43,7 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     info = run.info()
     if not require_extra(*engine_modules(info.engine, info.library)):
         return EXIT_FAILED
-    from ..training.evaluate import evaluate, save_evaluation
+    from ..training.trained.evaluate import evaluate, save_evaluation
 
     result = evaluate(
         source,

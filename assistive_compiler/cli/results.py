@@ -1,6 +1,6 @@
 """``export`` (a run's newest checkpoint as a shipped-policy folder, evaluated) and ``results``
 (``docs/results.md``'s tables, curves and pictures from the shipped policies). The work is in
-:mod:`assistive_compiler.training.export` and :mod:`assistive_compiler.training.results`."""
+:mod:`assistive_compiler.training.trained.export` and :mod:`assistive_compiler.training.results.results_page`."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     if not require_extra(*engine_modules(info.engine, info.library)):
         return EXIT_FAILED
     from ..paths import display
-    from ..training.export import export_run
+    from ..training.trained.export import export_run
 
     record = export_run(
         args.run_dir,
@@ -45,7 +45,7 @@ def cmd_results(args: argparse.Namespace) -> int:
     if not args.no_pictures and not require_extra("matplotlib"):
         return EXIT_FAILED
     from ..paths import display
-    from ..training.results import shipped_records, update_doc, write_pictures
+    from ..training.results.results_page import shipped_records, update_doc, write_pictures
 
     doc = Path(args.out)
     records = shipped_records()
@@ -58,7 +58,7 @@ def cmd_results(args: argparse.Namespace) -> int:
 
 
 def add_commands(sub) -> None:
-    from ..training.export import EVAL_SEED
+    from ..training.trained.export import EVAL_SEED
 
     p = sub.add_parser(
         "export", help="a run's newest checkpoint as a shipped policy (NumPy only), evaluated on unseen seeds"

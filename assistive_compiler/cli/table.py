@@ -12,7 +12,7 @@ from .common import EXIT_FAILED, EXIT_OK, require_extra
 def cmd_table(args: argparse.Namespace) -> int:
     if not require_extra("torch", "matplotlib"):
         return EXIT_FAILED
-    from ..training.table import make_tables
+    from ..training.results.table import make_tables
 
     print(make_tables(args.run_dirs, out=args.out, episodes=args.episodes, seed=args.seed))
     return EXIT_OK

@@ -1,6 +1,6 @@
 """The two agents of a co-optimisation env seen as one Gymnasium env, for learners that train the
 pair with one shared critic (Stable-Baselines3 SAC with one actor per agent:
-:mod:`assistive_compiler.training.factored_actor`).
+:mod:`assistive_compiler.training.learners.factored_actor`).
 
 * **Observation**: the robot's observation, then the person's (the PettingZoo env's ``state()``).
 * **Action**: the robot's action, then the person's, each in [−1, 1].

@@ -114,7 +114,7 @@ class SB3Policy:
 
 class SB3PairPolicy(SB3Policy):
     """A co-optimised pair trained with SB3 SAC, one actor per agent
-    (:mod:`assistive_compiler.training.factored_actor`): ``(robot_obs, human_obs) -> (a_robot,
+    (:mod:`assistive_compiler.training.learners.factored_actor`): ``(robot_obs, human_obs) -> (a_robot,
     a_human)``, and each agent alone with :meth:`agent` (its actor reads its own observation only)."""
 
     def __init__(self, checkpoint: Path, algorithm: str = "sac", stochastic: bool = False, seed: int = 0):

@@ -4,7 +4,7 @@ A :class:`TrainingConfig` says *how* to learn a task's policy — algorithm (the
 PPO, or the off-policy SAC that learns from far fewer env steps), network, the algorithm's own
 settings, how many steps and env processes, the seed and how often to checkpoint. The same config
 drives Stable-Baselines3 (single agent, one machine) and Ray RLlib (co-optimisation, clusters);
-:mod:`.sb3` and :mod:`.rllib` translate it.
+:mod:`.engines.sb3` and :mod:`.engines.rllib` translate it.
 """
 
 from __future__ import annotations
@@ -195,7 +195,7 @@ class SAC(Strict):
 
 class Demonstrations(Strict):
     """Start a new run from demonstrations: a Minari dataset that ``collect`` wrote on the same
-    compiled task (:mod:`.demonstrations`). Before the first env step, the actor is fitted to the
+    compiled task (:mod:`.learners.demonstrations`). Before the first env step, the actor is fitted to the
     successful episodes' actions (behaviour cloning), every demonstrated transition goes into the
     replay buffer and the critics warm up on them; optionally a cloning term stays in the actor's
     loss while SAC learns. Results from such a run are labelled as starting from demonstrations."""

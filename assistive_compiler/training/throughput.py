@@ -111,9 +111,9 @@ def measure_training(spec: str, robot: str, config_path: str, steps: int) -> dic
     engine, a temporary run directory) and return :meth:`StageTimer.report`'s figures with the
     config's name and settings. An off-policy config's random warm-up (``learning_starts``) is
     cut to 1,000 steps so that the few thousand steps measured are mostly learning ones."""
-    from . import sb3
+    from .bookkeeping.resume import new_run_info
     from .config import load_training_config
-    from .resume import new_run_info
+    from .engines import sb3
     from .train import compile_for_run, reward_weights
 
     config: TrainingConfig = load_training_config(config_path)

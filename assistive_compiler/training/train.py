@@ -17,8 +17,8 @@ from pathlib import Path
 from ..errors import UsageError
 from ..paths import display
 from ..run_dir import RunDir
+from .bookkeeping.resume import check_resumable, new_run_info
 from .config import TrainingConfig, load_training_config, run_config
-from .resume import check_resumable, new_run_info
 
 ENGINES = ("auto", "sb3", "rllib")
 
@@ -81,7 +81,7 @@ def train(
 ) -> dict:
     """Train a policy for ``spec`` and ``robot`` as ``config_path`` says; returns the run's summary.
     ``demonstrations``: a Minari dataset id of the same task to start a new SAC run from
-    (:mod:`.demonstrations`)."""
+    (:mod:`.learners.demonstrations`)."""
     engine = choose_engine(engine, coop, address)
     if demonstrations is not None and resume:
         raise UsageError(
@@ -103,12 +103,12 @@ def train(
             "learns with sbx (sac.library): use a config with library: sb3 (e.g. sac_laptop)"
         )
     if engine == "rllib":
-        from .rllib import check_supported
+        from .engines.rllib import check_supported
 
         check_supported(config)  # settings only SB3 builds are refused before anything is compiled or written
     result, robot = compile_for_run(spec, robot, coop)
     if engine == "rllib":
-        from .rllib import init_ray
+        from .engines.rllib import init_ray
 
         init_ray(address, config.envs)  # an unreachable cluster fails here, before the run directory is written
     manifest = result.manifest
@@ -126,23 +126,13 @@ def train(
         raise UsageError(
             f"{display(run.path)}: the run directory already holds a run; pass --resume to continue it, or choose another --out"
         )
-    demo_data = None
     # read and checked before the run directory is written; a resumed run reads them again for its actor's updates
-    d = config.demonstrations
-    if d is not None and (not resume or d.steers_actor_updates):
-        from .demonstrations import load_demonstrations
-
-        if d.dataset is None:
-            raise UsageError(
-                f"{display(Path(config_path))}: this config starts from demonstrations; "
-                "name the dataset with --demonstrations DATASET (a `collect` dataset of this task)"
-            )
-        demo_data = load_demonstrations(d, manifest.content_hash)
+    demo_data = read_demonstrations(config, config_path, manifest.content_hash, resume)
     if not resume:
         run.create(new_run_info(spec, manifest, robot, coop, engine, config), result.out_dir)
     weights = reward_weights(manifest)
     if not quiet:
-        from .progress import print_reward_table
+        from .bookkeeping.progress import print_reward_table
 
         print(
             f"{manifest.label}{' + human (co-optimisation)' if coop else ''}: {engine} {config.algorithm.upper()}, {config.envs} envs, "
@@ -152,18 +142,36 @@ def train(
         print_reward_table(weights, manifest.task)
     with stop_on_signals() as stop:
         if engine == "sb3":
-            from . import sb3
+            from .engines import sb3
 
             figures = sb3.train(
                 run, config, weights, resume=resume, quiet=quiet, stop=stop, demonstrations=demo_data, coop=coop
             )
         else:
-            from . import rllib
+            from .engines import rllib
 
             figures = rllib.train(
                 run, config, weights, coop=coop, resume=resume, address=address, quiet=quiet, stop=stop
             )
     return finish(run, manifest, engine, config, figures)
+
+
+def read_demonstrations(config: TrainingConfig, config_path: str, content_hash: str, resume: bool):
+    """The demonstrations a config with a ``demonstrations`` block starts from (a new run) or keeps
+    cloning in its actor's updates (a resumed one), read and checked against the run's compiled
+    task (``content_hash``); None where the run does not read them."""
+    demo_data = None
+    d = config.demonstrations
+    if d is not None and (not resume or d.steers_actor_updates):
+        from .learners.demonstrations import load_demonstrations
+
+        if d.dataset is None:
+            raise UsageError(
+                f"{display(Path(config_path))}: this config starts from demonstrations; "
+                "name the dataset with --demonstrations DATASET (a `collect` dataset of this task)"
+            )
+        demo_data = load_demonstrations(d, content_hash)
+    return demo_data
 
 
 class StopRequest:
@@ -204,7 +212,7 @@ def stop_on_signals():
 
 def finish(run: RunDir, manifest, engine: str, config: TrainingConfig, figures: dict) -> dict:
     """Write the learning-curve figure and ``summary.json``; returns the summary."""
-    from .curves import plot_curves, read_curve
+    from .bookkeeping.curves import plot_curves, read_curve
 
     curve = read_curve(run.curve_csv)
     tail = curve[-5:]

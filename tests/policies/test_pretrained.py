@@ -34,7 +34,7 @@ REGRESSION = json.loads(STORE.read_text()) if STORE.is_file() else {}
 
 def _env(name: str, **kwargs) -> AssistiveEnv:
     from assistive_compiler.registration import cached_artifact_dir
-    from assistive_compiler.training.evaluate import trained_task_spec
+    from assistive_compiler.training.trained.evaluate import trained_task_spec
 
     info = shipped_info(name)
     spec = trained_task_spec(info)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from assistive_compiler.training.results import BEGIN, END, results_block, shipped_records, update_doc
+from assistive_compiler.training.results.results_page import BEGIN, END, results_block, shipped_records, update_doc
 
 REPO = Path(__file__).resolve().parents[2]
 DOC = REPO / "docs" / "results.md"

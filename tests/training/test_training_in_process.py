@@ -17,7 +17,7 @@ pytest.importorskip("stable_baselines3", reason='needs the "train" extra (README
 
 from assistive_compiler.cli import main
 from assistive_compiler.run_dir import RunDir
-from assistive_compiler.training.evaluate import evaluate
+from assistive_compiler.training.trained.evaluate import evaluate
 
 pytestmark = pytest.mark.slow
 
@@ -52,7 +52,7 @@ def in_process_run(tmp_path_factory) -> Path:
 def test_the_envs_step_in_the_trainers_process_each_seeded_apart(tmp_path):
     from stable_baselines3.common.vec_env import DummyVecEnv
 
-    from assistive_compiler.training.sb3 import make_vec_env
+    from assistive_compiler.training.engines.sb3 import make_vec_env
     from assistive_compiler.training.train import compile_for_run
 
     result, _ = compile_for_run(str(REACH), "jaco", coop=False)
@@ -68,7 +68,7 @@ def test_the_envs_step_in_the_trainers_process_each_seeded_apart(tmp_path):
 def test_an_in_process_run_resumes_exports_and_plays_as_its_checkpoint(in_process_run, tmp_path, capsys):
     from assistive_compiler.policies.checkpoint import SB3Policy
     from assistive_compiler.policies.mlp import MLPPolicy
-    from assistive_compiler.training.export import export_run
+    from assistive_compiler.training.trained.export import export_run
 
     run = RunDir(in_process_run)
     assert run.info().config["vec_env"] == "in_process"

@@ -22,8 +22,8 @@ from helpers import assert_exported_pair_acts_as  # noqa: E402 (after the import
 
 from assistive_compiler.cli import main  # noqa: E402 (after the importorskip)
 from assistive_compiler.run_dir import RunDir  # noqa: E402 (after the importorskip)
-from assistive_compiler.training.evaluate import evaluate  # noqa: E402 (after the importorskip)
 from assistive_compiler.training.train import train  # noqa: E402 (after the importorskip)
+from assistive_compiler.training.trained.evaluate import evaluate  # noqa: E402 (after the importorskip)
 
 REPO = Path(__file__).resolve().parents[2]
 FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
@@ -92,7 +92,7 @@ def test_multi_agent_ppo_iteration_checkpoint_resume_evaluate(local_ray, tmp_pat
     import torch
 
     from assistive_compiler.policies.checkpoint import RLlibPolicy
-    from assistive_compiler.training.export import export_run
+    from assistive_compiler.training.trained.export import export_run
 
     pair = RLlibPolicy(checkpoint.parent / f"step_{400:010d}", coop=True, algorithm="ppo")
     with torch.no_grad():  # a head whose means leave the bounds
@@ -153,7 +153,7 @@ eval_episodes: 1
 def test_multi_agent_sac_trains_and_exports_a_pair_that_plays_under_coop(local_ray, tmp_path, capsys):
     """Co-optimisation with SAC on RLlib: robot and human modules learn, the pair exports to NumPy
     (each agent's actions equal the checkpoint's) and plays both agents from `run --coop`."""
-    from assistive_compiler.training.export import export_run
+    from assistive_compiler.training.trained.export import export_run
 
     config = tmp_path / "sac_tiny.yaml"
     config.write_text(SAC_TINY)
@@ -295,7 +295,7 @@ def test_local_training_starts_its_own_ray_while_a_cluster_runs_here(tmp_path):
     home = _ray_home(tmp_path / "home", "c" * 64)
     probe = (
         "import ray\n"
-        "from assistive_compiler.training.rllib import init_ray\n"
+        "from assistive_compiler.training.engines.rllib import init_ray\n"
         "init_ray(None, 2)\n"
         "print(ray.get_runtime_context().gcs_address, ray.cluster_resources().get('CPU'))\n"
     )

@@ -31,8 +31,8 @@ from assistive_compiler.errors import SpecError
 from assistive_compiler.policies import make_policy
 from assistive_compiler.run_dir import RunDir
 from assistive_compiler.runtime.env import AssistiveEnv
-from assistive_compiler.training.evaluate import evaluate, evaluate_exported
-from assistive_compiler.training.resume import check_resumable
+from assistive_compiler.training.bookkeeping.resume import check_resumable
+from assistive_compiler.training.trained.evaluate import evaluate, evaluate_exported
 
 pytestmark = pytest.mark.slow
 
@@ -369,20 +369,21 @@ def test_sac_run_checkpoints_with_its_replay_buffer_and_resumes(sac_run, tmp_pat
 @pytest.mark.parametrize(("engine", "alpha"), [("sb3", 1.0), ("sb3", 0.01), ("rllib", 0.01)])
 def test_a_learned_temperature_starts_where_the_config_says(sac_run, tmp_path, engine, alpha):
     """sac.initial_ent_coef: the α that ent_coef 'auto' starts from (SB3's and RLlib's default 1.0)."""
-    from assistive_compiler.training import sb3
     from assistive_compiler.training.config import load_training_config
+    from assistive_compiler.training.engines import sb3
+    from assistive_compiler.training.learners.choice import new_model
 
     path = tmp_path / "sac.yaml"
     path.write_text(SAC_TINY.replace("batch_size: 32}", f"batch_size: 32, initial_ent_coef: {alpha}}}"))
     config = load_training_config(path)
     if engine == "sb3":
         venv = sb3.make_vec_env(RunDir(sac_run).artifact, 1, 0)
-        model = sb3._new_model(venv, config, RunDir(tmp_path / "run"))
+        model = new_model(venv, config, RunDir(tmp_path / "run"))
         venv.close()
         assert float(model.log_ent_coef.exp()) == pytest.approx(alpha)
     else:
         pytest.importorskip("ray")
-        from assistive_compiler.training.rllib import build_sac_config
+        from assistive_compiler.training.engines.rllib import build_sac_config
 
         assert build_sac_config(RunDir(sac_run), config, {}, False).initial_alpha == alpha
 
@@ -396,7 +397,7 @@ def test_layer_normed_critics_train_resume_and_stay_bounded_where_plain_ones_gro
     from stable_baselines3 import SAC
     from torch import nn
 
-    from assistive_compiler.training.critics import LayerNormSACPolicy
+    from assistive_compiler.training.learners.critics import LayerNormSACPolicy
 
     config = tmp_path / "sac_ln.yaml"
     config.write_text(SAC_TINY.replace("batch_size: 32}", "batch_size: 32, critic_layer_norm: true}"))
@@ -518,7 +519,7 @@ def test_an_actor_learning_rate_of_its_own_slows_the_actor_and_not_the_critics(s
     assert resumed.critic.optimizer.param_groups[0]["lr"] == 3.0e-4
     pytest.importorskip("ray")
     from assistive_compiler.training.config import load_training_config
-    from assistive_compiler.training.rllib import build_sac_config
+    from assistive_compiler.training.engines.rllib import build_sac_config
 
     rllib = build_sac_config(RunDir(out), load_training_config(config), {}, False)  # RLlib has the setting itself
     assert (rllib.actor_lr, rllib.critic_lr, rllib.alpha_lr) == (3.0e-7, 3.0e-4, 3.0e-4)
@@ -529,7 +530,7 @@ def test_the_averaged_actor_follows_the_actor_by_polyak_steps(sac_run):
     import torch
     from stable_baselines3 import SAC
 
-    from assistive_compiler.training.averaging import averaged, make_averaged
+    from assistive_compiler.training.learners.averaging import averaged, make_averaged
 
     checkpoint = RunDir(sac_run).latest_checkpoint()[1]
     model = SAC.load(str(checkpoint / "model.zip"), device="cpu", custom_objects={"replay_buffer_class": None})
@@ -558,7 +559,7 @@ def test_a_run_with_an_averaged_actor_acts_evaluates_exports_and_resumes_with_th
 
     from assistive_compiler.policies.checkpoint import SB3Policy
     from assistive_compiler.policies.mlp import MLPPolicy
-    from assistive_compiler.training.export import export_run
+    from assistive_compiler.training.trained.export import export_run
 
     config = tmp_path / "sac_averaged.yaml"
     config.write_text(SAC_TINY.replace("batch_size: 32}", "batch_size: 32, actor_average_tau: 0.002}"))
@@ -638,7 +639,7 @@ def test_export_gives_the_checkpoints_actions_in_numpy(which, reach_run, sac_run
     the same episodes; its policy.json carries the evaluation on unseen seeds."""
     from assistive_compiler.policies.checkpoint import SB3Policy
     from assistive_compiler.policies.mlp import MLPPolicy
-    from assistive_compiler.training.export import export_run
+    from assistive_compiler.training.trained.export import export_run
 
     run_dir = reach_run if which == "ppo" else sac_run
     record = export_run(run_dir, tmp_path / which, episodes=3, seed=100, label=f"{which} tiny")
@@ -683,7 +684,7 @@ def test_export_gives_the_checkpoints_actions_in_numpy(which, reach_run, sac_run
 
 
 def test_run_render_and_evaluate_take_a_run_directory_or_an_exported_policy(reach_run, tmp_path, capsys):
-    from assistive_compiler.training.export import export_run
+    from assistive_compiler.training.trained.export import export_run
 
     export_run(reach_run, tmp_path / "exported", episodes=2, seed=5)
     returns = {}
@@ -753,8 +754,8 @@ def test_a_coop_pair_trains_on_sb3_with_one_critic_and_each_agent_acts_on_its_ow
 
     from assistive_compiler.policies.checkpoint import load_policy
     from assistive_compiler.policies.pretrained import load_trained
-    from assistive_compiler.training.export import export_run
-    from assistive_compiler.training.factored_actor import FactoredActor
+    from assistive_compiler.training.learners.factored_actor import FactoredActor
+    from assistive_compiler.training.trained.export import export_run
 
     config = tmp_path / "sac_tiny.yaml"
     config.write_text(SAC_TINY)
@@ -1127,7 +1128,7 @@ def test_the_cloning_loss_fits_sigma_per_action_dimension_to_the_misses():
     import torch
     from stable_baselines3 import SAC
 
-    from assistive_compiler.training.demonstrations import cloning_loss
+    from assistive_compiler.training.learners.demonstrations import cloning_loss
 
     env = gym.make("Pendulum-v1")  # one action dimension
     model = SAC("MlpPolicy", env, policy_kwargs={"net_arch": [16]}, seed=0, device="cpu")
@@ -1242,9 +1243,9 @@ def test_demonstrations_need_sac_on_one_env_and_a_new_run(demos_root, demo_run, 
 def test_results_from_demonstrations_say_so_in_every_table(demo_run, tmp_path):
     """`table` marks the cell, an exported policy records the dataset, and the results doc's row
     names what the run started from: a demonstration start is never passed off as pure RL."""
-    from assistive_compiler.training.export import export_run
-    from assistive_compiler.training.results import results_block
-    from assistive_compiler.training.table import make_tables
+    from assistive_compiler.training.results.results_page import results_block
+    from assistive_compiler.training.results.table import make_tables
+    from assistive_compiler.training.trained.export import export_run
 
     copy = tmp_path / "run"
     shutil.copytree(demo_run, copy)

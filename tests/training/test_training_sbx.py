@@ -18,7 +18,7 @@ from assistive_compiler.cli import main
 from assistive_compiler.errors import SpecError
 from assistive_compiler.run_dir import RunDir
 from assistive_compiler.training.config import load_training_config
-from assistive_compiler.training.evaluate import evaluate
+from assistive_compiler.training.trained.evaluate import evaluate
 
 pytestmark = pytest.mark.slow
 
@@ -60,7 +60,7 @@ def test_an_sbx_run_resumes_with_its_replay_buffer_exports_and_plays_as_its_chec
 
     from assistive_compiler.policies.checkpoint import SB3Policy
     from assistive_compiler.policies.mlp import MLPPolicy
-    from assistive_compiler.training.export import export_run
+    from assistive_compiler.training.trained.export import export_run
 
     run = RunDir(sbx_run)
     assert run.info().library == "sbx"

@@ -6,7 +6,7 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
-from ..run_dir import write_atomic
+from ...run_dir import write_atomic
 
 CURVE_FIELDS = ("steps", "wall_s", "episodes", "mean_return", "success_rate", "steps_per_s")
 

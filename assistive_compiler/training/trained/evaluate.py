@@ -13,13 +13,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..episode import rollout
-from ..errors import UsageError
-from ..paths import display
-from ..policies.checkpoint import latest_checkpoint, load_policy
-from ..policies.pair import both_agents
-from ..run_dir import RunDir
-from .config import run_config
+from ...episode import rollout
+from ...errors import UsageError
+from ...paths import display
+from ...policies.checkpoint import latest_checkpoint, load_policy
+from ...policies.pair import both_agents
+from ...run_dir import RunDir
+from ..config import run_config
 
 
 def checkpoint_at(run: RunDir, steps: int | None) -> tuple[int, Path]:
@@ -40,7 +40,7 @@ def _stats(values: list[float]) -> tuple[float, float]:
 def trained_task_spec(info: dict) -> Path:
     """The spec an exported policy was trained on: its recorded path where it exists, else the
     shipped task of the same name."""
-    from ..paths import specs_dir
+    from ...paths import specs_dir
 
     recorded = Path(info.get("spec", ""))
     if recorded.is_file():
@@ -50,8 +50,8 @@ def trained_task_spec(info: dict) -> Path:
 
 def compile_for_policy(info: dict):
     """The task an exported policy was trained on, compiled on the current code (a cache hit when unchanged)."""
-    from ..compile.compiler import compile_task
-    from ..registration import cached_artifact_dir
+    from ...compile.compiler import compile_task
+    from ...registration import cached_artifact_dir
 
     spec = trained_task_spec(info)
     return compile_task(spec, info["robot"], cached_artifact_dir(spec, info["robot"]))
@@ -61,13 +61,13 @@ def play_episodes(artifact_dir: str | Path, policy, coop: bool, episodes: int, s
     """``episodes`` seeded episodes (``seed``, ``seed + 1``, ...) of ``policy`` on the artifact; a
     co-optimised pair (anything with ``agent("robot")`` and ``agent("human")``) plays both agents."""
     if coop:
-        from ..coop.parallel import AssistiveParallelEnv
-        from ..coop.rollout import rollout_coop
+        from ...coop.parallel import AssistiveParallelEnv
+        from ...coop.rollout import rollout_coop
 
         env = AssistiveParallelEnv(artifact_dir)
         play = lambda k: rollout_coop(env, policy.agent("robot"), policy.agent("human"), seed + k)  # noqa: E731
     else:
-        from ..runtime.env import AssistiveEnv
+        from ...runtime.env import AssistiveEnv
 
         env = AssistiveEnv(artifact_dir)
         play = lambda k: rollout(env, policy, seed + k)  # noqa: E731
@@ -79,8 +79,8 @@ def play_episodes(artifact_dir: str | Path, policy, coop: bool, episodes: int, s
 
 def write_rollout(artifact_dir: str | Path, policy, coop: bool, seed: int, out: Path, every: int = 2) -> str:
     """Write one rollout of ``policy`` as a GIF (or a PNG strip); returns a line saying so."""
-    from ..pictures import episode_frames, write_picture
-    from ..runtime.env import AssistiveEnv
+    from ...pictures import episode_frames, write_picture
+    from ...runtime.env import AssistiveEnv
 
     env = AssistiveEnv(artifact_dir, render_mode="rgb_array")
     target, act = (env, policy) if not coop else both_agents(env, policy)
@@ -97,8 +97,8 @@ def evaluate_exported(
     task, compiled on the current code (NumPy only; no training library needed). A co-optimised
     pair plays both agents. ``stochastic`` samples its actions as training did (seeded with
     ``seed``): for policies exported with their log-std; older ones are refused with what to do."""
-    from ..errors import UsageError
-    from ..policies.pretrained import load_trained
+    from ...errors import UsageError
+    from ...policies.pretrained import load_trained
 
     trained, info = load_trained(source)
     if stochastic and not trained.samples:
@@ -192,7 +192,7 @@ def save_evaluation(run: RunDir, result: dict) -> Path:
     """Write ``evaluation.json`` in the run directory (``table`` reads it)."""
     import json
 
-    from ..run_dir import write_atomic
+    from ...run_dir import write_atomic
 
     out = run.path / "evaluation.json"
     write_atomic(out, json.dumps(result, indent=1))

@@ -21,7 +21,7 @@ from stable_baselines3.common.torch_layers import create_mlp
 from stable_baselines3.sac.policies import LOG_STD_MAX, LOG_STD_MIN, Actor, SACPolicy
 from torch import nn
 
-from ..artifact import AGENTS
+from ...artifact import AGENTS
 from .critics import LayerNormSACPolicy
 
 

@@ -14,8 +14,8 @@ import csv
 import json
 from pathlib import Path
 
-from ..paths import display
-from ..run_dir import RunDir
+from ...paths import display
+from ...run_dir import RunDir
 from .paper import PAPER, ROBOT_TITLES, ROBOTS, TASK_TITLES, TASKS
 
 EVALUATION_FILE = "evaluation.json"
@@ -25,7 +25,7 @@ DEMONSTRATIONS_MARK = " †"
 
 def run_figures(run_dir: str | Path, episodes: int | None = None, seed: int = 0) -> dict:
     """The run's evaluation (read from ``evaluation.json``, or computed and written there)."""
-    from .evaluate import evaluate, save_evaluation
+    from ..trained.evaluate import evaluate, save_evaluation
 
     run = RunDir(run_dir)
     run.info()  # a clear error when this is not a run directory
@@ -100,7 +100,7 @@ def markdown_table(header: list[str], rows: list[list[str]]) -> str:
 
 def make_tables(run_dirs: list[str], out: str | None = None, episodes: int | None = None, seed: int = 0) -> str:
     """The Markdown report; with ``out`` (``results.md``) also ``results.csv`` and ``results.png``."""
-    from .curves import plot_curves, read_curve
+    from ..bookkeeping.curves import plot_curves, read_curve
 
     results = [run_figures(d, episodes, seed) for d in run_dirs]
     best = best_per_cell(results)

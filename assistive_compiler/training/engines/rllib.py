@@ -21,11 +21,11 @@ import socket
 import sys
 from pathlib import Path
 
-from ..artifact import AGENTS
-from ..errors import UsageError
-from ..run_dir import RunDir
-from .config import TrainingConfig
-from .progress import Progress
+from ...artifact import AGENTS
+from ...errors import UsageError
+from ...run_dir import RunDir
+from ..bookkeeping.progress import Progress
+from ..config import TrainingConfig
 
 ENV_NAME = "assistive_compiler"
 CONNECT_TIMEOUT_S = 3.0
@@ -36,23 +36,23 @@ def make_rllib_env(env_config: dict):
     """RLlib's env creator: the run's compiled task, as two agents (co-op) or one. The task
     travels in the env config (:mod:`assistive_compiler.bundle`): each worker unpacks it into its
     own cache, so no machine needs the driver's files."""
-    from ..bundle import unpack
+    from ...bundle import unpack
 
     artifact_dir = unpack(env_config["artifact_bundle"])
     if env_config["coop"]:
         from ray.rllib.env.wrappers.pettingzoo_env import ParallelPettingZooEnv
 
-        from ..coop.parallel import AssistiveParallelEnv
+        from ...coop.parallel import AssistiveParallelEnv
 
         return ParallelPettingZooEnv(AssistiveParallelEnv(artifact_dir))
-    from ..runtime.env import AssistiveEnv
+    from ...runtime.env import AssistiveEnv
 
     return AssistiveEnv(artifact_dir)
 
 
 def env_config(run: RunDir, coop: bool, weights: dict[str, float]) -> dict:
     """What every env runner gets: the compiled task itself (not a path), co-op or not, the reward weights."""
-    from ..bundle import pack
+    from ...bundle import pack
 
     return {"artifact_bundle": pack(run.artifact), "coop": coop, "weights": weights}
 

@@ -18,10 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..policies.mlp import MLPPolicy
-from ..run_dir import RunDir
-from .config import run_config
-from .curves import cut_curve
+from ...policies.mlp import MLPPolicy
+from ...run_dir import RunDir
+from ..bookkeeping.curves import cut_curve
+from ..config import run_config
 from .evaluate import checkpoint_at
 
 #: Unseen seeds of the evaluation: training seeds its envs with the config's seed (0–10 in the
@@ -126,7 +126,7 @@ def check_same_actions(exported: MLPPolicy, original, observations: np.ndarray, 
 def evaluate_policy(artifact: Path, policy, episodes: int, seed: int) -> dict:
     """Mean ± std return, success rate and force on the person over seeded episodes (deterministic);
     a co-optimised pair (:class:`~assistive_compiler.policies.pretrained.CoopPolicy`) plays both agents."""
-    from ..policies.pretrained import CoopPolicy
+    from ...policies.pretrained import CoopPolicy
     from .evaluate import play_episodes
 
     runs = play_episodes(artifact, policy, isinstance(policy, CoopPolicy), episodes, seed)
@@ -148,7 +148,7 @@ def evaluate_policy(artifact: Path, policy, episodes: int, seed: int) -> dict:
 def _wall_at(run: RunDir, steps: int) -> float | None:
     """Wall seconds of training up to ``steps`` env steps (over every sitting of a resumed run),
     from the learning curve's last row at or before them."""
-    from .curves import read_curve
+    from ..bookkeeping.curves import read_curve
 
     rows = [r for r in read_curve(run.curve_csv) if r["steps"] <= steps]
     return rows[-1]["wall_s"] if rows else None
@@ -175,17 +175,17 @@ def export_run(
     """Export the run's checkpoint at ``checkpoint_steps`` env steps (None: the newest) to ``out``
     and evaluate the exported policy there; returns its ``policy.json``. ``label`` names the table
     row (e.g. ``"PPO (paper) baseline"``). The learning curve goes with it up to that checkpoint."""
-    from ..policies.pretrained import pretrained_dir
+    from ...policies.pretrained import pretrained_dir
 
     run = RunDir(run_dir)
     info = run.info()
     steps, checkpoint = checkpoint_at(run, checkpoint_steps)
     config = run_config(info)
     rng = np.random.default_rng(0)
-    from ..policies.pretrained import CoopPolicy
+    from ...policies.pretrained import CoopPolicy
 
     if info.engine == "sb3" and not info.coop:
-        from ..policies.checkpoint import SB3Policy
+        from ...policies.checkpoint import SB3Policy
 
         original = SB3Policy(checkpoint, config.algorithm, library=config.library)
         policy = mlp_from_sb3(original, config.algorithm, config.network.activation)
@@ -193,7 +193,7 @@ def export_run(
         acting = original if original.numpy_policy is None else _jax_mean_action(original.model)
         worst = check_same_actions(policy, acting, rng.normal(0.0, 1.0, (32, policy.obs_dim)))
     else:
-        from ..policies.checkpoint import SINGLE_MODULE, RLlibPolicy, SB3PairPolicy
+        from ...policies.checkpoint import SINGLE_MODULE, RLlibPolicy, SB3PairPolicy
 
         agents: SB3PairPolicy | RLlibPolicy  # each agent's checkpoint policy, by name: .agent(name)
         if info.engine == "sb3":

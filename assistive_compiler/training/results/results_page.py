@@ -24,8 +24,8 @@ PICTURES = "results/cells"  # beside the doc: docs/results/cells/<name>-curve.pn
 
 def shipped_records() -> list[dict]:
     """Every shipped policy's ``policy.json``, by name."""
-    from ..policies.mlp import POLICY_FILE
-    from ..policies.pretrained import pretrained_dir, shipped_names
+    from ...policies.mlp import POLICY_FILE
+    from ...policies.pretrained import pretrained_dir, shipped_names
 
     return [json.loads((pretrained_dir() / n / POLICY_FILE).read_text()) for n in shipped_names()]
 
@@ -205,9 +205,9 @@ def results_block(records: list[dict]) -> str:
 
 def write_pictures(records: list[dict], doc_dir: Path, progress=None) -> list[Path]:
     """Each cell's learning curve and a strip of its first evaluation episode (rendered anew)."""
-    from ..policies.pretrained import PREFIX, load_trained, pretrained_dir
-    from .curves import plot_curves, read_curve
-    from .evaluate import compile_for_policy, write_rollout
+    from ...policies.pretrained import PREFIX, load_trained, pretrained_dir
+    from ..bookkeeping.curves import plot_curves, read_curve
+    from ..trained.evaluate import compile_for_policy, write_rollout
 
     out_dir = doc_dir / PICTURES
     written = []

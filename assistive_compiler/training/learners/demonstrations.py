@@ -34,8 +34,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import UsageError
-from .config import Demonstrations
+from ...errors import UsageError
+from ..config import Demonstrations
 from .wrapped_optimizer import WrappedOptimizer
 
 

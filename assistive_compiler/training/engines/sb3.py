@@ -5,7 +5,9 @@ each a :class:`~assistive_compiler.runtime.env.AssistiveEnv` built from the run'
 artifact, optionally (PPO) behind :class:`VecNormalize` (running observation and return
 statistics, saved with every checkpoint). A co-optimisation run (``coop``, SAC only) trains the
 robot and the person together: each env is :class:`~assistive_compiler.coop.joint.JointAgentsEnv`
-and the actor one network per agent with one shared critic (:mod:`.factored_actor`).
+and the actor one network per agent with one shared critic (:mod:`.learners.factored_actor`).
+The model itself, and the SAC settings that change its updates, come from :mod:`.learners`
+(:func:`.learners.choice.new_model`, :func:`.learners.sac.set_up_sac`): this module runs it.
 
 A checkpoint is a directory holding ``model.zip``, PPO's ``vecnormalize.pkl`` and SAC's
 ``replay_buffer.pkl`` (kept in the newest checkpoint only: it is the bulk of a checkpoint);
@@ -17,13 +19,14 @@ from __future__ import annotations
 import functools
 from pathlib import Path
 
-from ..episode import EpisodeTally
-from ..policies.checkpoint import algorithm_class
-from ..run_dir import RunDir
-from .config import TrainingConfig
-from .progress import Progress
+from ...episode import EpisodeTally
+from ...policies.checkpoint import algorithm_class
+from ...run_dir import RunDir
+from ..bookkeeping.progress import Progress
+from ..config import TrainingConfig
+from ..learners.choice import new_model
+from ..learners.sac import set_up_sac
 
-ACTIVATIONS = {"tanh": "Tanh", "relu": "ReLU"}
 #: Env steps between two learning-curve rows for SAC, whose "rollouts" are single env steps.
 SAC_LOG_EVERY_STEPS = 2_000
 REPLAY_BUFFER = "replay_buffer.pkl"
@@ -40,10 +43,10 @@ def make_monitored_env(artifact_dir: str, in_worker: bool = False, coop: bool = 
 
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     if coop:
-        from ..coop.joint import JointAgentsEnv
+        from ...coop.joint import JointAgentsEnv
 
         return Monitor(JointAgentsEnv(artifact_dir))
-    from ..runtime.env import AssistiveEnv
+    from ...runtime.env import AssistiveEnv
 
     return Monitor(AssistiveEnv(artifact_dir))
 
@@ -60,20 +63,6 @@ def make_vec_env(artifact_dir: Path, n_envs: int, seed: int, coop: bool = False,
     return venv
 
 
-def policy_kwargs(config: TrainingConfig) -> dict:
-    """The network's shape and activation as the learning library takes them (a PyTorch module
-    class for SB3, a JAX function for SBX)."""
-    hidden = list(config.network.hidden)
-    arch = {"pi": hidden, "vf": hidden} if config.algorithm == "ppo" else {"pi": hidden, "qf": hidden}
-    if config.library == "sbx":
-        import flax.linen
-
-        return {"net_arch": arch, "activation_fn": getattr(flax.linen, config.network.activation)}
-    import torch.nn as nn
-
-    return {"net_arch": arch, "activation_fn": getattr(nn, ACTIVATIONS[config.network.activation])}
-
-
 def _normalized(venv, config: TrainingConfig, checkpoint: Path | None):
     from stable_baselines3.common.vec_env import VecNormalize
 
@@ -86,69 +75,6 @@ def _normalized(venv, config: TrainingConfig, checkpoint: Path | None):
         norm_obs=config.ppo.normalize_observations,
         norm_reward=config.ppo.normalize_rewards,
         gamma=config.ppo.gamma,
-    )
-
-
-def sac_policy(config: TrainingConfig, agent_split: tuple[int, int] | None) -> tuple[object, dict]:
-    """SAC's policy class and ``policy_kwargs``: SB3's own, with layer-normalised critics
-    (``sac.critic_layer_norm``) and, for a co-optimised pair (``agent_split``: the robot's
-    observation and action sizes), one actor per agent."""
-    from .critics import LayerNormSACPolicy
-
-    assert config.sac is not None
-    kwargs = policy_kwargs(config)
-    if agent_split is None:
-        return (LayerNormSACPolicy if config.sac.critic_layer_norm else "MlpPolicy"), kwargs
-    from .factored_actor import FactoredLayerNormSACPolicy, FactoredSACPolicy
-
-    policy = FactoredLayerNormSACPolicy if config.sac.critic_layer_norm else FactoredSACPolicy
-    return policy, kwargs | {"agent_split": agent_split}
-
-
-def _new_model(venv, config: TrainingConfig, run: RunDir, agent_split: tuple[int, int] | None = None):
-    from stable_baselines3 import PPO
-
-    if config.sac is not None:
-        s = config.sac
-        policy, kwargs = sac_policy(config, agent_split) if s.library == "sb3" else ("MlpPolicy", policy_kwargs(config))
-        return algorithm_class(config)(
-            policy,
-            venv,
-            learning_rate=s.learning_rate,
-            buffer_size=s.buffer_size,
-            learning_starts=s.learning_starts,
-            batch_size=s.batch_size,
-            tau=s.tau,
-            gamma=s.gamma,
-            train_freq=s.train_freq,
-            gradient_steps=s.gradient_steps,
-            ent_coef=f"auto_{s.initial_ent_coef:g}" if s.ent_coef == "auto" else s.ent_coef,
-            target_entropy="auto" if s.target_entropy == "cloned" else s.target_entropy,  # cloned: set on cloning
-            policy_kwargs=kwargs,
-            tensorboard_log=str(run.tb),
-            seed=config.seed,
-            device="cpu",
-            verbose=0,
-        )
-    p = config.ppo
-    return PPO(
-        "MlpPolicy",
-        venv,
-        n_steps=p.rollout_steps,
-        batch_size=p.minibatch_size,
-        n_epochs=p.epochs,
-        gamma=p.gamma,
-        gae_lambda=p.gae_lambda,
-        learning_rate=p.learning_rate,
-        clip_range=p.clip_range,
-        ent_coef=p.entropy_coef,
-        vf_coef=p.value_coef,
-        max_grad_norm=p.max_grad_norm,
-        policy_kwargs=policy_kwargs(config),
-        tensorboard_log=str(run.tb),
-        seed=config.seed,
-        device="cpu",
-        verbose=0,
     )
 
 
@@ -167,7 +93,7 @@ def save_checkpoint(run: RunDir, model, steps: int) -> Path:
     off_policy = isinstance(model, OffPolicyAlgorithm)
     if off_policy:
         model.save_replay_buffer(str(out / REPLAY_BUFFER))
-        from .averaging import averaged
+        from ..learners.averaging import averaged
 
         average = averaged(model)
         if average is not None:
@@ -237,7 +163,7 @@ def train(
     the learner's updates of this session.
     ``coop`` (SAC): the robot and the person together, one actor each and one critic.
 
-    A new run given ``demonstrations`` (:class:`.demonstrations.DemonstrationData`) starts from
+    A new run given ``demonstrations`` (:class:`.learners.demonstrations.DemonstrationData`) starts from
     them: its actor cloned, its replay buffer filled, its critics warmed up and a checkpoint
     written at step 0 (the cloned policy, before any env step), before it learns; with the
     config's ``clone_weight`` > 0 (new or resumed run) the cloning stays in the actor's loss, and
@@ -252,7 +178,7 @@ def train(
     latest = run.latest_checkpoint() if resume else None
     start_steps = latest[0] if latest else 0
     if latest and config.sac is not None and not (latest[1] / REPLAY_BUFFER).is_file():
-        from ..errors import UsageError
+        from ...errors import UsageError
 
         raise UsageError(
             f"{latest[1] / REPLAY_BUFFER}: --resume of a SAC run needs the newest checkpoint's replay buffer, which is missing"
@@ -269,33 +195,12 @@ def train(
         if config.sac is not None:
             model.load_replay_buffer(str(latest[1] / REPLAY_BUFFER))
     else:
-        model = _new_model(venv, config, run, venv.get_attr("agent_split")[0] if coop else None)
-    if config.sac is not None and config.sac.actor_learning_rate is not None:  # new or resumed
-        from .actor_rate import set_actor_learning_rate
-
-        set_actor_learning_rate(model, config.sac.actor_learning_rate)
-    if config.sac is not None and config.sac.conservative_weight > 0:  # new or resumed: not in the checkpoint
-        from .critics import make_conservative
-
-        make_conservative(model, config.sac.conservative_weight, config.seed + start_steps)
-    if demonstrations is not None:  # train.train reads them only for a config that has a demonstrations block
-        from .demonstrations import start_from, update_actor_as_configured
-
-        assert config.demonstrations is not None
-        if not latest:
-            assert config.sac is not None
-            started_from = start_from(
-                model, demonstrations, config.demonstrations, config.seed, config.sac.target_entropy
-            )
-        update_actor_as_configured(model, demonstrations, config.demonstrations, config.seed + start_steps)
-    if config.sac is not None and config.sac.actor_average_tau > 0:  # new (after any cloning) or resumed
-        from .averaging import make_averaged
-
-        make_averaged(model, config.sac.actor_average_tau, latest[1] if latest else None)
+        model = new_model(venv, config, run, venv.get_attr("agent_split")[0] if coop else None)
+    started_from = set_up_sac(model, config, demonstrations, latest, start_steps)
     if demonstrations is not None and not latest:
         import json
 
-        from ..run_dir import write_atomic
+        from ...run_dir import write_atomic
 
         save_checkpoint(run, model, 0)  # the cloned policy, before any env step
         write_atomic(run.demonstrations_json, json.dumps(started_from, indent=1))

@@ -11,7 +11,7 @@ import time
 
 import numpy as np
 
-from ..run_dir import RunDir
+from ...run_dir import RunDir
 from .curves import CURVE_FIELDS, cut_curve
 
 

@@ -7,11 +7,11 @@ import sys
 import time
 from pathlib import Path
 
-from ..artifact import Manifest
-from ..errors import SpecError
-from ..paths import display
-from ..run_dir import RUN_FILE, RunDir, RunInfo, package_versions
-from .config import TrainingConfig
+from ...artifact import Manifest
+from ...errors import SpecError
+from ...paths import display
+from ...run_dir import RUN_FILE, RunDir, RunInfo, package_versions
+from ..config import TrainingConfig
 
 
 def new_run_info(spec: str, manifest, robot: str, coop: bool, engine: str, config: TrainingConfig) -> RunInfo:

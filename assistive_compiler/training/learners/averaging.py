@@ -22,8 +22,8 @@ from pathlib import Path
 import torch
 from stable_baselines3.common.utils import polyak_update
 
-from ..errors import UsageError
-from ..policies.checkpoint import ACTOR_AVERAGE
+from ...errors import UsageError
+from ...policies.checkpoint import ACTOR_AVERAGE
 from .wrapped_optimizer import WrappedOptimizer
 
 
