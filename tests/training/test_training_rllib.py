@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import re
 import time
 from pathlib import Path
 
@@ -212,9 +213,10 @@ def test_multi_agent_sac_trains_and_exports_a_pair_that_plays_under_coop(local_r
         )
         == 0
     )
-    assert (
-        f"return {record['evaluation']['returns'][0]:.1f}" in capsys.readouterr().out
-    )  # both agents acted, as in run --coop
+    # both agents acted, as in run --coop: the picture's episode has the evaluation's return (printed
+    # to one decimal, so a return near a rounding edge may print either neighbour)
+    printed = re.search(r"return (-?[0-9.]+)", capsys.readouterr().out)
+    assert printed and float(printed.group(1)) == pytest.approx(record["evaluation"]["returns"][0], abs=0.06)
 
 
 def _free_port() -> int:
