@@ -255,7 +255,7 @@ class ScriptedPolicy:
                 distance = float(np.linalg.norm(ahead))
                 if distance > step:
                     goal = here + ahead * (step / distance)
-            inward = -env.snap.normal(track.waypoints[track.index][0])
+            inward = None  # into the surface faced: the followed surface's, else the target's (read when needed)
             if surface is not None:  # the look-ahead put on the followed surface
                 goal, outward = self._on_surface(track, goal)
                 inward = -outward
@@ -263,6 +263,8 @@ class ScriptedPolicy:
             inv_pos, inv_orn = pb.invertTransform(*track.point_in_ee)
             orn = self._orientation(track)
             if track.face_normal[track.index] is not None:
+                if inward is None:
+                    inward = -env.snap.normal(track.waypoints[track.index][0])
                 turn = self._yawing if track.face_level[track.index] else self._facing
                 orn = turn(track, orn, inward, track.face_normal[track.index])
             turn_step = track.turn_steps[track.index]
