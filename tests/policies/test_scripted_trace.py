@@ -11,6 +11,8 @@ from pathlib import Path
 import pytest
 from helpers import cli
 
+from assistive_compiler.artifact import Manifest
+from assistive_compiler.artifact.canonical import canonical_data
 from assistive_compiler.paths import specs_dir
 from assistive_compiler.spec.models import Waypoint
 
@@ -57,7 +59,7 @@ def test_an_unreachable_waypoint_is_explained_in_one_trace_line(far):
     assert "success rate 0.00" in out  # run's own report follows
 
 
-def test_the_stall_rule_is_set_per_waypoint_and_kept_in_the_manifest_only_when_not_default(tmp_path, far):
+def test_the_stall_rule_is_set_per_waypoint_and_hashed_only_when_not_default(tmp_path, far):
     spec = _reach_with(tmp_path, "{to: mouth, offset_m: [0.0, 0.0, 1.0], stall_steps: 4, stall_progress_m: 0.005}")
     status, out, err = _run(spec, "--trace", "--json", "--quiet")
     assert status == 0, err
@@ -67,7 +69,11 @@ def test_the_stall_rule_is_set_per_waypoint_and_kept_in_the_manifest_only_when_n
     assert "(no progress of more than 5 mm in 4 steps); on to waypoint 1" in stall["line"]
     waypoints = json.loads((tmp_path / "art" / "manifest.json").read_text())["scripted"]["waypoints"]
     assert (waypoints[0]["stall_steps"], waypoints[0]["stall_progress_m"]) == (4, 0.005)
-    assert "stall_steps" not in waypoints[1] and "stall_progress_m" not in waypoints[1]
+    assert (waypoints[1]["stall_steps"], waypoints[1]["stall_progress_m"]) == (10, 0.002)
+    # the content hash's form leaves the default rule out, so tasks compiled before it hash the same
+    hashed = canonical_data(Manifest.read(tmp_path / "art"))["scripted"]["waypoints"]
+    assert (hashed[0]["stall_steps"], hashed[0]["stall_progress_m"]) == (4, 0.005)
+    assert "stall_steps" not in hashed[1] and "stall_progress_m" not in hashed[1]
     # the default rule gives up later
     status, default_out, err = _run(far, "--trace", "--json", "--quiet")
     assert status == 0, err

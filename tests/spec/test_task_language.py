@@ -115,7 +115,8 @@ def test_facing_a_normal_needs_a_surface_target(tmp_path):
     spec = _first_scratch_waypoint_replaced("    - {to: person.right_wrist, face_normal_within_deg: 90}")
     err = _rejected_at(tmp_path, spec, "person.right_wrist, face_normal")
     assert (
-        "face_normal_within_deg needs a target drawn on a surface (surface_of); 'person.right_wrist' is not one" in err
+        "face_normal_within_deg needs a target drawn on a surface (surface_of) or a surface to follow "
+        "(along_surface_of); 'person.right_wrist' is not one" in err
     )
 
 
