@@ -677,6 +677,10 @@ def test_export_gives_the_checkpoints_actions_in_numpy(which, reach_run, sac_run
     sampled = [evaluate_exported(str(tmp_path / which), episodes=2, seed=100, stochastic=True) for _ in range(2)]
     assert sampled[0]["actions"] == "stochastic" and sampled[0]["per_episode"] == sampled[1]["per_episode"]
     assert [e["return"] for e in sampled[0]["per_episode"]] != record["evaluation"]["returns"][:2]
+    # export recorded the sampled-action protocol too: the same episodes as evaluate --stochastic
+    recorded_sampled = record["evaluation_sampled"]
+    assert recorded_sampled["episodes"] == 3 and recorded_sampled["seed"] == 100
+    assert recorded_sampled["returns"][:2] == [round(e["return"], 3) for e in sampled[0]["per_episode"]]
     ours = evaluate(run_dir, episodes=3, seed=100)
     assert [round(e["return"], 3) for e in ours["per_episode"]] == record["evaluation"]["returns"]
     assert record["evaluation"]["success_rate"] == ours["success_rate"]

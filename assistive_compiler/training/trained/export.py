@@ -5,9 +5,10 @@ The folder (default ``pretrained/<task>-<robot>[-coop]``) holds the network as
 (``curve.csv``) and, in ``policy.json``, everything ``results`` needs to write a table row:
 what was trained (task, robot, algorithm, config, the compiled task's content hash), how long
 (env steps, wall time, env steps/s including learning), and the exported policy's own
-evaluation as the paper evaluates (deterministic actions, ``episodes`` episodes on seeds
-``seed``.. that training never used) plus the few fixed ``regression`` seeds the test suite
-re-checks on the current code.
+evaluation (the mean action, ``episodes`` episodes on seeds ``seed``.. that training never used),
+the same with actions sampled from the policy's Gaussian (``evaluation_sampled``: the reference
+code's protocol), plus the few fixed ``regression`` seeds the test suite re-checks on the current
+code.
 """
 
 from __future__ import annotations
@@ -214,8 +215,12 @@ def export_run(
     name = f"{info.task}-{info.robot}{'-coop' if info.coop else ''}"
     out = Path(out) if out else pretrained_dir() / name
     evaluation = evaluate_policy(run.artifact, policy, episodes, seed)
+    # the reference code's protocol as well: actions sampled from the policy's Gaussian (seeded with
+    # the first episode's seed, as evaluate --stochastic samples), on the same seeds
+    sampled = evaluate_policy(run.artifact, policy.sampling(seed), episodes, seed) if policy.samples else None
     if progress:
-        progress(f"evaluated {episodes} episodes: success {evaluation['success_rate']:.2f}")
+        also = f", sampled actions {sampled['success_rate']:.2f}" if sampled else ""
+        progress(f"evaluated {episodes} episodes: success {evaluation['success_rate']:.2f}{also}")
     first = min(REGRESSION_EPISODES, episodes)
     regression = {
         "seed": seed,
@@ -244,6 +249,7 @@ def export_run(
         "versions": info.versions,
         "export_max_action_difference": worst,
         "evaluation": evaluation,
+        "evaluation_sampled": sampled,
         "regression": regression,
     }
     if out.exists():
