@@ -1,6 +1,6 @@
 """Small helpers shared by test modules: where a needle sits in a spec's text (``LINE:COL``, as
 the CLI reports locations), an env of a spec compiled into a fresh directory, and the check that
-an exported co-optimised pair acts as its checkpoint, and reads of the person and a mobile base
+an exported co-optimised pair acts as its checkpoint, training the reach example, and reads of the person and a mobile base
 through the env's API."""
 
 from __future__ import annotations
@@ -23,6 +23,18 @@ def at(text: str, needle: str, occurrence: int = 1) -> str:
     line = text.count("\n", 0, index) + 1
     column = index - (text.rfind("\n", 0, index) + 1) + 1
     return f"{line}:{column}"
+
+
+#: The reach example (specs/examples/reach.yaml): a small task the training tests learn quickly.
+REACH = Path(__file__).resolve().parents[1] / "specs" / "examples" / "reach.yaml"
+
+
+def train_reach(config: Path, out: Path, *extra: str) -> None:
+    """``train`` the reach example for Jaco with ``config`` into ``out`` (quiet), and check it succeeded."""
+    from assistive_compiler.cli import main
+
+    argv = ["train", str(REACH), "--robot", "jaco", "--config", str(config), "--out", str(out), "--quiet", *extra]
+    assert main(argv) == 0
 
 
 def compiled_env(tmp_path_factory, spec: Path, robot: str):

@@ -15,6 +15,8 @@ import yaml
 
 pytest.importorskip("stable_baselines3", reason='needs the "train" extra (README: Training); CI installs it')
 
+from helpers import REACH, train_reach
+
 from assistive_compiler.cli import main
 from assistive_compiler.run_dir import RunDir
 from assistive_compiler.training.trained.evaluate import evaluate
@@ -22,7 +24,6 @@ from assistive_compiler.training.trained.evaluate import evaluate
 pytestmark = pytest.mark.slow
 
 REPO = Path(__file__).resolve().parents[2]
-REACH = REPO / "specs" / "examples" / "reach.yaml"
 ROLLOUT, ENVS = 256, 2
 BATCH = ROLLOUT * ENVS
 
@@ -37,15 +38,10 @@ def _config(tmp: Path, total_steps: int) -> Path:
     return path
 
 
-def _train(config: Path, out: Path, *extra: str) -> None:
-    argv = ["train", str(REACH), "--robot", "jaco", "--config", str(config), "--out", str(out), "--quiet", *extra]
-    assert main(argv) == 0
-
-
 @pytest.fixture(scope="module")
 def in_process_run(tmp_path_factory) -> Path:
     tmp = tmp_path_factory.mktemp("in-process")
-    _train(_config(tmp, BATCH * 4), tmp / "run")
+    train_reach(_config(tmp, BATCH * 4), tmp / "run")
     return tmp / "run"
 
 
@@ -76,7 +72,7 @@ def test_an_in_process_run_resumes_exports_and_plays_as_its_checkpoint(in_proces
     assert steps == BATCH * 4 and sorted(run.complete_checkpoints()) == [BATCH * 2, BATCH * 4]
 
     # resume: the step count and the curve go on from the newest checkpoint
-    _train(_config(tmp_path, BATCH * 4), in_process_run, "--resume", "--steps", str(BATCH * 6))
+    train_reach(_config(tmp_path, BATCH * 4), in_process_run, "--resume", "--steps", str(BATCH * 6))
     assert run.latest_checkpoint()[0] == BATCH * 6
     rows = list(csv.DictReader((in_process_run / "curve.csv").open()))
     assert [int(r["steps"]) for r in rows] == [BATCH * k for k in range(1, 7)]

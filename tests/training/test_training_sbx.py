@@ -14,6 +14,8 @@ import yaml
 
 pytest.importorskip("sbx", reason='needs the "train" extra (README: Training); CI installs it')
 
+from helpers import REACH, train_reach
+
 from assistive_compiler.cli import main
 from assistive_compiler.errors import SpecError
 from assistive_compiler.run_dir import RunDir
@@ -23,7 +25,6 @@ from assistive_compiler.training.trained.evaluate import evaluate
 pytestmark = pytest.mark.slow
 
 REPO = Path(__file__).resolve().parents[2]
-REACH = REPO / "specs" / "examples" / "reach.yaml"
 CHECKPOINT_EVERY = 300
 
 
@@ -38,15 +39,10 @@ def _config(tmp: Path, total_steps: int, **sac) -> Path:
     return path
 
 
-def _train(config: Path, out: Path, *extra: str) -> None:
-    argv = ["train", str(REACH), "--robot", "jaco", "--config", str(config), "--out", str(out), "--quiet", *extra]
-    assert main(argv) == 0
-
-
 @pytest.fixture(scope="module")
 def sbx_run(tmp_path_factory) -> Path:
     tmp = tmp_path_factory.mktemp("sbx")
-    _train(_config(tmp, 2 * CHECKPOINT_EVERY), tmp / "run")
+    train_reach(_config(tmp, 2 * CHECKPOINT_EVERY), tmp / "run")
     return tmp / "run"
 
 
@@ -71,7 +67,7 @@ def test_an_sbx_run_resumes_with_its_replay_buffer_exports_and_plays_as_its_chec
     assert model.replay_buffer.size() == 2 * CHECKPOINT_EVERY  # every transition so far, none lost
 
     # resume: the step count goes on, and the replay buffer holds the first session's data too
-    _train(_config(tmp_path, 2 * CHECKPOINT_EVERY), sbx_run, "--resume", "--steps", str(3 * CHECKPOINT_EVERY))
+    train_reach(_config(tmp_path, 2 * CHECKPOINT_EVERY), sbx_run, "--resume", "--steps", str(3 * CHECKPOINT_EVERY))
     steps, checkpoint = run.latest_checkpoint()
     assert steps == 3 * CHECKPOINT_EVERY
     model.load_replay_buffer(str(checkpoint / "replay_buffer.pkl"))
