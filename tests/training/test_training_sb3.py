@@ -263,6 +263,12 @@ def test_a_run_written_before_the_canonical_content_hash_resumes(tmp_path):
     newest = sorted(p.name for p in (copy / "checkpoints").iterdir())[-1]
     assert newest == "step_0000001600", newest
     assert RunDir(copy).info().content_hash == recorded  # the run keeps the task it was started on
+    # its policy is shipped with the hash today's code gives that task, not the older rule's number
+    from assistive_compiler.training.trained.export import export_run
+
+    exported = export_run(copy, tmp_path / "exported", episodes=1, seed=0)
+    today = Manifest.read(RunDir(copy).artifact)
+    assert exported["content_hash"] == today.hash_of(RunDir(copy).artifact) != recorded
 
 
 @pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])

@@ -155,6 +155,14 @@ def _wall_at(run: RunDir, steps: int) -> float | None:
     return rows[-1]["wall_s"] if rows else None
 
 
+def _trained_on_hash(run: RunDir) -> str:
+    """The content hash, as today's code hashes it, of the compiled task the run trained on (its
+    own artifact, checked undamaged)."""
+    from ...artifact import Manifest
+
+    return Manifest.read(run.artifact, verify=True).hash_of(run.artifact)
+
+
 def _default_label(info) -> str:
     """``SAC (sac_laptop)``: the algorithm and the config the run was started with (``results``
     adds what a run that started from demonstrations started from)."""
@@ -237,7 +245,9 @@ def export_run(
         "coop": info.coop,
         "gym_id": info.gym_id,
         "spec": info.spec,
-        "content_hash": info.content_hash,
+        # the run's own artifact under today's hashing rule (a run started before the rule recorded
+        # the hash of its manifest file's JSON: the same task, another number)
+        "content_hash": _trained_on_hash(run),
         "engine": info.engine,
         "algorithm": config.algorithm,
         # False for pure RL; a run started from demonstrations: its dataset and how the start went
