@@ -49,8 +49,15 @@ def cmd_results(args: argparse.Namespace) -> int:
 
     doc = Path(args.out)
     records = shipped_records()
+    if args.pictures_of:
+        unknown = sorted(set(args.pictures_of) - {r["name"] for r in records})
+        if unknown:
+            from ..errors import UsageError
+
+            raise UsageError(f"results --pictures-of: no shipped policy {', '.join(unknown)} (see pretrained/)")
+    drawn = [r for r in records if not args.pictures_of or r["name"] in args.pictures_of]
     if not args.no_pictures:
-        write_pictures(records, doc.parent, progress=lambda name: print(f"pictures of {name}", file=sys.stderr))
+        write_pictures(drawn, doc.parent, progress=lambda name: print(f"pictures of {name}", file=sys.stderr))
     doc.parent.mkdir(parents=True, exist_ok=True)
     doc.write_text(update_doc(doc, records))
     print(f"wrote {display(doc)} from {len(records)} shipped polic{'y' if len(records) == 1 else 'ies'}")
@@ -92,5 +99,11 @@ def add_commands(sub) -> None:
     p.add_argument("--out", default="docs/results.md", help="the results document (its generated block is replaced)")
     p.add_argument(
         "--no-pictures", action="store_true", help="tables only; keep the curve and rollout pictures as they are"
+    )
+    p.add_argument(
+        "--pictures-of",
+        nargs="+",
+        metavar="NAME",
+        help="draw only these cells' pictures (e.g. newly shipped ones); the tables still cover every cell",
     )
     p.set_defaults(func=cmd_results)

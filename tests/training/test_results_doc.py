@@ -7,6 +7,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import pytest
+
 from assistive_compiler.training.results.results_page import BEGIN, END, results_block, shipped_records, update_doc
 
 REPO = Path(__file__).resolve().parents[2]
@@ -104,3 +106,19 @@ def test_the_claim_pairs_a_coop_cell_with_the_static_cell_of_its_settings_before
     claim = block[block.index("### The paper's claim") : block.index("### Each cell")]
     row = next(line for line in claim.splitlines() if line.startswith("| Itch Scratching | Jaco | SAC |"))
     assert "`scratch_itch-jaco-low-entropy`" in row and "`scratch_itch-jaco`" not in row
+
+
+def test_results_draws_the_pictures_of_the_named_cells_only(tmp_path, capsys):
+    """``results --pictures-of NAME``: that cell's curve and rollout are drawn, no other cell's; the
+    tables cover every cell; an unknown name is refused before anything is written."""
+    pytest.importorskip("matplotlib")
+    from assistive_compiler.cli import main
+
+    doc = tmp_path / "results.md"
+    assert main(["results", "--out", str(doc), "--pictures-of", "feeding-jaco-typo"]) == 2
+    assert "results --pictures-of: no shipped policy feeding-jaco-typo" in capsys.readouterr().err
+    assert not doc.exists()
+    assert main(["results", "--out", str(doc), "--pictures-of", "arm_manipulation-jaco"]) == 0
+    drawn = sorted(p.name for p in (tmp_path / "results" / "cells").iterdir())
+    assert drawn == ["arm_manipulation-jaco-curve.png", "arm_manipulation-jaco.png"]
+    assert doc.read_text().count("| Feeding | Jaco |") >= 2
