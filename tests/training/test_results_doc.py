@@ -44,13 +44,14 @@ def test_the_block_reports_the_papers_figures_beside_ours():
     row = next(line for line in block.splitlines() if line.startswith("| Feeding | Jaco |"))
     cells = [c.strip() for c in row.strip("|").split("|")]
     assert cells[3] == f"{feeding['trained_steps']:,}"
-    assert cells[6:10] == [
+    assert cells[6:11] == [
         f"{e['mean_return']:.1f} ± {e['std_return']:.1f}",
         f"{100 * e['success_rate']:.0f}%",
         "—",  # exported before export measured the sampled-action protocol
+        "—",
         f"{e['mean_force_on_human_n']:.2f}",
     ]
-    assert cells[10:12] == ["83.8", "88%"]  # the paper's Table I: Jaco's Feeding return, the best robot's success
+    assert cells[11:13] == ["83.8", "88%"]  # the paper's Table I: Jaco's Feeding return, the best robot's success
     assert "### Table II (active person, co-optimisation)" in block
 
 
@@ -69,7 +70,8 @@ def test_a_cell_with_both_protocols_is_judged_against_the_paper_by_sampled_actio
     cells = [
         c.strip() for c in next(line for line in block.splitlines() if line.startswith("| Itch")).strip("|").split("|")
     ]
-    assert (cells[7], cells[8], cells[12]) == ("1%", "60%", "yes (sampled)")
+    assert (cells[7], cells[9], cells[13]) == ("1%", "60%", "yes (sampled)")
+    assert cells[8].startswith("250.0 ± ")
     assert "(the reference code's protocol), the same seeds: success 60%, return 250.0" in block
 
 
