@@ -108,4 +108,11 @@ class Browser:
         finally:
             self.proc.terminate()
             self.proc.wait(timeout=10)
-            self._profile.cleanup()
+            for _ in range(40):  # chromium's helper processes may still be writing into its profile
+                try:
+                    self._profile.cleanup()
+                    break
+                except OSError:
+                    time.sleep(0.25)
+            else:
+                shutil.rmtree(self._profile.name, ignore_errors=True)

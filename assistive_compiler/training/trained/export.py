@@ -146,6 +146,25 @@ def evaluate_policy(artifact: Path, policy, episodes: int, seed: int) -> dict:
     }
 
 
+def _evaluations(artifact: Path, policy, episodes: int, seed: int, progress=None) -> tuple[dict, dict | None, dict]:
+    """The exported policy's evaluation with its mean action; the same with actions sampled from its
+    Gaussian (the reference code's protocol; seeded with the first episode's seed, as ``evaluate
+    --stochastic`` samples), None without a log-std; and the regression record of its first seeds."""
+    evaluation = evaluate_policy(artifact, policy, episodes, seed)
+    sampled = evaluate_policy(artifact, policy.sampling(seed), episodes, seed) if policy.samples else None
+    if progress:
+        also = f", sampled actions {sampled['success_rate']:.2f}" if sampled else ""
+        progress(f"evaluated {episodes} episodes: success {evaluation['success_rate']:.2f}{also}")
+    first = min(REGRESSION_EPISODES, episodes)
+    regression = {
+        "seed": seed,
+        "episodes": first,
+        "success_rate": float(np.mean(evaluation["successes"][:first])),
+        "mean_return": float(np.mean(evaluation["returns"][:first])),
+    }
+    return evaluation, sampled, regression
+
+
 def _wall_at(run: RunDir, steps: int) -> float | None:
     """Wall seconds of training up to ``steps`` env steps (over every sitting of a resumed run),
     from the learning curve's last row at or before them."""
@@ -222,20 +241,7 @@ def export_run(
 
     name = f"{info.task}-{info.robot}{'-coop' if info.coop else ''}"
     out = Path(out) if out else pretrained_dir() / name
-    evaluation = evaluate_policy(run.artifact, policy, episodes, seed)
-    # the reference code's protocol as well: actions sampled from the policy's Gaussian (seeded with
-    # the first episode's seed, as evaluate --stochastic samples), on the same seeds
-    sampled = evaluate_policy(run.artifact, policy.sampling(seed), episodes, seed) if policy.samples else None
-    if progress:
-        also = f", sampled actions {sampled['success_rate']:.2f}" if sampled else ""
-        progress(f"evaluated {episodes} episodes: success {evaluation['success_rate']:.2f}{also}")
-    first = min(REGRESSION_EPISODES, episodes)
-    regression = {
-        "seed": seed,
-        "episodes": first,
-        "success_rate": float(np.mean(evaluation["successes"][:first])),
-        "mean_return": float(np.mean(evaluation["returns"][:first])),
-    }
+    evaluation, sampled, regression = _evaluations(run.artifact, policy, episodes, seed, progress)
     wall = _wall_at(run, steps)
     record = {
         "name": out.name,
