@@ -16,7 +16,11 @@ from ..errors import SpecError
 from ..pictures import check_picture_path, episode_frames, write_picture
 from ..rotation import quat_matrix
 from .common import EXIT_BAD_INPUT, EXIT_OK, SPEC_HELP, add_library_argument, add_spec_arguments, make_env
-from .run import TRACE_HELP, trace_fits, trace_lines
+from .run import TRACE_HELP, add_coop_arguments, human_policy_for, trace_fits
+
+COOP_PICTURE_HELP = (
+    "co-optimisation: the person acts too, by --human-policy (a co-optimised pair plays both agents anyway)"
+)
 
 
 def control_hz(manifest) -> float:
@@ -65,7 +69,7 @@ def cmd_render(args: argparse.Namespace) -> int:
         target, act = _player(args, env)
     frames, summary = episode_frames(target, act, args.seed, args.every)
     fps = args.fps or control_hz(env.manifest) / args.every
-    trace = trace_lines(act, args.seed) if args.trace else []  # where the episode ended: read before closing
+    trace = act.trace_report(args.seed) if args.trace else []  # where the episode ended: read before closing
     env.close()
     write_picture(frames, out, fps=fps)
     print(
@@ -86,29 +90,9 @@ def _player(args: argparse.Namespace, env):
         return make_player(args.policy, env, seed=args.seed)
     from ..coop.policies import pair_policy
     from ..policies.pair import both_agents
-    from .run import _check_human_policy, _default_human_policy
 
-    args.human_policy = args.human_policy or _default_human_policy(args.policy)
-    _check_human_policy(args.human_policy)
+    args.human_policy = human_policy_for(args.policy, args.human_policy)
     return both_agents(env, pair_policy(env, args.policy, args.human_policy, args.seed))
-
-
-def add_coop_arguments(p: argparse.ArgumentParser) -> None:
-    """``--coop`` and ``--human-policy``, as ``run`` has them: the person acts too."""
-    from ..policies import HUMAN_POLICIES
-
-    p.add_argument(
-        "--coop",
-        action="store_true",
-        help="co-optimisation: the person acts too, by --human-policy (a co-optimised pair plays both agents anyway)",
-    )
-    p.add_argument(
-        "--human-policy",
-        dest="human_policy",
-        default=None,
-        help=f"with --coop: {', '.join(HUMAN_POLICIES)}, or a co-optimised pair (pretrained:<task>-<robot>-coop...); "
-        "default: the pair's own person when --policy is one, else random",
-    )
 
 
 def render_people(artifact_dir: Path, width: int = 360, height: int = 480) -> np.ndarray:
@@ -193,7 +177,7 @@ def add_commands(sub) -> None:
         action="store_true",
         help="draw the end effector's, tools' and targets' frames (x red, y green, z blue, 6 cm) with their names",
     )
-    add_coop_arguments(p)
+    add_coop_arguments(p, COOP_PICTURE_HELP)
     p.add_argument("--trace", action="store_true", help=TRACE_HELP + ", after the picture")
     p.set_defaults(func=cmd_render)
 

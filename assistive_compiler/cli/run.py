@@ -44,6 +44,29 @@ def _check_human_policy(name: str) -> None:
         load_trained(name)
 
 
+def human_policy_for(robot_policy: str, human_policy: str | None) -> str:
+    """The person's policy under --coop: ``--human-policy`` as given, else a co-optimised pair's own
+    person, else random; checked (a bad one is a usage error)."""
+    chosen = human_policy or _default_human_policy(robot_policy)
+    _check_human_policy(chosen)
+    return chosen
+
+
+def add_coop_arguments(p: argparse.ArgumentParser, coop_help: str) -> None:
+    """``--coop`` (helped by ``coop_help``) and ``--human-policy``: the person acts too."""
+    from ..policies import HUMAN_POLICIES
+
+    p.add_argument("--coop", action="store_true", help=coop_help)
+    p.add_argument(
+        "--human-policy",
+        dest="human_policy",
+        default=None,
+        help=f"with --coop: {', '.join(HUMAN_POLICIES)} (zero: keep still by acting; hold: no human action, the static "
+        "person), or a co-optimised pair (pretrained:<task>-<robot>-coop, a --coop run directory); default: the "
+        "pair's own person when --policy is one, else random",
+    )
+
+
 TRACE_HELP = (
     "with --policy scripted: print each waypoint event (reached within tolerance_m, stalled, where the "
     "episode ended) with its goal (world, m), the distance left and what the robot and its tools touch"
@@ -63,12 +86,6 @@ def trace_fits(command: str, args: argparse.Namespace) -> bool:
     return True
 
 
-def trace_lines(policy, seed: int | None) -> list[str]:
-    """The scripted ``policy``'s trace of the episode just played (seed ``seed``), as printed."""
-    policy.end_episode()
-    return [f"trace of the episode (seed {seed}):", *(f"  {event['line']}" for event in policy.trace)]
-
-
 def cmd_run(args: argparse.Namespace) -> int:
     from ..policies import make_policy
     from .output import print_table, progress
@@ -82,8 +99,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         from ..coop import parallel_env, rollout_coop
 
         coop_env = parallel_env(args.spec, args.robot, out_dir=args.out)
-        args.human_policy = args.human_policy or _default_human_policy(args.policy)
-        _check_human_policy(args.human_policy)
+        args.human_policy = human_policy_for(args.policy, args.human_policy)
         env, label = coop_env.env, f"{args.policy}, human {args.human_policy}"
 
         def play(seed: int) -> dict:
@@ -187,7 +203,6 @@ def cmd_demo(args: argparse.Namespace) -> int:
 
 
 def add_commands(sub) -> None:
-    from ..policies import HUMAN_POLICIES
 
     p = sub.add_parser("run", help="roll out a policy and report returns, success and the largest terms")
     add_spec_arguments(p)
@@ -196,17 +211,7 @@ def add_commands(sub) -> None:
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument("--trace", action="store_true", help=TRACE_HELP + " (with --json: each episode's 'trace' list)")
-    p.add_argument(
-        "--coop", action="store_true", help="co-optimisation: the person acts too (by --human-policy), shared reward"
-    )
-    p.add_argument(
-        "--human-policy",
-        dest="human_policy",
-        default=None,
-        help=f"with --coop: {', '.join(HUMAN_POLICIES)} (zero: keep still by acting; hold: no human action, the static "
-        "person), or a co-optimised pair (pretrained:<task>-<robot>-coop, a --coop run directory); default: the "
-        "pair's own person when --policy is one, else random",
-    )
+    add_coop_arguments(p, "co-optimisation: the person acts too (by --human-policy), shared reward")
     p.add_argument(
         "--record",
         metavar="DIR",

@@ -34,10 +34,9 @@ def cmd_view(args: argparse.Namespace) -> int:
         return EXIT_BAD_INPUT
     human_policy = None
     if args.coop:
-        from .run import _check_human_policy, _default_human_policy
+        from .run import human_policy_for
 
-        human_policy = args.human_policy or _default_human_policy(args.policy or "scripted")
-        _check_human_policy(human_policy)
+        human_policy = human_policy_for(args.policy or "scripted", args.human_policy)
     status = view(
         args.spec,
         args.robot,
@@ -77,10 +76,10 @@ def add_commands(sub) -> None:
         "--gui", action="store_true", help="pybullet's own GUI window instead of the browser (needs a display)"
     )
     add_artifact_argument(p)
-    from .render import add_coop_arguments
+    from .render import COOP_PICTURE_HELP
+    from .run import TRACE_HELP, add_coop_arguments
 
-    add_coop_arguments(p)
-    from .run import TRACE_HELP
+    add_coop_arguments(p, COOP_PICTURE_HELP)
 
     p.add_argument("--trace", action="store_true", help=TRACE_HELP + ", for each episode it plays")
     p.set_defaults(func=cmd_view)

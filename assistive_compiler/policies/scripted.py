@@ -294,6 +294,13 @@ class ScriptedPolicy:
             return list(own)
         return quat_mul(self.env.snap.orientation(frame), np.asarray(own)).tolist()
 
+    def trace_report(self, seed: int | None) -> list[str]:
+        """With ``trace``: the trace of the episode just played from ``seed`` (ended first, see
+        :meth:`end_episode`), as ``render --trace`` and ``view --trace`` print it."""
+        self.end_episode()
+        assert self.trace is not None
+        return [f"trace of the episode (seed {seed}):", *(f"  {event['line']}" for event in self.trace)]
+
     def end_episode(self) -> None:
         """With ``trace``: note where each arm stands when the episode ends (call it after the
         episode's last step; the event is ``ended``)."""

@@ -56,9 +56,7 @@ class EpisodePlayer:
                 self.env, self.policy, seed, self._dir.name, policy_name=self.policy_name, options=options
             )
             if self.trace:
-                self.policy.end_episode()
-                lines = [f"  {event['line']}" for event in self.policy.trace]
-                print("\n".join([f"trace of the episode (seed {seed}):", *lines]), flush=True)
+                print("\n".join(self.policy.trace_report(seed)), flush=True)
             return recording
         from ..policies.pair import both_agents
 
