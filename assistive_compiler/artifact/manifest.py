@@ -116,7 +116,9 @@ class Manifest(ArtifactModel):
         nothing about what was compiled (:data:`NOT_HASHED`). What ``content_hash`` records when the
         artifact is as compiled; the same content compiled by another version of the compiler
         source, from another folder, or before a field with a default was added hashes the same."""
-        files = self._body_bytes(artifact_dir)
+        return self._hash(self._body_bytes(artifact_dir))
+
+    def _hash(self, files: bytes) -> str:
         text = canonical_json(self, leave_out=NOT_HASHED)
         return hashlib.sha256(files + b"\0" + text.encode()).hexdigest()
 
@@ -138,19 +140,35 @@ class Manifest(ArtifactModel):
     def damage(self, artifact_dir: str | Path) -> str | None:
         """What is wrong with the files of the artifact at ``artifact_dir`` (a missing, truncated or
         edited URDF), or None when they are exactly as compiled."""
+        return self._verified(artifact_dir)[0]
+
+    def intact_hash(self, artifact_dir: str | Path) -> str | None:
+        """The content hash today's rule gives the artifact at ``artifact_dir`` when its files are
+        exactly as compiled (whichever rule its manifest recorded its hash by), else None."""
+        problem, today = self._verified(artifact_dir)
+        return None if problem else today
+
+    def _verified(self, artifact_dir: str | Path) -> tuple[str | None, str | None]:
+        """(what is wrong with the artifact's files, or None; their content hash by today's rule,
+        where they could be read), the files read once."""
         for b in self.bodies:
             path = Path(artifact_dir, b.urdf)
             if not path.is_file():
-                return f"{path}: missing"
+                return f"{path}: missing", None
             try:
                 ET.parse(path)
             except ET.ParseError as exc:
-                return f"{path}: not complete URDF XML ({exc}); truncated or edited?"
-        if not self.content_hash or self.content_hash == self.hash_of(artifact_dir):
-            return None
-        if self.content_hash in self._hashes_as_written(artifact_dir, self._body_bytes(artifact_dir)):
-            return None  # an artifact written under an earlier hashing rule, verified as its file holds it
-        return f"{artifact_dir}: files differ from what was compiled (the manifest's content hash does not match)"
+                return f"{path}: not complete URDF XML ({exc}); truncated or edited?", None
+        files = self._body_bytes(artifact_dir)
+        today = self._hash(files)
+        if not self.content_hash or self.content_hash == today:
+            return None, today
+        if self.content_hash in self._hashes_as_written(artifact_dir, files):
+            return None, today  # an artifact written under an earlier hashing rule, verified as its file holds it
+        return (
+            f"{artifact_dir}: files differ from what was compiled (the manifest's content hash does not match)",
+            today,
+        )
 
     @classmethod
     def read(cls, artifact_dir: str | Path, verify: bool = False) -> Manifest:

@@ -38,7 +38,7 @@ def _same_content(run: RunDir, content_hash: str) -> bool:
         own = Manifest.read(run.artifact)
     except (OSError, ValueError, SpecError):  # no readable artifact: nothing to compare
         return False
-    return own.damage(run.artifact) is None and own.hash_of(run.artifact) == content_hash
+    return own.intact_hash(run.artifact) == content_hash
 
 
 def check_resumable(run: RunDir, content_hash: str, robot: str, coop: bool, engine: str) -> RunInfo:
