@@ -115,13 +115,19 @@ def _inside(point: np.ndarray, shapes: list[Capsule | Sphere]) -> bool:
         if isinstance(s, Sphere):
             if math.dist(point, s.centre) < s.radius - INSIDE_TOLERANCE_M:
                 return True
-        else:
-            start, end = np.asarray(s.start), np.asarray(s.end)
-            d = end - start
-            t = min(1.0, max(0.0, float(np.dot(point - start, d) / np.dot(d, d))))
-            if float(np.linalg.norm(point - (start + t * d))) < s.radius - INSIDE_TOLERANCE_M:
-                return True
+        elif float(np.linalg.norm(point - axis_point(s.start, s.end, point))) < s.radius - INSIDE_TOLERANCE_M:
+            return True
     return False
+
+
+def axis_point(start, end, point: np.ndarray) -> np.ndarray:
+    """The point of a capsule's axis (the segment ``start``-``end``, a sphere's centre when they
+    are equal) nearest to ``point``; all in one frame, m."""
+    a, b = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    ab = b - a
+    length2 = float(ab @ ab)
+    t = 0.0 if length2 < 1e-12 else min(1.0, max(0.0, float((point - a) @ ab) / length2))
+    return a + t * ab
 
 
 def link_surface(info: UrdfInfo, link: str, spacing: float, region: Region | None = None) -> list[SurfacePoint]:

@@ -12,6 +12,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..person.surface import axis_point
+
 Shape = tuple[np.ndarray, np.ndarray, float]
 """A capsule in a link frame: its axis's two ends (equal for a sphere) and its radius, m."""
 
@@ -21,18 +23,9 @@ def shapes_of(shapes: Sequence) -> list[Shape]:
     return [(np.asarray(s.start, dtype=float), np.asarray(s.end, dtype=float), float(s.radius)) for s in shapes]
 
 
-def _axis_point(shape: Shape, p: np.ndarray) -> np.ndarray:
-    """The point of the shape's axis nearest to ``p``."""
-    a, b, _ = shape
-    ab = b - a
-    length2 = float(ab @ ab)
-    t = 0.0 if length2 < 1e-12 else min(1.0, max(0.0, float((p - a) @ ab) / length2))
-    return a + t * ab
-
-
 def signed_distance(shape: Shape, p: np.ndarray) -> float:
     """Distance from ``p`` to the shape's surface, m (negative inside)."""
-    return float(np.linalg.norm(p - _axis_point(shape, p))) - shape[2]
+    return float(np.linalg.norm(p - axis_point(shape[0], shape[1], p))) - shape[2]
 
 
 def onto_surface(shapes: Sequence[Shape], p: Sequence[float] | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -43,7 +36,7 @@ def onto_surface(shapes: Sequence[Shape], p: Sequence[float] | np.ndarray) -> tu
     p = np.asarray(p, dtype=float)
     candidates: list[tuple[float, np.ndarray, np.ndarray]] = []
     for shape in shapes:
-        c = _axis_point(shape, p)
+        c = axis_point(shape[0], shape[1], p)
         d = p - c
         n = float(np.linalg.norm(d))
         normal = d / n if n > 1e-9 else np.array([0.0, 0.0, 1.0])
