@@ -6,8 +6,8 @@ itself never imports."""
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
+import os
 import sys
 from pathlib import Path
 
@@ -41,6 +41,17 @@ def _summary_line(summary: dict) -> str:
     )
 
 
+def _stdout_for_the_summary_alone():
+    """For ``--json``: a stream on the process's stdout for the summary, with file descriptor 1
+    pointed at stderr for the rest of the process, so that whatever else is written to stdout —
+    training's prints, and Ray's forwarded cluster messages (e.g. "raylet ... died"), which can
+    arrive from its threads or at interpreter exit, after the summary — goes to stderr."""
+    sys.stdout.flush()
+    summary_out = os.fdopen(os.dup(1), "w")
+    os.dup2(2, 1)
+    return summary_out
+
+
 def cmd_train(args: argparse.Namespace) -> int:
     from ..training.train import choose_engine
 
@@ -57,26 +68,24 @@ def cmd_train(args: argparse.Namespace) -> int:
         return EXIT_FAILED
     from ..training.train import train
 
-    # With --json, stdout holds the summary alone: whatever training prints (and Ray's forwarded
-    # cluster messages, e.g. "node ... marked dead") goes to stderr meanwhile.
-    with contextlib.redirect_stdout(sys.stderr) if args.json else contextlib.nullcontext():
-        summary = train(
-            args.spec,
-            robot=args.robot,
-            config_path=training_config_path(args.config),
-            coop=args.coop,
-            engine=engine,
-            steps=args.steps,
-            seed=args.seed,
-            envs=args.envs,
-            out=args.out,
-            resume=args.resume,
-            address=args.address,
-            quiet=args.quiet,
-            demonstrations=args.demonstrations,
-            demonstrations_root=args.demonstrations_root,
-        )
-    print(json.dumps(summary, indent=1) if args.json else _summary_line(summary))
+    summary_out = _stdout_for_the_summary_alone() if args.json else sys.stdout
+    summary = train(
+        args.spec,
+        robot=args.robot,
+        config_path=training_config_path(args.config),
+        coop=args.coop,
+        engine=engine,
+        steps=args.steps,
+        seed=args.seed,
+        envs=args.envs,
+        out=args.out,
+        resume=args.resume,
+        address=args.address,
+        quiet=args.quiet,
+        demonstrations=args.demonstrations,
+        demonstrations_root=args.demonstrations_root,
+    )
+    print(json.dumps(summary, indent=1) if args.json else _summary_line(summary), file=summary_out, flush=True)
     if summary["interrupted"]:
         print(
             f"stopped: {summary['stopped_because']}"
