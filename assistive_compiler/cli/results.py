@@ -41,7 +41,45 @@ def cmd_export(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _reevaluate(names: list[str]) -> list[str]:
+    """``results --reevaluate``: measure the named shipped policies (none named: those whose figures
+    were measured on another compile of their task) again on the current code; their names."""
+    from ..errors import UsageError, did_you_mean, one_of
+    from ..policies.pretrained import shipped_names
+    from ..training.trained.reevaluate import reevaluate_shipped, stale_figures
+
+    for name in names:  # an unknown name is a clear error before any work
+        if name not in shipped_names():
+            raise UsageError(
+                f"results --reevaluate: no shipped policy {name}; shipped: {one_of(shipped_names())}"
+                f"{did_you_mean(name, shipped_names())}"
+            )
+    chosen = names or [s.name for s in stale_figures(shipped_names())]
+    for name in chosen:
+        record = reevaluate_shipped(name, progress=lambda line, name=name: print(f"{name}: {line}", file=sys.stderr))
+        print(f"re-evaluated {name} on the task compiled now ({record['evaluated_on_content_hash'][:12]})")
+    if chosen:
+        print("now record their regression episodes: python -m tests.pretrained_regression --write " + " ".join(chosen))
+    return chosen
+
+
+def _say_which_figures_are_stale(names: list[str]) -> None:
+    from ..training.trained.reevaluate import stale_figures
+
+    stale = stale_figures(names)
+    if stale:
+        print(
+            f"{len(stale)} shipped polic{'y was' if len(stale) == 1 else 'ies were'} evaluated on another compile of "
+            f"the task than the current code's, so {'its' if len(stale) == 1 else 'their'} figures are not today's: "
+            + "; ".join(str(s) for s in stale)
+            + ". `assistive-compiler results --reevaluate` measures them again.",
+            file=sys.stderr,
+        )
+
+
 def cmd_results(args: argparse.Namespace) -> int:
+    if args.reevaluate is not None:
+        _reevaluate(args.reevaluate)
     if not args.no_pictures and not require_extra("matplotlib"):
         return EXIT_FAILED
     from ..paths import display
@@ -49,6 +87,7 @@ def cmd_results(args: argparse.Namespace) -> int:
 
     doc = Path(args.out)
     records = shipped_records()
+    _say_which_figures_are_stale([r["name"] for r in records])
     if args.pictures_of:
         unknown = sorted(set(args.pictures_of) - {r["name"] for r in records})
         if unknown:
@@ -105,5 +144,12 @@ def add_commands(sub) -> None:
         nargs="+",
         metavar="NAME",
         help="draw only these cells' pictures (e.g. newly shipped ones); the tables still cover every cell",
+    )
+    p.add_argument(
+        "--reevaluate",
+        nargs="*",
+        metavar="NAME",
+        help="first evaluate these shipped policies again on the task the current code compiles (none named: "
+        "every one whose figures were measured on another compile), then write the page",
     )
     p.set_defaults(func=cmd_results)

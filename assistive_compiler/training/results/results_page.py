@@ -211,13 +211,27 @@ def results_block(records: list[dict]) -> str:
             f"{e['seed'] + e['episodes'] - 1:,} (never used in training), deterministic actions: success "
             f"{100 * e['success_rate']:.0f}%, return {e['mean_return']:.1f} ± {e['std_return']:.1f}"
             f"{_sampled_sentence(r.get('evaluation_sampled'))}. "
-            f"Trained on the compiled task {r['content_hash'][:12]}.{_start_sentence(r['demonstrations'])}\n"
+            f"{_compiled_tasks_sentence(r)}{_start_sentence(r['demonstrations'])}\n"
         )
         if r["trained_steps"] > 0:  # a policy shipped before its first env step has no curve
             parts.append(f"![{r['name']} learning curve]({PICTURES}/{r['name']}-curve.png)\n")
         parts.append(f"![{r['name']} rollout, seed {e['seed']:,}]({PICTURES}/{r['name']}.png)\n")
     parts.append(END)
     return "\n".join(parts)
+
+
+def _compiled_tasks_sentence(record: dict) -> str:
+    """Which compiled task the policy trained on, and which its figures were measured on where
+    that is another (a policy evaluated again after a change of the code)."""
+    trained, evaluated = record["content_hash"], record.get("evaluated_on_content_hash", record["content_hash"])
+    if evaluated == trained:
+        return f"Trained and evaluated on the compiled task {trained[:12]}."
+    earlier = record.get("earlier_evaluations") or []
+    was = f" (at export: success {100 * earlier[0]['success_rate']:.0f}%)" if earlier else ""
+    return (
+        f"Trained on the compiled task {trained[:12]}; evaluated on {evaluated[:12]}, the task as the code "
+        f"compiled it on {record.get('evaluated', 'a later date')}{was}."
+    )
 
 
 def write_pictures(records: list[dict], doc_dir: Path, progress=None) -> list[Path]:

@@ -146,7 +146,7 @@ def evaluate_policy(artifact: Path, policy, episodes: int, seed: int) -> dict:
     }
 
 
-def _evaluations(artifact: Path, policy, episodes: int, seed: int, progress=None) -> tuple[dict, dict | None, dict]:
+def evaluations(artifact: Path, policy, episodes: int, seed: int, progress=None) -> tuple[dict, dict | None, dict]:
     """The exported policy's evaluation with its mean action; the same with actions sampled from its
     Gaussian (the reference code's protocol; seeded with the first episode's seed, as ``evaluate
     --stochastic`` samples), None without a log-std; and the regression record of its first seeds."""
@@ -241,7 +241,7 @@ def export_run(
 
     name = f"{info.task}-{info.robot}{'-coop' if info.coop else ''}"
     out = Path(out) if out else pretrained_dir() / name
-    evaluation, sampled, regression = _evaluations(run.artifact, policy, episodes, seed, progress)
+    evaluation, sampled, regression = evaluations(run.artifact, policy, episodes, seed, progress)
     wall = _wall_at(run, steps)
     record = {
         "name": out.name,
