@@ -218,27 +218,49 @@ def check_supported(config: TrainingConfig) -> None:
         )
 
 
+def _shared_settings(
+    algo_config, run: RunDir, config: TrainingConfig, weights, coop: bool, fragment_steps: int, **model
+):
+    """What the PPO and SAC configs share: the env, one env runner per ``--envs`` with one CPU each
+    (none beside the driver for one env), the learner in the driver, the network (``model``: the
+    algorithm's own settings of RLlib's default model), the callbacks, the seed, and for
+    co-optimisation one module per agent."""
+    from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
+
+    cfg = (
+        algo_config.environment(ENV_NAME, env_config=env_config(run, coop, weights))
+        .framework("torch")
+        .env_runners(
+            num_env_runners=config.envs if config.envs > 1 else 0,
+            num_envs_per_env_runner=1,
+            rollout_fragment_length=fragment_steps,
+            num_cpus_per_env_runner=1,
+        )
+        .learners(num_learners=0)
+        .rl_module(
+            model_config=DefaultModelConfig(
+                fcnet_hiddens=list(config.network.hidden), fcnet_activation=config.network.activation, **model
+            )
+        )
+        .callbacks(_callbacks_class())
+        .debugging(seed=config.seed, log_level="ERROR")
+    )
+    if coop:
+        cfg = cfg.multi_agent(policies=set(AGENTS), policy_mapping_fn=lambda agent_id, *args, **kwargs: agent_id)
+    return cfg
+
+
 def build_sac_config(run: RunDir, config: TrainingConfig, weights: dict[str, float], coop: bool):
     """RLlib's SACConfig for this run: the same SAC as the SB3 engine's (twin Q critics, target
     entropy, Polyak τ), with a multi-agent episode replay buffer for co-optimisation."""
     from ray.rllib.algorithms.sac import SACConfig
-    from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
 
     check_supported(config)
     s = config.sac
     updates_per_step = s.gradient_steps / s.train_freq
     buffer = "MultiAgentEpisodeReplayBuffer" if coop else "EpisodeReplayBuffer"
-    cfg = (
+    sac = (
         SACConfig()
-        .environment(ENV_NAME, env_config=env_config(run, coop, weights))
-        .framework("torch")
-        .env_runners(
-            num_env_runners=config.envs if config.envs > 1 else 0,
-            num_envs_per_env_runner=1,
-            rollout_fragment_length=SAC_FRAGMENT_STEPS,
-            num_cpus_per_env_runner=1,
-        )
-        .learners(num_learners=0)
         .training(
             actor_lr=s.actor_learning_rate or s.learning_rate,
             critic_lr=s.learning_rate,
@@ -254,70 +276,37 @@ def build_sac_config(run: RunDir, config: TrainingConfig, weights: dict[str, flo
             training_intensity=s.batch_size * updates_per_step,
             replay_buffer_config={"type": buffer, "capacity": s.buffer_size},
         )
-        .rl_module(
-            model_config=DefaultModelConfig(
-                fcnet_hiddens=list(config.network.hidden), fcnet_activation=config.network.activation
-            )
-        )
         .reporting(
             min_sample_timesteps_per_iteration=min(
                 SAC_ITERATION_STEPS, config.total_steps, config.checkpoint_every_steps
             )
         )
-        .callbacks(_callbacks_class())
-        .debugging(seed=config.seed, log_level="ERROR")
     )
-    if coop:
-        cfg = cfg.multi_agent(policies=set(AGENTS), policy_mapping_fn=lambda agent_id, *args, **kwargs: agent_id)
-    return cfg
+    return _shared_settings(sac, run, config, weights, coop, SAC_FRAGMENT_STEPS)
 
 
 def build_config(run: RunDir, config: TrainingConfig, weights: dict[str, float], coop: bool):
     """RLlib's PPOConfig (or SACConfig: :func:`build_sac_config`) for this run."""
     from ray.rllib.algorithms.ppo import PPOConfig
-    from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
     from ray.tune.registry import register_env
 
     register_env(ENV_NAME, make_rllib_env)
     if config.sac is not None:
         return build_sac_config(run, config, weights, coop)
     p = config.ppo
-    cfg = (
-        PPOConfig()
-        .environment(ENV_NAME, env_config=env_config(run, coop, weights))
-        .framework("torch")
-        .env_runners(
-            num_env_runners=config.envs if config.envs > 1 else 0,
-            num_envs_per_env_runner=1,
-            rollout_fragment_length=p.rollout_steps,
-            num_cpus_per_env_runner=1,
-        )
-        .learners(num_learners=0)
-        .training(
-            train_batch_size_per_learner=config.batch_size,
-            minibatch_size=p.minibatch_size,
-            num_epochs=p.epochs,
-            gamma=p.gamma,
-            lambda_=p.gae_lambda,
-            lr=p.learning_rate,
-            clip_param=p.clip_range,
-            vf_loss_coeff=p.value_coef,
-            entropy_coeff=p.entropy_coef,
-            grad_clip=p.max_grad_norm,
-        )
-        .rl_module(
-            model_config=DefaultModelConfig(
-                fcnet_hiddens=list(config.network.hidden),
-                fcnet_activation=config.network.activation,
-                vf_share_layers=False,
-            )
-        )
-        .callbacks(_callbacks_class())
-        .debugging(seed=config.seed, log_level="ERROR")
+    ppo = PPOConfig().training(
+        train_batch_size_per_learner=config.batch_size,
+        minibatch_size=p.minibatch_size,
+        num_epochs=p.epochs,
+        gamma=p.gamma,
+        lambda_=p.gae_lambda,
+        lr=p.learning_rate,
+        clip_param=p.clip_range,
+        vf_loss_coeff=p.value_coef,
+        entropy_coeff=p.entropy_coef,
+        grad_clip=p.max_grad_norm,
     )
-    if coop:
-        cfg = cfg.multi_agent(policies=set(AGENTS), policy_mapping_fn=lambda agent_id, *args, **kwargs: agent_id)
-    return cfg
+    return _shared_settings(ppo, run, config, weights, coop, p.rollout_steps, vf_share_layers=False)
 
 
 def _record(progress: Progress, result: dict, weights: dict[str, float]) -> None:
