@@ -124,3 +124,78 @@ def test_results_draws_the_pictures_of_the_named_cells_only(tmp_path, capsys):
     drawn = sorted(p.name for p in (tmp_path / "results" / "cells").iterdir())
     assert drawn == ["arm_manipulation-jaco-curve.png", "arm_manipulation-jaco.png"]
     assert doc.read_text().count("| Feeding | Jaco |") >= 2
+
+
+def _cell(name: str, task: str, robot: str, mean: float, sampled: float | None, *, success=0.5, coop=False) -> dict:
+    """A shipped policy's record with the figures that the paper's layout reads."""
+    evaluation = {"mean_return": mean, "std_return": 1.0, "success_rate": success / 2, "episodes": 100}
+    record = {
+        "name": name,
+        "task": task,
+        "robot": robot,
+        "coop": coop,
+        "trained_steps": 1000,
+        "demonstrations": False,
+        "evaluation": evaluation,
+        "evaluation_sampled": None,
+    }
+    if sampled is not None:
+        record["evaluation_sampled"] = {**evaluation, "mean_return": sampled, "success_rate": success}
+    return record
+
+
+def _layout_rows(block: str, table: str) -> dict[str, list[str]]:
+    part = block[block.index(f"### {table} in the paper's layout") :]
+    lines = part[: part.index("Cells: ")].splitlines()
+    return {
+        cells[0]: cells[1:]
+        for cells in ([c.strip() for c in line.strip("|").split("|")] for line in lines if line.startswith("| "))
+    }
+
+
+def test_the_papers_layout_compares_robots_under_the_papers_protocol():
+    """Robots as columns, "ours (paper)" per cell with the sampled-action return (bold where it
+    reaches the paper's), the mean action only where no policy of the cell has its log-std (marked),
+    the best of several policies of a cell, our best paper robot's success beside the paper's best
+    robot's, whether they are the same robot once all four are measured, and the goals counted."""
+    from assistive_compiler.training.results.results_page import _paper_layout
+
+    records = [
+        _cell("scratch_itch-pr2", "scratch_itch", "pr2", -1.0, 94.9, success=0.48),
+        _cell("scratch_itch-jaco", "scratch_itch", "jaco", 5.0, None),  # mean only: loses to the sampled cell
+        _cell("scratch_itch-jaco-ppo-paper", "scratch_itch", "jaco", 13.8, 290.0, success=0.73),
+        _cell("scratch_itch-jaco-second-seed", "scratch_itch", "jaco", 20.0, 200.0, success=0.80),  # lower return
+        _cell("scratch_itch-baxter", "scratch_itch", "baxter", 6.3, 108.0, success=0.52),
+        _cell("scratch_itch-sawyer", "scratch_itch", "sawyer", 0.1, 57.5, success=0.31),
+        _cell("scratch_itch-panda", "scratch_itch", "panda", 21.4, 300.0, success=0.9),  # beside, not compared
+        _cell("feeding-baxter", "feeding", "baxter", 100.0, None, success=0.9),
+        _cell("feeding-jaco-coop", "feeding", "jaco", 50.0, 120.0, coop=True),
+    ]
+    demonstrations = {**_cell("feeding-jaco-demos", "feeding", "jaco", 500.0, None), "demonstrations": {"x": 1}}
+    block = "\n".join(_paper_layout([*records, demonstrations]))
+    rows = _layout_rows(block, "Table I (static person)")
+    assert rows["Task"] == ["PR2", "Jaco", "Baxter", "Sawyer", "Panda", "Success", "Best robot as the paper's"]
+    assert rows["Itch Scratching"] == [
+        "**94.9** (55.1)",
+        "**290.0** (280.8)",
+        "108.0 (225.4)",
+        "57.5 (136.8)",
+        "300.0 (—)",
+        "73% Jaco (54% Jaco)",
+        "yes",
+    ]
+    assert rows["Feeding"] == [
+        "— (100.5)",
+        "— (83.8)",
+        "100.0 * (108.5)",
+        "— (95.6)",
+        "— (—)",
+        "45% * Baxter (88% Baxter)",
+        "— (1 of 4 robots measured)",
+    ]
+    assert (
+        "Goals: our return reaches the paper's in 2 of the 5 cells measured (of 24); our best robot's success "
+        "reaches the paper's best robot's on 1 of the 2 tasks measured (of 6)." in block
+    )
+    assert "`scratch_itch-jaco-ppo-paper`" in block and "feeding-jaco-demos" not in block
+    assert _layout_rows(block, "Table II (active person, co-optimisation)")["Feeding"][1] == "**120.0** (106.1)"

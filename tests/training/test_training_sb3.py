@@ -175,9 +175,9 @@ def test_table_from_a_real_run(reach_run, tmp_path, capsys):
     assert main(["table", str(reach_run), "--out", str(out)]) == 0
     evaluation = json.loads((reach_run / "evaluation.json").read_text())
     text = out.read_text()
-    assert "| Task | PR2 | Jaco | Baxter | Sawyer | Success |" in text
+    assert "| Task | PR2 | Jaco | Baxter | Sawyer | Success | Best robot as the paper's |" in text
     assert (
-        "| Feeding | — (100.5) | — (83.8) | — (108.5) | — (95.6) | — (88%) |" in text
+        "| Feeding | — (100.5) | — (83.8) | — (108.5) | — (95.6) | — (88% Baxter) | — |" in text
     )  # the paper's Table I beside ours
     assert f"| reach | — (—) | {evaluation['mean_return']:.1f} (—) |" in text
     rows = list(csv.DictReader((tmp_path / "results.csv").open()))

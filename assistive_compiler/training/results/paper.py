@@ -19,7 +19,14 @@ TASK_TITLES = {
     "arm_manipulation": "Arm Manipulation",
 }
 ROBOTS = ("pr2", "jaco", "baxter", "sawyer")
-ROBOT_TITLES = {"pr2": "PR2", "jaco": "Jaco", "baxter": "Baxter", "sawyer": "Sawyer", "panda": "Panda"}
+ROBOT_TITLES = {
+    "pr2": "PR2",
+    "jaco": "Jaco",
+    "baxter": "Baxter",
+    "sawyer": "Sawyer",
+    "panda": "Panda",
+    "stretch": "Stretch",
+}
 
 #: Table I (static person): task -> robot -> average reward; and the best robot's success (%).
 TABLE_I = {

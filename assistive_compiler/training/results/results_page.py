@@ -16,7 +16,7 @@ import json
 from pathlib import Path
 
 from .paper import PAPER, ROBOT_TITLES, TASK_TITLES, TASKS
-from .table import markdown_table
+from .table import best_per_cell, goals_met, markdown_table, table_rows
 
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
 PICTURES = "results/cells"  # beside the doc: docs/results/cells/<name>-curve.png and <name>.png
@@ -165,12 +165,80 @@ def _sampled_sentence(sampled: dict | None) -> str:
     )
 
 
+#: Marks a paper-layout cell measured with the mean action only (a policy exported without its
+#: log-std): the paper's code sampled its actions.
+MEAN_ACTION_MARK = " *"
+
+
+def _paper_protocol_figures(records: list[dict]) -> list[dict]:
+    """Each shipped policy's figures under the paper code's protocol (sampled actions) where its
+    export measured it; a (table, task, robot) with no such policy keeps its mean-action figures,
+    marked. Policies started from demonstrations are left out: the paper learned from the reward
+    alone (they are rows of the full tables). ``table``'s best-of-cell rule then picks the highest return, as the paper kept the best
+    of three seeds."""
+    figures = []
+    for r in records:
+        if r["demonstrations"]:  # the paper learned from the reward alone
+            continue
+        e = r.get("evaluation_sampled") or r["evaluation"]
+        figures.append(
+            {
+                **{k: e[k] for k in ("mean_return", "std_return", "success_rate", "episodes")},
+                "coop": bool(r["coop"]),
+                "task": r["task"],
+                "robot": r["robot"],
+                "trained_steps": r["trained_steps"],
+                "run": r["name"],
+                "demonstrations": bool(r["demonstrations"]),
+                "sampled": r.get("evaluation_sampled") is not None,
+                "mark": "" if r.get("evaluation_sampled") else MEAN_ACTION_MARK,
+            }
+        )
+    sampled_cells = {(f["coop"], f["task"], f["robot"]) for f in figures if f["sampled"]}
+    return [f for f in figures if f["sampled"] or (f["coop"], f["task"], f["robot"]) not in sampled_cells]
+
+
+def _paper_layout(records: list[dict]) -> list[str]:
+    """Tables I and II as the paper prints them: a row per task, a column per robot, each cell our
+    mean return under the paper code's protocol with the paper's in parentheses; the success of our
+    robot with the highest return beside the paper's best robot's; and the goals counted."""
+    best = best_per_cell(_paper_protocol_figures(records))
+    parts = []
+    for coop in (False, True):
+        title = PAPER[coop][0]
+        header, rows, _ = table_rows(best, coop)
+        goals = goals_met(best, coop)
+        used = sorted(
+            (v for (c, _, _), v in best.items() if c == coop), key=lambda v: (TASKS.index(v["task"]), v["robot"])
+        )
+        parts += [
+            f"### {title} in the paper's layout\n",
+            "Mean return on the 100 test seeds with actions sampled from the policy (the paper code's protocol), ours "
+            "in bold where it reaches the paper's (in parentheses, §V); Success: our robot with the highest return, "
+            f"its success with sampled actions (the paper's best robot's). `{MEAN_ACTION_MARK.strip()}` the mean "
+            "action only (a policy exported without its log-std). Where a task and robot have several shipped "
+            "policies learned from the reward alone, the one with the highest return fills the cell.\n",
+            markdown_table(header, rows) + "\n",
+            f"Goals: our return reaches the paper's in {goals['returns_met']} of the {goals['returns_compared']} "
+            f"cells measured (of {sum(len(v) for v in PAPER[coop][1].values())}); our best robot's success reaches "
+            f"the paper's best robot's on {goals['successes_met']} of the {goals['successes_compared']} tasks "
+            f"measured (of {len(PAPER[coop][2])}).\n",
+            "Cells: "
+            + "; ".join(
+                f"{TASK_TITLES[v['task']]} × {ROBOT_TITLES.get(v['robot'], v['robot'])} `{v['run']}`" for v in used
+            )
+            + ".\n",
+        ]
+    return parts
+
+
 def results_block(records: list[dict]) -> str:
     """The generated Markdown between the markers (no pictures are made here)."""
     parts = [
         BEGIN,
         "<!-- written by `assistive-compiler results`; edit the policies or the prose outside the markers -->",
         "",
+        *_paper_layout(records),
     ]
     for coop in (False, True):
         title, paper, paper_success = PAPER[coop]

@@ -51,12 +51,32 @@ def _fmt(value: float | None, digits: int = 1) -> str:
     return "—" if value is None else f"{value:.{digits}f}"
 
 
+def paper_best_robot(paper: dict, task: str) -> str | None:
+    """The robot with the paper's highest mean return on ``task`` (whose success the paper reports)."""
+    returns = paper.get(task)
+    return max(returns, key=returns.get) if returns else None
+
+
+def _cell(mine: dict | None, paper_value: float | None) -> str:
+    """``ours (paper)``; ours in bold where it reaches the paper's, with its marks (``mark``:
+    what the cell's figure is, e.g. the mean action where the paper sampled; † demonstrations)."""
+    if mine is None:
+        return f"— ({_fmt(paper_value)})"
+    ours = _fmt(mine["mean_return"])
+    if paper_value is not None and mine["mean_return"] >= paper_value:
+        ours = f"**{ours}**"
+    mark = (DEMONSTRATIONS_MARK if mine.get("demonstrations") else "") + mine.get("mark", "")
+    return f"{ours}{mark} ({_fmt(paper_value)})"
+
+
 def table_rows(best: dict, coop: bool) -> tuple[list[str], list[list[str]], list[dict]]:
-    """Header, Markdown cells and CSV records of Table I (``coop`` False) or II (True)."""
+    """Header, Markdown cells and CSV records of Table I (``coop`` False) or II (True): per task,
+    each robot's mean return beside the paper's, the success of our robot with the highest return
+    beside the paper's best robot's, and whether that robot is the paper's."""
     _, paper, paper_success = PAPER[coop]
     robots = list(ROBOTS) + sorted({r for (c, _, r) in best if c == coop and r not in ROBOTS})
     tasks = [t for t in TASKS if t in paper] + sorted({t for (c, t, _) in best if c == coop and t not in TASKS})
-    header = ["Task"] + [ROBOT_TITLES.get(r, r) for r in robots] + ["Success"]
+    header = ["Task"] + [ROBOT_TITLES.get(r, r) for r in robots] + ["Success", "Best robot as the paper's"]
     rows, records = [], []
     for task in tasks:
         cells = [TASK_TITLES.get(task, task)]
@@ -64,8 +84,7 @@ def table_rows(best: dict, coop: bool) -> tuple[list[str], list[list[str]], list
         for robot in robots:
             paper_value = paper.get(task, {}).get(robot)
             mine = ours[robot]
-            mark = DEMONSTRATIONS_MARK if mine and mine.get("demonstrations") else ""
-            cells.append(f"{_fmt(mine['mean_return'] if mine else None)}{mark} ({_fmt(paper_value)})")
+            cells.append(_cell(mine, paper_value))
             records.append(
                 {
                     "table": "II" if coop else "I",
@@ -81,15 +100,57 @@ def table_rows(best: dict, coop: bool) -> tuple[list[str], list[list[str]], list
                     "paper_mean_return": paper_value,
                 }
             )
-        evaluated = {r: v for r, v in ours.items() if v is not None}
-        top = max(evaluated.values(), key=lambda v: v["mean_return"]) if evaluated else None
+        top = _best_robot(ours)
         ours_success = (
-            f"{100 * top['success_rate']:.0f}% {ROBOT_TITLES.get(top['robot'], top['robot'])}" if top else "—"
+            f"{100 * top['success_rate']:.0f}%{top.get('mark', '')} {ROBOT_TITLES.get(top['robot'], top['robot'])}"
+            if top
+            else "—"
         )
-        paper_s = paper_success.get(task)
-        cells.append(f"{ours_success} ({'—' if paper_s is None else f'{paper_s}%'})")
+        paper_s, paper_top = paper_success.get(task), paper_best_robot(paper, task)
+        cells.append(
+            f"{ours_success} ({'—' if paper_s is None else f'{paper_s}%'}"
+            + (f" {ROBOT_TITLES.get(paper_top, paper_top)})" if paper_top else ")")
+        )
+        cells.append(_same_best_robot(ours, top, paper_top))
         rows.append(cells)
     return header, rows, records
+
+
+def _best_robot(ours: dict[str, dict | None]) -> dict | None:
+    """Our robot with the highest mean return on a task, among the paper's four where any of them
+    has a cell (the paper's comparison; later robots are columns beside it), else among all."""
+    evaluated = {r: v for r, v in ours.items() if v is not None}
+    among = {r: v for r, v in evaluated.items() if r in ROBOTS} or evaluated
+    return max(among.values(), key=lambda v: v["mean_return"]) if among else None
+
+
+def _same_best_robot(ours: dict[str, dict | None], top: dict | None, paper_top: str | None) -> str:
+    """Whether our best robot on a task is the paper's: said once all the paper's robots have a cell."""
+    if top is None or paper_top is None:
+        return "—"
+    missing = [r for r in ROBOTS if ours.get(r) is None]
+    if missing:
+        return f"— ({len(ROBOTS) - len(missing)} of {len(ROBOTS)} robots measured)"
+    return "yes" if top["robot"] == paper_top else f"no ({ROBOT_TITLES.get(top['robot'], top['robot'])})"
+
+
+def goals_met(best: dict, coop: bool) -> dict[str, int]:
+    """The paper's goals counted over Table I (``coop`` False) or II: cells whose return reaches the
+    paper's (of the cells both have), and tasks whose best robot's success reaches the paper's best
+    robot's (of the tasks we have a cell of)."""
+    _, paper, paper_success = PAPER[coop]
+    cells = [(v, paper[t][r]) for (c, t, r), v in best.items() if c == coop and r in paper.get(t, {})]
+    tasks = {}
+    for t in {t for (c, t, _) in best if c == coop and t in paper_success}:
+        top = _best_robot({r: v for (c, task, r), v in best.items() if c == coop and task == t})
+        if top is not None:
+            tasks[t] = top
+    return {
+        "returns_met": sum(v["mean_return"] >= p for v, p in cells),
+        "returns_compared": len(cells),
+        "successes_met": sum(100 * v["success_rate"] >= paper_success[t] for t, v in tasks.items()),
+        "successes_compared": len(tasks),
+    }
 
 
 def markdown_table(header: list[str], rows: list[list[str]]) -> str:
