@@ -1,10 +1,10 @@
 """The shipped policies' regression episodes as the current code plays them, one outcome per seed,
 so that ``tests/policies/test_pretrained.py`` replays a few seeds and takes the rest as recorded.
 
-A shipped policy (``pretrained/<name>``) is checked on its regression seeds: the first
-``regression.episodes`` (10) seeds of its evaluation, or the first ``CLOTH_EPISODES`` (4) for a
-task with a garment, whose episodes are slow. The record holds each seed's return (to 3 decimals,
-as the evaluation records it) and success. The test replays the first ``REPLAYED`` seeds
+A shipped policy (``pretrained/<name>``) is checked on its regression seeds: all of its
+evaluation's seeds (100), or the first ``CLOTH_EPISODES`` (4) for a task with a garment, whose
+episodes are slow. The record holds each seed's return (to 3 decimals, as the evaluation records
+it) and success. The test replays the first ``REPLAYED`` seeds
 (``CLOTH_REPLAYED`` for a cloth task): evaluation is deterministic, so where they give the recorded
 outcomes exactly, the policy plays as it did when the record was written and the other seeds'
 outcomes are the recorded ones; where one differs (a physics or runtime change), the test replays
@@ -14,6 +14,11 @@ Regenerate the record after a change that is meant to change episodes (with the 
 ``tests/episode_digests.py``), and say so in the commit::
 
     python -m tests.pretrained_regression --write
+
+A policy just evaluated on the current code (``export``, or ``assistive-compiler results
+--reevaluate``) played its regression seeds in that evaluation: ``--write --from-evaluation NAME``
+records those outcomes instead of playing them again (the test's replay of the first seeds checks
+them against the code).
 """
 
 from __future__ import annotations
@@ -46,7 +51,7 @@ class Regression:
         self.env = AssistiveEnv.from_spec(spec, robot=info["robot"], out_dir=cached_artifact_dir(spec, info["robot"]))
         self.seed = info["regression"]["seed"]
         cloth = bool(self.env.manifest.garments)
-        self.episodes = CLOTH_EPISODES if cloth else info["regression"]["episodes"]
+        self.episodes = CLOTH_EPISODES if cloth else info["evaluation"]["episodes"]
         self.replayed = CLOTH_REPLAYED if cloth else REPLAYED
         if info["coop"]:  # the pair plays both agents, as export evaluated it
             self.pair, _ = load_trained(f"pretrained:{name}")
@@ -86,6 +91,20 @@ def played_outcomes(name: str) -> dict[str, list]:
         regression.close()
 
 
+def evaluation_outcomes(name: str) -> dict[str, list]:
+    """The regression seeds' outcomes as the shipped policy's own evaluation recorded them, which
+    must have been measured on the task the current code compiles."""
+    from assistive_compiler.training.trained.reevaluate import stale_figures
+
+    stale = stale_figures([name])
+    if stale:
+        raise SystemExit(f"--from-evaluation: {stale[0]}: evaluate it again first (results --reevaluate {name})")
+    regression = Regression(name)
+    regression.close()
+    evaluation = regression.info["evaluation"]
+    return {k: evaluation[k][: regression.episodes] for k in ("returns", "successes")}
+
+
 def main(argv: list[str] | None = None) -> int:
     from assistive_compiler.policies.pretrained import shipped_names
 
@@ -99,6 +118,11 @@ def main(argv: list[str] | None = None) -> int:
         played_outcomes,
         lambda recorded, played: None if recorded == played else "changed",
         argv,
+        (
+            "--from-evaluation",
+            "record the outcomes of each policy's own evaluation on the current code",
+            evaluation_outcomes,
+        ),
     )
 
 

@@ -24,11 +24,14 @@ from assistive_compiler.runtime.env import AssistiveEnv
 
 REPO = Path(__file__).resolve().parents[2]
 SHIPPED = shipped_names()
-#: How far a shipped policy's success on its regression seeds may fall below the exported figure
-#: before the test fails: two episodes in ten. Evaluation is deterministic, so on unchanged code
-#: the figure is reproduced exactly; a change of physics or runtime moves single episodes.
-TOLERANCE = 0.2
+#: How far a shipped policy's success on its N regression seeds may fall below the recorded figure p
+#: before the test fails: Z binomial standard deviations, sqrt(p (1 - p) / N), and at least one
+#: episode. Evaluation is deterministic, so on unchanged code the figure is reproduced exactly; a
+#: change of physics or runtime moves single episodes, and a drop beyond the spread of 100 episodes
+#: is a broken policy (at p = 85% on 100 seeds the floor is 79.1%: a fall to 79% fails).
+Z = 1.645  # one-sided 95%
 MAX_BYTES = 2 * 1024 * 1024
+PAPER_STEPS = 10_000_000  # the paper's budget per cell (§IV): the anchor runs train to it
 REGRESSION = json.loads(STORE.read_text()) if STORE.is_file() else {}
 
 
@@ -54,7 +57,7 @@ def test_shipped_policy_is_small_and_says_what_it_is(name):
     cell = f"{info['task']}-{info['robot']}" + ("-coop" if info["coop"] else "")
     assert name == cell or name.startswith(f"{cell}-")  # the cell's policy, or another row of it (e.g. -ppo)
     assert info["evaluation"]["episodes"] == 100 and info["evaluation"]["seed"] >= 1_000_000  # unseen seeds
-    assert info["trained_steps"] <= 1_000_000 and info["export_max_action_difference"] < 1e-4
+    assert info["trained_steps"] <= PAPER_STEPS and info["export_max_action_difference"] < 1e-4
     env = _env(name)
     if info["coop"]:  # a robot and a human policy, each fitting its agent's spaces
         from assistive_compiler.coop.parallel import AssistiveParallelEnv
@@ -78,7 +81,7 @@ def test_shipped_policy_is_small_and_says_what_it_is(name):
 @pytest.mark.slow
 @pytest.mark.parametrize("name", SHIPPED)
 def test_shipped_policy_still_succeeds_on_the_current_code(name):
-    """Success on the regression seeds may fall by TOLERANCE at most, and the mean return by half
+    """Success on the regression seeds may fall by the binomial spread (allowed_drop), and the mean return by half
     the evaluation's episode-to-episode spread (which also guards policies that rarely succeed).
     Evaluation is deterministic, so the figures compared are those recorded for the same seeds.
     The first seeds are replayed; where they give the outcomes recorded for the current code
@@ -103,9 +106,10 @@ def test_shipped_policy_still_succeeds_on_the_current_code(name):
     recorded_return = float(np.mean(evaluation["returns"][:episodes]))
     seeds = f"seeds {reg['seed']}..{reg['seed'] + episodes - 1}"
     success = float(np.mean([r["success"] for r in runs]))
-    assert success >= recorded_success - max(TOLERANCE, 1.0 / episodes) - 1e-9, (
-        f"pretrained:{name} succeeds on {success:.0%} of {seeds}, exported at {recorded_success:.0%}: a physics or "
-        "runtime change broke it; retrain or re-export it"
+    floor = recorded_success - allowed_drop(recorded_success, episodes)
+    assert success >= floor - 1e-9, (
+        f"pretrained:{name} succeeds on {success:.0%} of {seeds}, evaluated at {recorded_success:.0%} (floor "
+        f"{floor:.1%}): a physics or runtime change broke it; retrain it, or evaluate it again if the change is meant"
     )
     mean_return = float(np.mean([r["return"] for r in runs]))
     floor = recorded_return - 0.5 * evaluation["std_return"]
@@ -113,6 +117,42 @@ def test_shipped_policy_still_succeeds_on_the_current_code(name):
         f"pretrained:{name} returns {mean_return:.1f} on {seeds}, exported at "
         f"{recorded_return:.1f} (floor {floor:.1f}): a physics or runtime change broke it"
     )
+
+
+#: Shipped policies whose figures are still those measured on an older compile of their task, and
+#: why: Dressing's cloth makes an episode 20-40 s here, so its 100 evaluation episodes take about
+#: 50 minutes a policy, which the sitting that re-evaluated the others (2026-12-07) did not have.
+#: The test fails when one of these is measured again (take it off the list) as when another goes stale.
+AWAITING_REEVALUATION = {"dressing-jaco", "dressing-jaco-coop", "dressing-jaco-coop-sac"}
+
+
+def test_every_shipped_figure_was_measured_on_the_task_the_code_compiles_now():
+    """A change that alters a shipped task's compile re-evaluates its policies (``assistive-compiler
+    results --reevaluate``), so that the shipped figures are the current code's."""
+    from assistive_compiler.training.trained.reevaluate import stale_figures
+
+    stale = {s.name: str(s) for s in stale_figures(SHIPPED)}
+    assert set(stale) == AWAITING_REEVALUATION & set(SHIPPED), (
+        "shipped figures measured on another compile of their task than the current code's: "
+        + "; ".join(v for k, v in stale.items() if k not in AWAITING_REEVALUATION)
+        + " (run `assistive-compiler results --reevaluate`, then `python -m tests.pretrained_regression --write`)"
+        + "; re-evaluated since, off the list: "
+        + ", ".join(sorted(AWAITING_REEVALUATION & set(SHIPPED) - set(stale)))
+    )
+
+
+def allowed_drop(success_rate: float, episodes: int) -> float:
+    """How far success on ``episodes`` regression seeds may fall below ``success_rate`` (see Z)."""
+    return max(Z * float(np.sqrt(success_rate * (1.0 - success_rate) / episodes)), 1.0 / episodes)
+
+
+def test_the_regression_bound_fails_on_a_drop_like_arm_manipulations():
+    """The bound the regression check holds a shipped policy to, on the 100 seeds of its evaluation:
+    Arm Manipulation's 85% falling to 78% (found by hand once; the fixed 0.2 on 10 seeds let it
+    pass) fails, one or two episodes lost pass, and a policy that never succeeded may lose nothing."""
+    assert 0.85 - allowed_drop(0.85, 100) == pytest.approx(0.7913, abs=1e-4)
+    assert 0.78 < 0.85 - allowed_drop(0.85, 100) < 0.83
+    assert allowed_drop(0.0, 100) == 0.01 and allowed_drop(0.25, 4) == pytest.approx(0.3561, abs=1e-4)
 
 
 def test_unknown_or_misfit_pretrained_policies_are_clear_errors(capsys):

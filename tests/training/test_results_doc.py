@@ -68,7 +68,10 @@ def test_a_cell_with_both_protocols_is_judged_against_the_paper_by_sampled_actio
     cell["evaluation_sampled"] = {**cell["evaluation"], "success_rate": 0.60, "mean_return": 250.0}
     block = results_block([cell])
     cells = [
-        c.strip() for c in next(line for line in block.splitlines() if line.startswith("| Itch")).strip("|").split("|")
+        c.strip()
+        for c in next(line for line in block.splitlines() if line.startswith("| Itch Scratching | Jaco |"))
+        .strip("|")
+        .split("|")
     ]
     assert (cells[7], cells[9], cells[13]) == ("1%", "60%", "yes (sampled)")
     assert cells[8].startswith("250.0 ± ")
