@@ -168,6 +168,10 @@ def _sampled_sentence(sampled: dict | None) -> str:
 #: Marks a paper-layout cell measured with the mean action only (a policy exported without its
 #: log-std): the paper's code sampled its actions.
 MEAN_ACTION_MARK = " *"
+#: The budget of a cell of the paper-layout tables (env steps): this project's cells are trained
+#: within it; policies trained beyond it — the anchor runs, the paper's PPO at its 10,000,000 steps
+#: — are reported beside the table, not mixed into its cells.
+CELL_BUDGET_STEPS = 1_000_000
 
 
 def _paper_protocol_figures(records: list[dict]) -> list[dict]:
@@ -202,7 +206,8 @@ def _paper_layout(records: list[dict]) -> list[str]:
     """Tables I and II as the paper prints them: a row per task, a column per robot, each cell our
     mean return under the paper code's protocol with the paper's in parentheses; the success of our
     robot with the highest return beside the paper's best robot's; and the goals counted."""
-    best = best_per_cell(_paper_protocol_figures(records))
+    best = best_per_cell(_paper_protocol_figures([r for r in records if r["trained_steps"] <= CELL_BUDGET_STEPS]))
+    anchors = _paper_protocol_figures([r for r in records if r["trained_steps"] > CELL_BUDGET_STEPS])
     parts = []
     for coop in (False, True):
         title = PAPER[coop][0]
@@ -229,7 +234,20 @@ def _paper_layout(records: list[dict]) -> list[str]:
             )
             + ".\n",
         ]
+        parts += [_anchor_line(a, PAPER[coop][1]) for a in anchors if a["coop"] == coop]
     return parts
+
+
+def _anchor_line(a: dict, paper: dict) -> str:
+    """A policy trained beyond the cells' budget (an anchor run), beside the table it belongs to."""
+    protocol = "the mean action" if a["mark"] else "sampled actions"
+    paper_return = paper.get(a["task"], {}).get(a["robot"])
+    return (
+        f"Beside the table, trained beyond its cells' {CELL_BUDGET_STEPS:,} env steps: "
+        f"{TASK_TITLES.get(a['task'], a['task'])} × {ROBOT_TITLES.get(a['robot'], a['robot'])} `{a['run']}` "
+        f"({a['trained_steps']:,} env steps), with {protocol}: return {a['mean_return']:.1f} "
+        f"({'—' if paper_return is None else f'{paper_return:.1f}'}), success {100 * a['success_rate']:.0f}%.\n"
+    )
 
 
 def results_block(records: list[dict]) -> str:
