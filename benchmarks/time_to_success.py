@@ -154,8 +154,23 @@ def main(argv: list[str] | None = None) -> int:
         metavar="LABEL=HOURS,SUCCESS",
         help="a single measured point, e.g. a shipped policy's success at its run's wall time",
     )
+    p.add_argument(
+        "--points",
+        action="append",
+        type=Path,
+        default=[],
+        metavar="CSV",
+        help="points written by an earlier call (its .csv), drawn beside the runs: runs no longer on this machine",
+    )
     args = p.parse_args(argv)
     runs: dict[str, list[dict]] = {}
+    for earlier in args.points:
+        with earlier.open() as f:
+            for row in csv.DictReader(f):
+                point = {"run": row["run"], "steps": int(row["steps"]), "hours": float(row["hours"])}
+                runs.setdefault(row["run"], []).append(
+                    {**point, "mean": float(row["mean"]), "sampled": float(row["sampled"])}
+                )
     for item in args.run:
         label, _, where = item.rpartition("=")
         path, _, rate = where.partition("@")
