@@ -168,9 +168,8 @@ def main(argv: list[str] | None = None) -> int:
         with earlier.open() as f:
             for row in csv.DictReader(f):
                 point = {"run": row["run"], "steps": int(row["steps"]), "hours": float(row["hours"])}
-                runs.setdefault(row["run"], []).append(
-                    {**point, "mean": float(row["mean"]), "sampled": float(row["sampled"])}
-                )
+                point.update({protocol: float(row[protocol]) for protocol in PROTOCOLS})
+                runs.setdefault(row["run"], []).append(point)
     for item in args.run:
         label, _, where = item.rpartition("=")
         path, _, rate = where.partition("@")

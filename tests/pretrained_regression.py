@@ -35,6 +35,14 @@ REPLAYED = 3
 CLOTH_REPLAYED = 2
 
 
+def regression_size(info: dict, manifest) -> tuple[int, int]:
+    """How many regression seeds a shipped policy (its ``policy.json``) is checked on, on its task's
+    compiled ``manifest``, and how many of them are replayed before the record is trusted."""
+    if manifest.garments:
+        return CLOTH_EPISODES, CLOTH_REPLAYED
+    return info["evaluation"]["episodes"], REPLAYED
+
+
 class Regression:
     """A shipped policy on its task compiled on the current code, playing its regression seeds."""
 
@@ -50,9 +58,7 @@ class Regression:
         spec = trained_task_spec(info)
         self.env = AssistiveEnv.from_spec(spec, robot=info["robot"], out_dir=cached_artifact_dir(spec, info["robot"]))
         self.seed = info["regression"]["seed"]
-        cloth = bool(self.env.manifest.garments)
-        self.episodes = CLOTH_EPISODES if cloth else info["evaluation"]["episodes"]
-        self.replayed = CLOTH_REPLAYED if cloth else REPLAYED
+        self.episodes, self.replayed = regression_size(info, self.env.manifest)
         if info["coop"]:  # the pair plays both agents, as export evaluated it
             self.pair, _ = load_trained(f"pretrained:{name}")
         else:
@@ -94,15 +100,16 @@ def played_outcomes(name: str) -> dict[str, list]:
 def evaluation_outcomes(name: str) -> dict[str, list]:
     """The regression seeds' outcomes as the shipped policy's own evaluation recorded them, which
     must have been measured on the task the current code compiles."""
+    from assistive_compiler.policies.pretrained import shipped_info
+    from assistive_compiler.training.trained.evaluate import compile_for_policy
     from assistive_compiler.training.trained.reevaluate import stale_figures
 
     stale = stale_figures([name])
     if stale:
         raise SystemExit(f"--from-evaluation: {stale[0]}: evaluate it again first (results --reevaluate {name})")
-    regression = Regression(name)
-    regression.close()
-    evaluation = regression.info["evaluation"]
-    return {k: evaluation[k][: regression.episodes] for k in ("returns", "successes")}
+    info = shipped_info(name)
+    episodes, _ = regression_size(info, compile_for_policy(info).manifest)
+    return {k: info["evaluation"][k][:episodes] for k in ("returns", "successes")}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -48,18 +48,21 @@ def _reevaluate(names: list[str]) -> list[str]:
     from ..policies.pretrained import shipped_names
     from ..training.trained.reevaluate import reevaluate_shipped, stale_figures
 
+    shipped = shipped_names()
     for name in names:  # an unknown name is a clear error before any work
-        if name not in shipped_names():
+        if name not in shipped:
             raise UsageError(
-                f"results --reevaluate: no shipped policy {name}; shipped: {one_of(shipped_names())}"
-                f"{did_you_mean(name, shipped_names())}"
+                f"results --reevaluate: no shipped policy {name}; shipped: {one_of(shipped)}{did_you_mean(name, shipped)}"
             )
-    chosen = names or [s.name for s in stale_figures(shipped_names())]
+    chosen = names or [s.name for s in stale_figures(shipped)]
     for name in chosen:
         record = reevaluate_shipped(name, progress=lambda line, name=name: print(f"{name}: {line}", file=sys.stderr))
         print(f"re-evaluated {name} on the task compiled now ({record['evaluated_on_content_hash'][:12]})")
     if chosen:
-        print("now record their regression episodes: python -m tests.pretrained_regression --write " + " ".join(chosen))
+        print(
+            "now record their regression episodes from these evaluations: "
+            "python -m tests.pretrained_regression --write --from-evaluation " + " ".join(chosen)
+        )
     return chosen
 
 

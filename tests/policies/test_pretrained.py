@@ -137,7 +137,7 @@ def test_every_shipped_figure_was_measured_on_the_task_the_code_compiles_now():
     assert set(stale) == AWAITING_REEVALUATION & set(SHIPPED), (
         "shipped figures measured on another compile of their task than the current code's: "
         + "; ".join(v for k, v in stale.items() if k not in AWAITING_REEVALUATION)
-        + " (run `assistive-compiler results --reevaluate`, then `python -m tests.pretrained_regression --write`)"
+        + " (run `assistive-compiler results --reevaluate`, then `python -m tests.pretrained_regression --write --from-evaluation`)"
         + "; re-evaluated since, off the list: "
         + ", ".join(sorted(AWAITING_REEVALUATION & set(SHIPPED) - set(stale)))
     )

@@ -58,7 +58,7 @@ def test_results_names_the_stale_figures_and_reevaluate_measures_them_on_todays_
     assert main(["results", "--reevaluate", "--no-pictures", "--out", str(doc)]) == 0
     out, err = capsys.readouterr()
     assert f"re-evaluated {NAME} on the task compiled now ({now[:12]})" in out
-    assert f"python -m tests.pretrained_regression --write {NAME}" in out
+    assert f"python -m tests.pretrained_regression --write --from-evaluation {NAME}" in out
     assert "measures them again" not in err and stale_figures([NAME]) == []
 
     record = shipped_info(NAME)

@@ -178,8 +178,8 @@ def _paper_protocol_figures(records: list[dict]) -> list[dict]:
     """Each shipped policy's figures under the paper code's protocol (sampled actions) where its
     export measured it; a (table, task, robot) with no such policy keeps its mean-action figures,
     marked. Policies started from demonstrations are left out: the paper learned from the reward
-    alone (they are rows of the full tables). ``table``'s best-of-cell rule then picks the highest return, as the paper kept the best
-    of three seeds."""
+    alone (they are rows of the full tables). ``table``'s best-of-cell rule then picks the highest
+    return, as the paper kept the best of three seeds."""
     figures = []
     for r in records:
         if r["demonstrations"]:  # the paper learned from the reward alone
@@ -193,7 +193,6 @@ def _paper_protocol_figures(records: list[dict]) -> list[dict]:
                 "robot": r["robot"],
                 "trained_steps": r["trained_steps"],
                 "run": r["name"],
-                "demonstrations": bool(r["demonstrations"]),
                 "sampled": r.get("evaluation_sampled") is not None,
                 "mark": "" if r.get("evaluation_sampled") else MEAN_ACTION_MARK,
             }
@@ -309,7 +308,9 @@ def results_block(records: list[dict]) -> str:
 def _compiled_tasks_sentence(record: dict) -> str:
     """Which compiled task the policy trained on, and which its figures were measured on where
     that is another (a policy evaluated again after a change of the code)."""
-    trained, evaluated = record["content_hash"], record.get("evaluated_on_content_hash", record["content_hash"])
+    from ..trained.reevaluate import evaluated_on
+
+    trained, evaluated = record["content_hash"], evaluated_on(record)
     if evaluated == trained:
         return f"Trained and evaluated on the compiled task {trained[:12]}."
     earlier = record.get("earlier_evaluations") or []
