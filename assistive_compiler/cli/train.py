@@ -106,8 +106,9 @@ def add_commands(sub) -> None:
         "sac_laptop's env steps per core-hour) for Feeding and the slow envs (Drinking, Dressing); "
         "ppo_paper_in_process (the paper's PPO, its 36 envs in one process) for "
         "Itch Scratching, whose success is a motion; ppo_one_core for the most env steps per hour and a working "
-        "policy soonest (Arm Manipulation); sac_laptop (SB3, PyTorch) for the higher final figures and what SBX does not do: --coop --engine sb3, "
-        "--demonstrations, the averaged actor, layer-normalised or conservative critics.",
+        "policy soonest (Arm Manipulation); sac_laptop (SB3, PyTorch) for the higher final figures and what SBX does not do: "
+        "--demonstrations, the averaged actor, layer-normalised or conservative critics. Co-optimisation on one core: "
+        "--coop --engine sb3 with ppo_paper_in_process or sac_laptop (one actor per agent, one shared critic).",
     )
     add_library_argument(p)
     p.add_argument("spec", help=SPEC_HELP)

@@ -1,6 +1,6 @@
 """The two agents of a co-optimisation env seen as one Gymnasium env, for learners that train the
-pair with one shared critic (Stable-Baselines3 SAC with one actor per agent:
-:mod:`assistive_compiler.training.learners.factored_actor`).
+pair with one shared critic (Stable-Baselines3 SAC or PPO with one actor per agent:
+:mod:`assistive_compiler.training.learners.factored_actor`, :mod:`~assistive_compiler.training.learners.factored_actor_critic`).
 
 * **Observation**: the robot's observation, then the person's (the PettingZoo env's ``state()``).
 * **Action**: the robot's action, then the person's, each in [−1, 1].
@@ -19,6 +19,16 @@ import gymnasium as gym
 import numpy as np
 
 from .parallel import AssistiveParallelEnv
+
+
+def agent_slices(agent_split: tuple[int, int], obs_size: int, action_size: int) -> tuple[dict, dict]:
+    """Each agent's slice of the joint observation and of the joint action, by agent name
+    (``agent_split``: the robot's observation and action sizes; the person's parts follow them)."""
+    obs_robot, act_robot = agent_split
+    return (
+        {"robot": slice(0, obs_robot), "human": slice(obs_robot, obs_size)},
+        {"robot": slice(0, act_robot), "human": slice(act_robot, action_size)},
+    )
 
 
 class JointAgentsEnv(gym.Env):

@@ -113,13 +113,14 @@ class SB3Policy:
 
 
 class SB3PairPolicy(SB3Policy):
-    """A co-optimised pair trained with SB3 SAC, one actor per agent
-    (:mod:`assistive_compiler.training.learners.factored_actor`): ``(robot_obs, human_obs) -> (a_robot,
-    a_human)``, and each agent alone with :meth:`agent` (its actor reads its own observation only)."""
+    """A co-optimised pair trained with SB3 SAC or PPO, one actor per agent
+    (:mod:`assistive_compiler.training.learners.factored_actor`, :mod:`~assistive_compiler.training.learners.factored_actor_critic`):
+    ``(robot_obs, human_obs) -> (a_robot, a_human)``, and each agent alone with :meth:`agent` (its
+    actor reads its own observation only; PPO's observation normalisation is per entry)."""
 
     def __init__(self, checkpoint: Path, algorithm: str = "sac", stochastic: bool = False, seed: int = 0):
         super().__init__(checkpoint, algorithm, stochastic, seed)
-        self.robot_obs_size, self.robot_action_size = self.model.actor.agent_split
+        self.robot_obs_size, self.robot_action_size = self.model.policy.agent_split
         self.human_obs_size = self.model.observation_space.shape[0] - self.robot_obs_size
 
     def __call__(self, obs: np.ndarray, human_obs: np.ndarray | None = None):

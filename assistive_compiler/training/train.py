@@ -1,7 +1,7 @@
 """``train``: compile the task, open (or resume) a run directory, and hand it to an engine.
 
-Engines: ``sb3`` (Stable-Baselines3 PPO or SAC on one machine; with ``--coop``, SAC with one actor
-per agent and one shared critic) and ``rllib`` (Ray RLlib PPO or SAC: co-optimisation with policies
+Engines: ``sb3`` (Stable-Baselines3 PPO or SAC on one machine; with ``--coop``, one actor per
+agent and one shared critic) and ``rllib`` (Ray RLlib PPO or SAC: co-optimisation with policies
 ``robot`` and ``human``, or any run on a Ray cluster via ``--address``). ``auto`` picks RLlib for
 ``--coop`` or an ``--address``, SB3 otherwise.
 """
@@ -92,15 +92,11 @@ def train(
     config: TrainingConfig = load_training_config(config_path).with_overrides(
         steps=steps, seed=seed, envs=envs, demonstrations=demonstrations, demonstrations_root=demonstrations_root
     )
-    if engine == "sb3" and coop and config.algorithm != "sac":
-        raise UsageError(
-            f"--coop --engine sb3 trains SAC (one actor per agent, one shared critic); {display(Path(config_path))} is "
-            f"{config.algorithm.upper()}: use --engine rllib (or auto) for {config.algorithm.upper()} co-optimisation"
-        )
     if engine == "sb3" and coop and config.library == "sbx":
         raise UsageError(
-            f"--coop --engine sb3 trains one actor per agent, built on SB3's PyTorch SAC; {display(Path(config_path))} "
-            "learns with sbx (sac.library): use a config with library: sb3 (e.g. sac_laptop)"
+            f"--coop --engine sb3 trains one actor per agent, built on SB3's PyTorch PPO and SAC; "
+            f"{display(Path(config_path))} learns with sbx (sac.library): use a config with library: sb3 "
+            "(e.g. sac_laptop, or ppo_paper_in_process)"
         )
     if engine == "rllib":
         from .engines.rllib import check_supported

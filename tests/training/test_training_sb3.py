@@ -815,17 +815,88 @@ def test_a_coop_pair_trains_on_sb3_with_one_critic_and_each_agent_acts_on_its_ow
     assert any(not torch.equal(first[k], v) for k, v in resumed.actor.state_dict().items())
 
 
-def test_coop_on_sb3_is_sac_and_without_demonstrations(tmp_path, capsys):
-    """PPO co-optimisation is RLlib's; SB3 co-optimises with SAC only, and not from demonstrations
-    (a dataset holds the robot's actions alone). Refused before the run directory is written."""
+PPO_TINY_IN_PROCESS = """algorithm: ppo
+network: {hidden: [32, 32], activation: tanh}
+ppo: {rollout_steps: 100, minibatch_size: 50, epochs: 2}
+total_steps: 400
+envs: 2
+vec_env: in_process
+seed: 3
+checkpoint_every_steps: 200
+eval_episodes: 1
+"""
+
+
+def test_a_coop_pair_trains_with_ppo_on_sb3_with_one_value_function(tmp_path, capsys):
+    """``--coop --engine sb3`` with PPO: one actor per agent (each its own hidden layers and mean
+    on its own observation, its own entries of the log-std) and one value function on both
+    observations. The pair exports to two NumPy policies (each with its slice of the observation
+    normalisation) that act as the checkpoint does and play under ``run --coop``; ``--resume``
+    continues the same factored policy; ``evaluate --stochastic`` samples both agents."""
+    import torch
+
+    from assistive_compiler.policies.checkpoint import load_policy
+    from assistive_compiler.policies.pretrained import load_trained
+    from assistive_compiler.training.learners.factored_actor_critic import FactoredActorCriticPolicy
+    from assistive_compiler.training.trained.export import export_run
+
+    config = tmp_path / "ppo_tiny.yaml"
+    config.write_text(PPO_TINY_IN_PROCESS)
+    out = tmp_path / "feeding-coop-ppo"
+    train = ["train", str(FEEDING), "--robot", "jaco", "--coop", "--engine", "sb3", "--config", str(config)]
+    assert main([*train, "--out", str(out), "--quiet"]) == 0
+    run = RunDir(out)
+    assert (run.info().engine, run.info().coop, run.info().algorithm) == ("sb3", True, "ppo")
+    pair = load_policy(run.info(), run.latest_checkpoint()[1])
+    policy = pair.model.policy
+    robot_obs, human_obs = 25, 23  # Feeding, Jaco: the robot's and the person's observation sizes
+    robot_act, human_act = 7, 4
+    assert isinstance(policy, FactoredActorCriticPolicy) and policy.agent_split == (robot_obs, robot_act)
+    heads = policy.mlp_extractor.policy_heads
+    assert (heads["robot"][0].in_features, heads["human"][0].in_features) == (robot_obs, human_obs)
+    assert policy.mlp_extractor.value_net[0].in_features == robot_obs + human_obs  # one critic, both observations
+    assert (policy.action_net.heads["robot"].out_features, policy.action_net.heads["human"].out_features) == (
+        robot_act,
+        human_act,
+    )
+    # the optimiser updates every network the policy acts and values with, the replaced means' included
+    optimised = {id(p) for group in policy.optimizer.param_groups for p in group["params"]}
+    assert optimised == {id(p) for p in policy.parameters()}
+    rng = np.random.default_rng(0)
+    o_robot, o_human = rng.normal(size=robot_obs).astype(np.float32), rng.normal(size=human_obs).astype(np.float32)
+    a_robot, a_human = pair(o_robot, o_human)
+    assert a_robot.shape == (robot_act,) and a_human.shape == (human_act,)
+    other_robot, other_human = pair(o_robot, o_human + 3.0)
+    assert np.array_equal(other_robot, a_robot) and not np.allclose(other_human, a_human)
+    other_robot, other_human = pair(o_robot + 3.0, o_human)
+    assert np.array_equal(other_human, a_human) and not np.allclose(other_robot, a_robot)
+    first = {k: v.clone() for k, v in policy.state_dict().items()}
+
+    record = export_run(out, tmp_path / "pair", episodes=1, seed=7)
+    assert record["coop"] and record["algorithm"] == "ppo" and record["export_max_action_difference"] < 1e-4
+    exported, _ = load_trained(str(tmp_path / "pair"))
+    assert_exported_pair_acts_as(pair, exported, run.artifact)
+    capsys.readouterr()
+    played = ["run", str(FEEDING), "--robot", "jaco", "--coop", "--policy", str(tmp_path / "pair")]
+    assert main([*played, "--episodes", "1", "--seed", "7", "--json", "--quiet"]) == 0
+    assert json.loads(capsys.readouterr().out)["episodes"][0]["return"] == pytest.approx(
+        record["evaluation"]["returns"][0], abs=1e-3
+    )
+    assert record["evaluation_sampled"]["episodes"] == 1  # exported with each agent's log-std: both protocols
+
+    assert main([*train, "--out", str(out), "--resume", "--steps", "600", "--quiet"]) == 0
+    steps, newest = run.latest_checkpoint()
+    resumed = load_policy(run.info(), newest).model.policy
+    assert steps == 600 and isinstance(resumed, FactoredActorCriticPolicy)
+    assert any(not torch.equal(first[k], v) for k, v in resumed.state_dict().items())
+
+
+def test_coop_on_sb3_is_without_demonstrations(tmp_path, capsys):
+    """SB3 co-optimises with its own PPO and SAC (SBX's refusal: test_training_sbx.py), not from
+    demonstrations (a dataset holds the robot's actions alone). Refused before the run directory is
+    written."""
     out = tmp_path / "run"
     train = ["train", str(FEEDING), "--robot", "jaco", "--coop", "--engine", "sb3", "--out", str(out)]
-    assert main([*train, "--config", "ppo_laptop"]) == 2
-    assert capsys.readouterr().err.strip().splitlines()[-1] == (
-        "error: --coop --engine sb3 trains SAC (one actor per agent, one shared critic); "
-        "specs/training/ppo_laptop.yaml is PPO: "
-        "use --engine rllib (or auto) for PPO co-optimisation"
-    )
     assert main([*train, "--config", "sac_demos", "--demonstrations", "assistive_compiler/feeding-jaco/any-v0"]) == 2
     assert capsys.readouterr().err.strip().splitlines()[-1] == (
         "error: --demonstrations: starting from demonstrations is for single-agent SB3 SAC (--engine sb3)"

@@ -3,9 +3,10 @@
 The envs are SB3's process-based vector env (:class:`SubprocVecEnv`; one env runs in-process),
 each a :class:`~assistive_compiler.runtime.env.AssistiveEnv` built from the run's compiled
 artifact, optionally (PPO) behind :class:`VecNormalize` (running observation and return
-statistics, saved with every checkpoint). A co-optimisation run (``coop``, SAC only) trains the
-robot and the person together: each env is :class:`~assistive_compiler.coop.joint.JointAgentsEnv`
-and the actor one network per agent with one shared critic (:mod:`.learners.factored_actor`).
+statistics, saved with every checkpoint). A co-optimisation run (``coop``) trains the robot and
+the person together: each env is :class:`~assistive_compiler.coop.joint.JointAgentsEnv` and the
+actor one network per agent with one shared critic (SAC: :mod:`.learners.factored_actor`; PPO:
+:mod:`.learners.factored_actor_critic`).
 The model itself, and the SAC settings that change its updates, come from :mod:`.learners`
 (:func:`.learners.choice.new_model`, :func:`.learners.sac.set_up_sac`): this module runs it.
 
@@ -161,7 +162,7 @@ def train(
     """Train (or continue) the run to ``config.total_steps``; returns the session's figures.
     ``timer`` (:class:`.throughput.StageTimer`, for ``bench --training``) times the env steps and
     the learner's updates of this session.
-    ``coop`` (SAC): the robot and the person together, one actor each and one critic.
+    ``coop``: the robot and the person together, one actor each and one critic.
 
     A new run given ``demonstrations`` (:class:`.learners.demonstrations.DemonstrationData`) starts from
     them: its actor cloned, its replay buffer filled, its critics warmed up and a checkpoint

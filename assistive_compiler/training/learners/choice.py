@@ -11,11 +11,11 @@ from ..config import TrainingConfig
 
 def new_model(venv, config: TrainingConfig, run: RunDir, agent_split: tuple[int, int] | None = None):
     """A new model of the config's algorithm on ``venv`` (``agent_split``: a co-optimised pair's
-    robot observation and action sizes, SAC only)."""
+    robot observation and action sizes: one actor per agent)."""
     if config.sac is not None:
         from .sac import new_sac
 
         return new_sac(venv, config, run, agent_split)
     from .ppo import new_ppo
 
-    return new_ppo(venv, config, run)
+    return new_ppo(venv, config, run, agent_split)

@@ -22,6 +22,7 @@ from stable_baselines3.sac.policies import LOG_STD_MAX, LOG_STD_MIN, Actor, SACP
 from torch import nn
 
 from ...artifact import AGENTS
+from ...coop.joint import agent_slices
 from .critics import LayerNormSACPolicy
 
 
@@ -46,12 +47,11 @@ class FactoredActor(Actor):
         super().__init__(*args, **kwargs)
         if self.use_sde:
             raise ValueError("a factored actor has Gaussian heads; gSDE (use_sde) is not supported")
-        obs_robot, act_robot = agent_split
-        obs_size, act_size = self.features_dim, get_action_dim(self.action_space)
-        self.agent_split = (int(obs_robot), int(act_robot))
+        self.agent_split = (int(agent_split[0]), int(agent_split[1]))
         #: Each agent's slice of the (flattened) joint observation and of the joint action.
-        self.obs_slices = {"robot": slice(0, obs_robot), "human": slice(obs_robot, obs_size)}
-        self.action_slices = {"robot": slice(0, act_robot), "human": slice(act_robot, act_size)}
+        self.obs_slices, self.action_slices = agent_slices(
+            self.agent_split, self.features_dim, get_action_dim(self.action_space)
+        )
         self.heads = nn.ModuleDict(
             {
                 agent: AgentHead(
@@ -84,15 +84,16 @@ class FactoredSACPolicy(SACPolicy):
     """SB3's SAC policy with a :class:`FactoredActor` (``agent_split`` in ``policy_kwargs``)."""
 
     def __init__(self, *args, agent_split: tuple[int, int], **kwargs):
-        self._agent_split = tuple(agent_split)  # make_actor runs inside SACPolicy.__init__
+        #: (robot observation size, robot action size), as :class:`FactoredActor` has it.
+        self.agent_split = (int(agent_split[0]), int(agent_split[1]))  # make_actor runs inside SACPolicy.__init__
         super().__init__(*args, **kwargs)
 
     def make_actor(self, features_extractor=None) -> Actor:
         actor_kwargs = self._update_features_extractor(self.actor_kwargs, features_extractor)
-        return FactoredActor(**actor_kwargs, agent_split=self._agent_split).to(self.device)
+        return FactoredActor(**actor_kwargs, agent_split=self.agent_split).to(self.device)
 
     def _get_constructor_parameters(self) -> dict:
-        return super()._get_constructor_parameters() | {"agent_split": self._agent_split}
+        return super()._get_constructor_parameters() | {"agent_split": self.agent_split}
 
 
 class FactoredLayerNormSACPolicy(FactoredSACPolicy, LayerNormSACPolicy):

@@ -54,15 +54,55 @@ def _sac_actor(actor, activation: str, low: np.ndarray, high: np.ndarray) -> MLP
     return MLPPolicy(layers, activation, "tanh", low, high, log_std=log_std, log_std_bounds=(LOG_STD_MIN, LOG_STD_MAX))
 
 
-def pair_from_sb3(loaded, activation: str) -> dict[str, MLPPolicy]:
-    """Each agent's deterministic policy of a co-optimised SB3 SAC checkpoint
-    (:class:`~assistive_compiler.policies.checkpoint.SB3PairPolicy`), by agent name."""
-    actor, space = loaded.model.actor, loaded.model.action_space
+def _ppo_actor(
+    loaded, linears, activation: str, actions: slice = slice(None), observations: slice = slice(None)
+) -> MLPPolicy:
+    """PPO's Gaussian mean (the ``linears`` from observation to mean), clipped to the action
+    bounds, with its observation normalisation if it used one and its free log-std vector; the
+    ``actions`` and ``observations`` slices pick one agent's part of a co-optimised pair's."""
+    model = loaded.model
+    low, high = model.action_space.low[actions], model.action_space.high[actions]
+    free = model.policy.log_std.detach().cpu().numpy().astype(np.float64)[actions]  # one vector, whatever the state
+    if loaded.obs_rms is None:
+        return MLPPolicy(_layers(linears), activation, "clip", low, high, log_std=free)
+    rms = loaded.obs_rms
+    return MLPPolicy(
+        _layers(linears),
+        activation,
+        "clip",
+        low,
+        high,
+        rms.mean[observations],
+        rms.var[observations],
+        loaded.clip,
+        loaded.eps,
+        log_std=free,
+    )
+
+
+def pair_from_sb3(loaded, algorithm: str, activation: str) -> dict[str, MLPPolicy]:
+    """Each agent's deterministic policy of a co-optimised SB3 checkpoint
+    (:class:`~assistive_compiler.policies.checkpoint.SB3PairPolicy`: SAC's factored actor, or PPO's
+    factored actor-critic), by agent name."""
+    model = loaded.model
+    if algorithm == "sac":
+        actor, space = model.actor, model.action_space
+        return {
+            agent: _sac_actor(
+                head, activation, space.low[actor.action_slices[agent]], space.high[actor.action_slices[agent]]
+            )
+            for agent, head in actor.heads.items()
+        }
+    policy = model.policy
     return {
-        agent: _sac_actor(
-            head, activation, space.low[actor.action_slices[agent]], space.high[actor.action_slices[agent]]
+        agent: _ppo_actor(
+            loaded,
+            _linears(head) + [policy.action_net.heads[agent]],
+            activation,
+            policy.action_slices[agent],
+            policy.obs_slices[agent],
         )
-        for agent, head in actor.heads.items()
+        for agent, head in policy.mlp_extractor.policy_heads.items()
     }
 
 
@@ -70,27 +110,11 @@ def mlp_from_sb3(loaded, algorithm: str, activation: str) -> MLPPolicy:
     """The deterministic policy of a loaded SB3 checkpoint (:class:`~assistive_compiler.policies.checkpoint.SB3Policy`: SAC's actor
     mean through tanh; PPO's Gaussian mean, clipped), with PPO's observation normalisation if it used one."""
     model = loaded.model
-    low, high = model.action_space.low, model.action_space.high
     if loaded.numpy_policy is not None:  # SBX's SAC: its actor as the checkpoint already acts with it
         return loaded.numpy_policy
     if algorithm == "sac":
-        return _sac_actor(model.actor, activation, low, high)
-    layers = _layers(_linears(model.policy.mlp_extractor.policy_net) + [model.policy.action_net])
-    free = model.policy.log_std.detach().cpu().numpy().astype(np.float64)  # one vector, whatever the state
-    if loaded.obs_rms is None:
-        return MLPPolicy(layers, activation, "clip", low, high, log_std=free)
-    return MLPPolicy(
-        layers,
-        activation,
-        "clip",
-        low,
-        high,
-        loaded.obs_rms.mean,
-        loaded.obs_rms.var,
-        loaded.clip,
-        loaded.eps,
-        log_std=free,
-    )
+        return _sac_actor(model.actor, activation, model.action_space.low, model.action_space.high)
+    return _ppo_actor(loaded, _linears(model.policy.mlp_extractor.policy_net) + [model.policy.action_net], activation)
 
 
 def mlp_from_rllib(module, algorithm: str, activation: str) -> MLPPolicy:
@@ -226,7 +250,7 @@ def export_run(
         agents: SB3PairPolicy | RLlibPolicy  # each agent's checkpoint policy, by name: .agent(name)
         if info.engine == "sb3":
             agents = SB3PairPolicy(checkpoint, config.algorithm)
-            parts = pair_from_sb3(agents, config.network.activation)
+            parts = pair_from_sb3(agents, config.algorithm, config.network.activation)
         else:
             agents = RLlibPolicy(checkpoint, info.coop, config.algorithm)
             parts = {
