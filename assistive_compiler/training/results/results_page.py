@@ -132,8 +132,9 @@ def _settings(r: dict) -> tuple:
 
 def _claim_row(coop: dict, records: list[dict]) -> list[str] | None:
     """A co-optimised cell against the static-person cell of the same task, robot and algorithm —
-    of the same settings where there is one — with the nearest budget: success (env steps, policy)
-    each; None when there is no such static cell."""
+    of the same settings where there is one — with the nearest budget: success with sampled actions
+    where the policy kept its log-std, and with the mean action (env steps, policy), each; None when
+    there is no such static cell."""
     static = [
         r
         for r in records
@@ -144,7 +145,10 @@ def _claim_row(coop: dict, records: list[dict]) -> list[str] | None:
     s = min(static, key=lambda r: (_settings(r) != _settings(coop), abs(r["trained_steps"] - coop["trained_steps"])))
 
     def cell(r: dict) -> str:
-        return f"{100 * r['evaluation']['success_rate']:.0f}% ({r['trained_steps']:,} steps, `{r['name']}`)"
+        mean = f"{100 * r['evaluation']['success_rate']:.0f}% mean action"
+        sampled = r.get("evaluation_sampled")
+        figures = f"{100 * sampled['success_rate']:.0f}% sampled, {mean}" if sampled else mean
+        return f"{figures} ({r['trained_steps']:,} steps, `{r['name']}`)"
 
     return [
         TASK_TITLES[coop["task"]],
@@ -274,7 +278,9 @@ def results_block(records: list[dict]) -> str:
     if claim:
         parts.append(
             "Each co-optimised cell beside the static-person cell of the same task, robot and algorithm "
-            "(of the same settings where one has them, then the nearest budget); the same evaluation seeds.\n"
+            "(of the same settings where one has them, then the nearest budget); the same evaluation seeds, "
+            "success with actions sampled from the policy (the paper code's protocol) where both kept their "
+            "log-std, and with the mean action.\n"
         )
         parts.append(
             markdown_table(["Task", "Robot", "Algorithm", "Static person", "Active person (co-optimised)"], claim)
