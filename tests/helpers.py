@@ -64,6 +64,26 @@ def cli(*args: str, cwd: Path | None = None, env: dict | None = None, timeout: f
     return proc.returncode, proc.stdout, proc.stderr
 
 
+def assert_each_agent_acts_on_its_own_observation(pair, sizes: tuple[int, int, int, int]) -> None:
+    """A co-optimised checkpoint ``pair`` ((robot_obs, human_obs) -> (a_robot, a_human)) whose
+    actors read only their own agent's observation: changing one agent's observation changes that
+    agent's action and leaves the other's as it was; each agent alone (``pair.agent``) acts as in
+    the pair. ``sizes``: robot and person observation sizes, robot and person action sizes."""
+    import numpy as np
+
+    robot_obs, human_obs, robot_act, human_act = sizes
+    rng = np.random.default_rng(0)
+    o_robot, o_human = rng.normal(size=robot_obs).astype(np.float32), rng.normal(size=human_obs).astype(np.float32)
+    a_robot, a_human = pair(o_robot, o_human)
+    assert a_robot.shape == (robot_act,) and a_human.shape == (human_act,)
+    other_robot, other_human = pair(o_robot, o_human + 3.0)
+    assert np.array_equal(other_robot, a_robot) and not np.allclose(other_human, a_human)
+    other_robot, other_human = pair(o_robot + 3.0, o_human)
+    assert np.array_equal(other_human, a_human) and not np.allclose(other_robot, a_robot)
+    assert np.array_equal(pair.agent("robot")(o_robot), a_robot)
+    assert np.array_equal(pair.agent("human")(o_human), a_human)
+
+
 def assert_exported_pair_acts_as(checkpoint_pair, exported, artifact: Path, seed: int = 7) -> None:
     """On the observations of a real co-optimised episode of ``artifact`` (seed ``seed``, played by
     ``checkpoint_pair``), each agent of the ``exported`` pair acts as the checkpoint's, to float32

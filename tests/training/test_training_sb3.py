@@ -22,7 +22,7 @@ from PIL import Image
 pytest.importorskip("stable_baselines3", reason='needs the "train" extra (README: Training); CI installs it')
 
 from conftest import built_once
-from helpers import assert_exported_pair_acts_as
+from helpers import assert_each_agent_acts_on_its_own_observation, assert_exported_pair_acts_as
 
 from assistive_compiler.artifact import Manifest
 from assistive_compiler.cli import main
@@ -753,6 +753,23 @@ def test_run_render_and_evaluate_take_a_run_directory_or_an_exported_policy(reac
 
 
 FEEDING = REPO / "specs" / "tasks" / "feeding.yaml"
+#: Feeding × Jaco co-optimised: the robot's and the person's observation sizes, then their action sizes.
+FEEDING_JACO_PAIR = (25, 23, 7, 4)
+
+
+def _train_coop_pair(tmp_path: Path, config_text: str, algorithm: str):
+    """``train --coop --engine sb3`` on Feeding × Jaco with the config ``config_text``: the run
+    directory, its :class:`RunDir`, the train command (to resume with) and the checkpoint's pair."""
+    from assistive_compiler.policies.checkpoint import load_policy
+
+    config = tmp_path / f"{algorithm}_tiny.yaml"
+    config.write_text(config_text)
+    out = tmp_path / f"feeding-coop-{algorithm}"
+    train = ["train", str(FEEDING), "--robot", "jaco", "--coop", "--engine", "sb3", "--config", str(config)]
+    assert main([*train, "--out", str(out), "--quiet"]) == 0
+    run = RunDir(out)
+    assert (run.info().engine, run.info().coop, run.info().algorithm) == ("sb3", True, algorithm)
+    return out, run, train, load_policy(run.info(), run.latest_checkpoint()[1])
 
 
 def test_a_coop_pair_trains_on_sb3_with_one_critic_and_each_agent_acts_on_its_own_observation(tmp_path, capsys):
@@ -767,32 +784,14 @@ def test_a_coop_pair_trains_on_sb3_with_one_critic_and_each_agent_acts_on_its_ow
     from assistive_compiler.training.learners.factored_actor import FactoredActor
     from assistive_compiler.training.trained.export import export_run
 
-    config = tmp_path / "sac_tiny.yaml"
-    config.write_text(SAC_TINY)
-    out = tmp_path / "feeding-coop-sac"
-    train = ["train", str(FEEDING), "--robot", "jaco", "--coop", "--engine", "sb3", "--config", str(config)]
-    assert main([*train, "--out", str(out), "--quiet"]) == 0
-    run = RunDir(out)
-    assert (run.info().engine, run.info().coop, run.info().algorithm) == ("sb3", True, "sac")
-    pair = load_policy(run.info(), run.latest_checkpoint()[1])
+    out, run, train, pair = _train_coop_pair(tmp_path, SAC_TINY, "sac")
     model = pair.model
-    robot_obs, human_obs = 25, 23  # Feeding, Jaco: the robot's and the person's observation sizes
-    robot_act, human_act = 7, 4
+    robot_obs, human_obs, robot_act, human_act = FEEDING_JACO_PAIR
     assert isinstance(model.actor, FactoredActor) and model.actor.agent_split == (robot_obs, robot_act)
     # One critic for the pair: both observations and both actions in.
     assert model.critic.q_networks[0][0].in_features == robot_obs + human_obs + robot_act + human_act
     # Each actor learnt (its weights moved from their start) and reads only its own observation.
-    rng = np.random.default_rng(0)
-    o_robot, o_human = rng.normal(size=robot_obs).astype(np.float32), rng.normal(size=human_obs).astype(np.float32)
-    a_robot, a_human = pair(o_robot, o_human)
-    assert a_robot.shape == (robot_act,) and a_human.shape == (human_act,)
-    other_robot, other_human = pair(o_robot, o_human + 3.0)
-    assert np.array_equal(other_robot, a_robot) and not np.allclose(other_human, a_human)
-    other_robot, other_human = pair(o_robot + 3.0, o_human)
-    assert np.array_equal(other_human, a_human) and not np.allclose(other_robot, a_robot)
-    assert np.array_equal(pair.agent("robot")(o_robot), a_robot) and np.array_equal(
-        pair.agent("human")(o_human), a_human
-    )
+    assert_each_agent_acts_on_its_own_observation(pair, FEEDING_JACO_PAIR)
     first = {k: v.clone() for k, v in model.actor.state_dict().items()}
 
     # Export: two NumPy policies, each acting as the checkpoint's on a real co-optimised episode.
@@ -840,17 +839,9 @@ def test_a_coop_pair_trains_with_ppo_on_sb3_with_one_value_function(tmp_path, ca
     from assistive_compiler.training.learners.factored_actor_critic import FactoredActorCriticPolicy
     from assistive_compiler.training.trained.export import export_run
 
-    config = tmp_path / "ppo_tiny.yaml"
-    config.write_text(PPO_TINY_IN_PROCESS)
-    out = tmp_path / "feeding-coop-ppo"
-    train = ["train", str(FEEDING), "--robot", "jaco", "--coop", "--engine", "sb3", "--config", str(config)]
-    assert main([*train, "--out", str(out), "--quiet"]) == 0
-    run = RunDir(out)
-    assert (run.info().engine, run.info().coop, run.info().algorithm) == ("sb3", True, "ppo")
-    pair = load_policy(run.info(), run.latest_checkpoint()[1])
+    out, run, train, pair = _train_coop_pair(tmp_path, PPO_TINY_IN_PROCESS, "ppo")
     policy = pair.model.policy
-    robot_obs, human_obs = 25, 23  # Feeding, Jaco: the robot's and the person's observation sizes
-    robot_act, human_act = 7, 4
+    robot_obs, human_obs, robot_act, human_act = FEEDING_JACO_PAIR
     assert isinstance(policy, FactoredActorCriticPolicy) and policy.agent_split == (robot_obs, robot_act)
     heads = policy.mlp_extractor.policy_heads
     assert (heads["robot"][0].in_features, heads["human"][0].in_features) == (robot_obs, human_obs)
@@ -862,14 +853,7 @@ def test_a_coop_pair_trains_with_ppo_on_sb3_with_one_value_function(tmp_path, ca
     # the optimiser updates every network the policy acts and values with, the replaced means' included
     optimised = {id(p) for group in policy.optimizer.param_groups for p in group["params"]}
     assert optimised == {id(p) for p in policy.parameters()}
-    rng = np.random.default_rng(0)
-    o_robot, o_human = rng.normal(size=robot_obs).astype(np.float32), rng.normal(size=human_obs).astype(np.float32)
-    a_robot, a_human = pair(o_robot, o_human)
-    assert a_robot.shape == (robot_act,) and a_human.shape == (human_act,)
-    other_robot, other_human = pair(o_robot, o_human + 3.0)
-    assert np.array_equal(other_robot, a_robot) and not np.allclose(other_human, a_human)
-    other_robot, other_human = pair(o_robot + 3.0, o_human)
-    assert np.array_equal(other_human, a_human) and not np.allclose(other_robot, a_robot)
+    assert_each_agent_acts_on_its_own_observation(pair, FEEDING_JACO_PAIR)
     first = {k: v.clone() for k, v in policy.state_dict().items()}
 
     record = export_run(out, tmp_path / "pair", episodes=1, seed=7)

@@ -18,9 +18,9 @@ policy class and ``agent_split`` (in ``policy_kwargs``), so it loads (``PPO.load
 
 from __future__ import annotations
 
-import numpy as np
 import torch
 from stable_baselines3.common.policies import ActorCriticPolicy
+from stable_baselines3.common.preprocessing import get_action_dim
 from stable_baselines3.common.torch_layers import create_mlp
 from torch import nn
 
@@ -89,7 +89,7 @@ class FactoredActorCriticPolicy(ActorCriticPolicy):
 
     def _build_mlp_extractor(self) -> None:
         self.obs_slices, self.action_slices = agent_slices(
-            self.agent_split, self.features_dim, int(np.prod(self.action_space.shape))
+            self.agent_split, self.features_dim, get_action_dim(self.action_space)
         )
         self.mlp_extractor = FactoredExtractor(self.features_dim, self.net_arch, self.activation_fn, self.obs_slices)
 

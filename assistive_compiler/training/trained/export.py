@@ -63,21 +63,18 @@ def _ppo_actor(
     model = loaded.model
     low, high = model.action_space.low[actions], model.action_space.high[actions]
     free = model.policy.log_std.detach().cpu().numpy().astype(np.float64)[actions]  # one vector, whatever the state
-    if loaded.obs_rms is None:
-        return MLPPolicy(_layers(linears), activation, "clip", low, high, log_std=free)
     rms = loaded.obs_rms
-    return MLPPolicy(
-        _layers(linears),
-        activation,
-        "clip",
-        low,
-        high,
-        rms.mean[observations],
-        rms.var[observations],
-        loaded.clip,
-        loaded.eps,
-        log_std=free,
+    normalisation = (
+        {}
+        if rms is None
+        else {
+            "obs_mean": rms.mean[observations],
+            "obs_var": rms.var[observations],
+            "obs_clip": loaded.clip,
+            "obs_eps": loaded.eps,
+        }
     )
+    return MLPPolicy(_layers(linears), activation, "clip", low, high, log_std=free, **normalisation)
 
 
 def pair_from_sb3(loaded, algorithm: str, activation: str) -> dict[str, MLPPolicy]:
